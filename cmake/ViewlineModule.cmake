@@ -1,0 +1,65 @@
+# Helpers that declare a module, a test, a benchmark and an app the same way everywhere.
+
+# Compiler warnings as an INTERFACE target (no global flags).
+if(NOT TARGET viewline_warnings)
+  add_library(viewline_warnings INTERFACE)
+  target_compile_options(viewline_warnings INTERFACE
+    $<$<CXX_COMPILER_ID:GNU,Clang>:-Wall -Wextra -Wpedantic -Wshadow -Wnon-virtual-dtor -Wold-style-cast -Wcast-align -Woverloaded-virtual -Wnull-dereference -Wdouble-promotion -Wformat=2>)
+  if(VIEWLINE_WARNINGS_AS_ERRORS)
+    target_compile_options(viewline_warnings INTERFACE $<$<CXX_COMPILER_ID:GNU,Clang>:-Werror>)
+  endif()
+  target_compile_features(viewline_warnings INTERFACE cxx_std_17)
+  add_library(viewline::warnings ALIAS viewline_warnings)
+endif()
+
+# viewline_add_module(<name> SOURCES a.cpp ... DEPENDS <targets>... [PRIVATE_DEPENDS ...])
+# Creates target viewline_<name>, alias viewline::<name>, headers under include/viewline/<name>.
+function(viewline_add_module name)
+  cmake_parse_arguments(ARG "" "" "SOURCES;DEPENDS;PRIVATE_DEPENDS" ${ARGN})
+  set(target viewline_${name})
+  add_library(${target} STATIC ${ARG_SOURCES})
+  add_library(viewline::${name} ALIAS ${target})
+  target_include_directories(${target} PUBLIC
+    $<BUILD_INTERFACE:${CMAKE_CURRENT_SOURCE_DIR}/include>)
+  target_link_libraries(${target} PUBLIC ${ARG_DEPENDS} PRIVATE viewline::warnings ${ARG_PRIVATE_DEPENDS})
+  target_compile_features(${target} PUBLIC cxx_std_17)
+  set_target_properties(${target} PROPERTIES CXX_EXTENSIONS OFF POSITION_INDEPENDENT_CODE ON)
+endfunction()
+
+# viewline_add_test(<name> SOURCES ... DEPENDS ... [LABELS ...] [TIMEOUT s])
+# One GoogleTest executable; every TEST() becomes a ctest test.
+function(viewline_add_test name)
+  if(NOT VIEWLINE_BUILD_TESTS)
+    return()
+  endif()
+  cmake_parse_arguments(ARG "" "TIMEOUT" "SOURCES;DEPENDS;LABELS" ${ARGN})
+  if(NOT ARG_TIMEOUT)
+    set(ARG_TIMEOUT 300)
+  endif()
+  add_executable(${name} ${ARG_SOURCES})
+  target_link_libraries(${name} PRIVATE ${ARG_DEPENDS} GTest::gtest GTest::gtest_main viewline::warnings)
+  set_target_properties(${name} PROPERTIES CXX_EXTENSIONS OFF)
+  gtest_discover_tests(${name}
+    WORKING_DIRECTORY ${PROJECT_SOURCE_DIR}
+    PROPERTIES LABELS "${ARG_LABELS}" TIMEOUT ${ARG_TIMEOUT}
+    DISCOVERY_TIMEOUT 60)
+endfunction()
+
+# viewline_add_bench(<name> SOURCES ... DEPENDS ...)
+function(viewline_add_bench name)
+  if(NOT VIEWLINE_BUILD_BENCH)
+    return()
+  endif()
+  cmake_parse_arguments(ARG "" "" "SOURCES;DEPENDS" ${ARGN})
+  add_executable(${name} ${ARG_SOURCES})
+  target_link_libraries(${name} PRIVATE ${ARG_DEPENDS} benchmark::benchmark viewline::warnings)
+  set_target_properties(${name} PROPERTIES CXX_EXTENSIONS OFF RUNTIME_OUTPUT_DIRECTORY ${PROJECT_BINARY_DIR}/bench)
+endfunction()
+
+# viewline_add_app(<name> SOURCES ... DEPENDS ...): executables land in <build>/bin.
+function(viewline_add_app name)
+  cmake_parse_arguments(ARG "" "" "SOURCES;DEPENDS" ${ARGN})
+  add_executable(${name} ${ARG_SOURCES})
+  target_link_libraries(${name} PRIVATE ${ARG_DEPENDS} viewline::warnings)
+  set_target_properties(${name} PROPERTIES CXX_EXTENSIONS OFF RUNTIME_OUTPUT_DIRECTORY ${PROJECT_BINARY_DIR}/bin)
+endfunction()
