@@ -1,0 +1,52 @@
+#pragma once
+// Writing output files so that a crash or an error never leaves a half-written
+// file: content goes to a temporary file next to the target, which is renamed
+// over the target (rename is atomic on POSIX within one file system).
+
+#include <map>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+namespace viewline::io {
+
+/// Writes `content` to `path` atomically (tmp file + rename). Creates missing parent
+/// directories. Throws core::InvalidInput naming the path on failure (the target is untouched).
+void writeTextFileAtomic(const std::string& path, const std::string& content);
+
+/// nlohmann::json to a file, atomically (e.g. an app's --summary FILE).
+void writeJsonFile(const std::string& path, const nlohmann::json& j, int indent = 2);
+/// Reads a JSON file; errors name the file and the parse position.
+nlohmann::json readJsonFile(const std::string& path);
+
+/// All-or-nothing output of several files, whoever writes them (ofstream, cv::FileStorage,
+/// vpXmlParserCamera...):
+///
+///   io::StagedFiles out;
+///   writeSomething(out.stage("a.xml"));   // returns a temporary path next to a.xml
+///   writeOther(out.stage("b.yaml"));
+///   out.commit();                         // renames all; until then no target is touched
+///
+/// If commit() is never reached (an exception), the destructor deletes the temporaries.
+class StagedFiles {
+public:
+  StagedFiles() = default;
+  StagedFiles(const StagedFiles&) = delete;
+  StagedFiles& operator=(const StagedFiles&) = delete;
+  ~StagedFiles();
+
+  /// A fresh temporary path (not existing) for the final `path`; creates parent directories.
+  std::string stage(const std::string& path);
+  /// Checks every temporary exists, then renames them onto their targets.
+  void commit();
+  /// Deletes all temporaries (also done by the destructor when not committed).
+  void discard();
+  /// Final paths staged so far.
+  std::vector<std::string> targets() const;
+
+private:
+  std::vector<std::pair<std::string, std::string>> files_;  // (tmp, final)
+  bool committed_ = false;
+};
+
+}  // namespace viewline::io

@@ -1,0 +1,172 @@
+#include "viewline/io/camera_io.h"
+
+#include <filesystem>
+#include <opencv2/core.hpp>
+#include <visp3/core/vpException.h>
+#include <visp3/core/vpXmlParserCamera.h>
+
+#include "viewline/core/error.h"
+#include "viewline/io/files.h"
+
+namespace fs = std::filesystem;
+
+namespace viewline::io {
+namespace {
+vpCameraParameters::vpCameraParametersProjType toVisp(Projection p) {
+  return p == Projection::WithDistortion ? vpCameraParameters::perspectiveProjWithDistortion
+                                         : vpCameraParameters::perspectiveProjWithoutDistortion;
+}
+
+std::string extensionOf(const std::string& path) {
+  std::string e = fs::path(path).extension().string();
+  for (auto& c : e) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return e;
+}
+}  // namespace
+
+std::string toString(Projection p) {
+  return p == Projection::WithDistortion ? "with_distortion" : "without_distortion";
+}
+
+Projection projectionFromString(const std::string& s) {
+  if (s == "with_distortion") return Projection::WithDistortion;
+  if (s == "without_distortion") return Projection::WithoutDistortion;
+  throw core::InvalidInput("projection '" + s + "': expected with_distortion or without_distortion");
+}
+
+CameraXml loadVispCameraXml(const std::string& path, const std::string& camera_name, Projection projection,
+                            unsigned width, unsigned height) {
+  if (!fs::is_regular_file(path)) throw core::InvalidInput(path + ": camera XML file does not exist");
+  vpXmlParserCamera parser;
+  vpCameraParameters cam;
+  int status = vpXmlParserCamera::SEQUENCE_ERROR;
+  try {
+    status = parser.parse(cam, path, camera_name, toVisp(projection), width, height);
+  } catch (const vpException& e) {
+    throw core::InvalidInput(path + ": cannot parse the ViSP camera XML: " + e.getStringMessage());
+  }
+  if (status != vpXmlParserCamera::SEQUENCE_OK || cam.get_projModel() != toVisp(projection)) {
+    std::string size = (width || height) ? " of size " + std::to_string(width) + "x" + std::to_string(height) : "";
+    throw core::InvalidInput(path + ": no camera named '" + camera_name + "'" + size + " with model " +
+                             toString(projection) + " (vpXmlParserCamera)");
+  }
+  if (!(cam.get_px() > 0.0) || !(cam.get_py() > 0.0))
+    throw core::InvalidInput(path + ": camera '" + camera_name + "': px and py must be positive");
+  CameraXml out;
+  out.intrinsics = cam;
+  out.width = parser.getWidth();
+  out.height = parser.getHeight();
+  return out;
+}
+
+void writeVispCameraXmlTo(const std::string& path, const std::string& camera_name,
+                          const vpCameraParameters& without_distortion,
+                          const std::optional<vpCameraParameters>& with_distortion, unsigned width,
+                          unsigned height, const std::string& additional_info) {
+  if (camera_name.empty()) throw core::InvalidInput(path + ": camera name must not be empty");
+  if (without_distortion.get_projModel() != vpCameraParameters::perspectiveProjWithoutDistortion)
+    throw core::InvalidInput(path + ": the first model must be the one without distortion");
+  if (with_distortion && with_distortion->get_projModel() != vpCameraParameters::perspectiveProjWithDistortion)
+    throw core::InvalidInput(path + ": the second model must be the one with distortion");
+  std::error_code ec;
+  fs::remove(path, ec);  // vpXmlParserCamera::save merges into an existing file: start afresh
+  vpXmlParserCamera parser;
+  if (parser.save(without_distortion, path, camera_name, width, height, additional_info) !=
+      vpXmlParserCamera::SEQUENCE_OK)
+    throw core::InvalidInput(path + ": vpXmlParserCamera could not save camera '" + camera_name + "'");
+  if (with_distortion && parser.save(*with_distortion, path, camera_name, width, height) !=
+                             vpXmlParserCamera::SEQUENCE_OK)
+    throw core::InvalidInput(path + ": vpXmlParserCamera could not save the distortion model of '" +
+                             camera_name + "'");
+}
+
+void saveVispCameraXml(const std::string& path, const std::string& camera_name,
+                       const vpCameraParameters& without_distortion,
+                       const std::optional<vpCameraParameters>& with_distortion, unsigned width, unsigned height,
+                       const std::string& additional_info) {
+  StagedFiles out;
+  std::string tmp = out.stage(path);
+  tmp += ".xml";  // vpXmlParserCamera wants an .xml name
+  writeVispCameraXmlTo(tmp, camera_name, without_distortion, with_distortion, width, height, additional_info);
+  std::error_code ec;
+  fs::rename(tmp, fs::path(tmp).replace_extension().string(), ec);
+  if (ec) throw core::InvalidInput(path + ": cannot write: " + ec.message());
+  out.commit();
+}
+
+OpenCvIntrinsics loadOpenCvIntrinsics(const std::string& path) {
+  if (!fs::is_regular_file(path)) throw core::InvalidInput(path + ": OpenCV intrinsics file does not exist");
+  cv::FileStorage fsr;
+  try {
+    fsr.open(path, cv::FileStorage::READ);
+  } catch (const cv::Exception& e) {
+    throw core::InvalidInput(path + ": cannot parse as OpenCV FileStorage: " + e.what());
+  }
+  if (!fsr.isOpened()) throw core::InvalidInput(path + ": cannot open as OpenCV FileStorage");
+  cv::Mat K, D;
+  OpenCvIntrinsics out;
+  try {
+    fsr["camera_matrix"] >> K;
+    fsr["distortion_coefficients"] >> D;
+    int w = 0, h = 0;
+    fsr["image_width"] >> w;
+    fsr["image_height"] >> h;
+    if (w < 0 || h < 0) throw core::InvalidInput(path + ": image_width/image_height must be positive");
+    out.width = static_cast<unsigned>(w);
+    out.height = static_cast<unsigned>(h);
+    if (!fsr["avg_reprojection_error"].empty()) fsr["avg_reprojection_error"] >> out.rms_px;
+  } catch (const cv::Exception& e) {
+    throw core::InvalidInput(path + ": bad OpenCV intrinsics: " + e.what());
+  }
+  if (K.rows != 3 || K.cols != 3)
+    throw core::InvalidInput(path + ": 'camera_matrix' missing or not a 3x3 matrix");
+  K.convertTo(K, CV_64F);
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) out.camera_matrix(r, c) = K.at<double>(r, c);
+  if (!D.empty()) {
+    D.convertTo(D, CV_64F);
+    D = D.reshape(1, static_cast<int>(D.total()));
+    out.distortion.resize(static_cast<Eigen::Index>(D.total()));
+    for (int i = 0; i < static_cast<int>(D.total()); ++i) out.distortion(i) = D.at<double>(i);
+  } else {
+    out.distortion = Eigen::VectorXd::Zero(5);
+  }
+  if (!(out.camera_matrix(0, 0) > 0.0) || !(out.camera_matrix(1, 1) > 0.0) || !out.camera_matrix.allFinite())
+    throw core::InvalidInput(path + ": 'camera_matrix' must have positive finite focal lengths");
+  return out;
+}
+
+void writeOpenCvIntrinsicsTo(const std::string& path, const OpenCvIntrinsics& intr, const std::string& format_path) {
+  const std::string ext = extensionOf(format_path);
+  int flags = cv::FileStorage::WRITE | cv::FileStorage::MEMORY;
+  flags |= (ext == ".xml") ? cv::FileStorage::FORMAT_XML : cv::FileStorage::FORMAT_YAML;
+  cv::FileStorage fsw(".yaml", flags);
+  fsw << "image_width" << static_cast<int>(intr.width);
+  fsw << "image_height" << static_cast<int>(intr.height);
+  cv::Mat K(3, 3, CV_64F);
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) K.at<double>(r, c) = intr.camera_matrix(r, c);
+  cv::Mat D(static_cast<int>(intr.distortion.size()), 1, CV_64F);
+  for (int i = 0; i < D.rows; ++i) D.at<double>(i) = intr.distortion(i);
+  fsw << "camera_matrix" << K;
+  fsw << "distortion_coefficients" << D;
+  if (intr.rms_px >= 0.0) fsw << "avg_reprojection_error" << intr.rms_px;
+  const std::string text = fsw.releaseAndGetString();
+  writeTextFileAtomic(path, text);
+}
+
+void saveOpenCvIntrinsics(const std::string& path, const OpenCvIntrinsics& intrinsics) {
+  writeOpenCvIntrinsicsTo(path, intrinsics, path);
+}
+
+vpCameraParameters toVispWithoutDistortion(const OpenCvIntrinsics& intr, const std::string& what, double tolerance) {
+  if (intr.distortion.size() > 0 && intr.distortion.cwiseAbs().maxCoeff() > tolerance)
+    throw core::InvalidInput(what + ": OpenCV distortion coefficients are not zero; ViSP's radial model cannot "
+                                    "represent them: use the ViSP XML written by calibrate-camera instead");
+  vpCameraParameters cam;
+  cam.initPersProjWithoutDistortion(intr.camera_matrix(0, 0), intr.camera_matrix(1, 1), intr.camera_matrix(0, 2),
+                                    intr.camera_matrix(1, 2));
+  return cam;
+}
+
+}  // namespace viewline::io

@@ -1,0 +1,415 @@
+#include "viewline/io/config.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <optional>
+#include <sstream>
+
+#include "viewline/core/error.h"
+#include "viewline/core/frames.h"
+
+namespace viewline::io {
+namespace {
+
+using core::InvalidInput;
+
+std::string markText(const std::string& file, const YAML::Mark& mark) {
+  std::ostringstream os;
+  os << file;
+  if (mark.line >= 0) os << ':' << (mark.line + 1) << ':' << (mark.column + 1);
+  return os.str();
+}
+
+std::string describe(const YAML::Node& n) {
+  switch (n.Type()) {
+    case YAML::NodeType::Null: return "null";
+    case YAML::NodeType::Scalar: return "'" + n.Scalar() + "'";
+    case YAML::NodeType::Sequence: return "a list of " + std::to_string(n.size()) + " items";
+    case YAML::NodeType::Map: return "a map";
+    default: return "nothing";
+  }
+}
+
+// Finds the key node of `key` in a map (for its mark) — YAML::Node::operator[] gives the value.
+std::optional<YAML::Node> keyNode(const YAML::Node& map, const std::string& key) {
+  if (!map.IsMap()) return std::nullopt;
+  for (auto it = map.begin(); it != map.end(); ++it)
+    if (it->first.IsScalar() && it->first.Scalar() == key) return it->first;
+  return std::nullopt;
+}
+
+// Rejects duplicate keys (yaml-cpp silently keeps one) and non-scalar keys.
+void checkKeys(const YAML::Node& n, const std::string& file) {
+  if (n.IsMap()) {
+    std::set<std::string> seen;
+    for (auto it = n.begin(); it != n.end(); ++it) {
+      if (!it->first.IsScalar())
+        throw InvalidInput(markText(file, it->first.Mark()) + ": map keys must be plain names");
+      if (!seen.insert(it->first.Scalar()).second)
+        throw InvalidInput(markText(file, it->first.Mark()) + ": duplicate key '" + it->first.Scalar() + "'");
+      checkKeys(it->second, file);
+    }
+  } else if (n.IsSequence()) {
+    for (const auto& e : n) checkKeys(e, file);
+  }
+}
+
+template <class T>
+T convert(const YAML::Node& n, bool& ok) {
+  ok = false;
+  if (!n.IsScalar()) return T{};
+  try {
+    T v = n.as<T>();
+    ok = true;
+    return v;
+  } catch (const YAML::Exception&) {
+    return T{};
+  }
+}
+
+}  // namespace
+
+ConfigNode::ConfigNode(std::shared_ptr<Shared> shared, YAML::Node node, std::string path)
+    : shared_(std::move(shared)), node_(std::move(node)), path_(std::move(path)) {}
+
+ConfigNode ConfigNode::loadFile(const std::string& path) {
+  if (!std::filesystem::exists(path)) throw InvalidInput(path + ": config file does not exist");
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(path);
+  } catch (const YAML::BadFile&) {
+    throw InvalidInput(path + ": cannot read the config file");
+  } catch (const YAML::Exception& e) {
+    throw InvalidInput(markText(path, e.mark) + ": YAML syntax error: " + e.msg);
+  }
+  if (!root.IsMap())
+    throw InvalidInput(path + ": expected a YAML map of keys at the top level, got " + describe(root));
+  checkKeys(root, path);
+  auto shared = std::make_shared<Shared>();
+  shared->file = path;
+  shared->dir = std::filesystem::path(path).parent_path().string();
+  return ConfigNode(shared, root, "");
+}
+
+ConfigNode ConfigNode::fromString(const std::string& text, const std::string& name) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(text);
+  } catch (const YAML::Exception& e) {
+    throw InvalidInput(markText(name, e.mark) + ": YAML syntax error: " + e.msg);
+  }
+  if (root.IsNull()) root = YAML::Node(YAML::NodeType::Map);
+  if (!root.IsMap())
+    throw InvalidInput(name + ": expected a YAML map of keys at the top level, got " + describe(root));
+  checkKeys(root, name);
+  auto shared = std::make_shared<Shared>();
+  shared->file = name;
+  return ConfigNode(shared, root, "");
+}
+
+const std::string& ConfigNode::fileName() const { return shared_->file; }
+
+std::string ConfigNode::keyPath(const std::string& key) const {
+  if (key.empty()) return path_;
+  return path_.empty() ? key : path_ + "." + key;
+}
+
+std::string ConfigNode::location(const std::string& key) const {
+  if (!key.empty()) {
+    const auto k = keyNode(node_, key);
+    if (k) return markText(shared_->file, k->Mark());
+  }
+  return markText(shared_->file, node_.Mark());
+}
+
+bool ConfigNode::has(const std::string& key) const {
+  if (!node_.IsMap()) return false;
+  return keyNode(node_, key).has_value();
+}
+
+void ConfigNode::fail(const std::string& key, const std::string& expected) const {
+  std::string where = key.empty() ? path_ : keyPath(key);
+  if (where.empty()) where = "<top level>";
+  std::string got;
+  if (!key.empty() && has(key)) got = ", got " + describe(node_[key]);
+  throw InvalidInput(location(key) + ": key '" + where + "': expected " + expected + got);
+}
+
+YAML::Node ConfigNode::valueNode(const std::string& key, const char* expected) const {
+  if (!has(key)) {
+    std::string parent = path_.empty() ? "the top level" : "'" + path_ + "'";
+    throw InvalidInput(location() + ": missing required key '" + keyPath(key) + "' in " + parent +
+                       " (expected " + expected + ")");
+  }
+  shared_->consumed.insert(keyPath(key));
+  return node_[key];
+}
+
+void ConfigNode::ignore(const std::string& key) const { shared_->consumed.insert(keyPath(key)); }
+
+// ---- scalars ---------------------------------------------------------------------------------
+
+template <>
+bool ConfigNode::get<bool>(const std::string& key) const {
+  const char* what = "a boolean (true/false)";
+  bool ok = false;
+  const bool v = convert<bool>(valueNode(key, what), ok);
+  if (!ok) fail(key, what);
+  return v;
+}
+
+template <>
+long long ConfigNode::get<long long>(const std::string& key) const {
+  const char* what = "an integer";
+  bool ok = false;
+  const long long v = convert<long long>(valueNode(key, what), ok);
+  if (!ok) fail(key, what);
+  return v;
+}
+
+template <>
+int ConfigNode::get<int>(const std::string& key) const {
+  const long long v = get<long long>(key);
+  if (v < std::numeric_limits<int>::min() || v > std::numeric_limits<int>::max())
+    fail(key, "an integer in the range of int");
+  return static_cast<int>(v);
+}
+
+template <>
+unsigned long long ConfigNode::get<unsigned long long>(const std::string& key) const {
+  const char* what = "a non-negative integer";
+  const YAML::Node n = valueNode(key, what);
+  if (!n.IsScalar() || n.Scalar().empty() || n.Scalar()[0] == '-') fail(key, what);
+  bool ok = false;
+  const unsigned long long v = convert<unsigned long long>(n, ok);
+  if (!ok) fail(key, what);
+  return v;
+}
+
+template <>
+unsigned long ConfigNode::get<unsigned long>(const std::string& key) const {
+  const unsigned long long v = get<unsigned long long>(key);
+  if (v > std::numeric_limits<unsigned long>::max()) fail(key, "a non-negative integer in range");
+  return static_cast<unsigned long>(v);
+}
+
+template <>
+unsigned ConfigNode::get<unsigned>(const std::string& key) const {
+  const unsigned long long v = get<unsigned long long>(key);
+  if (v > std::numeric_limits<unsigned>::max()) fail(key, "a non-negative integer in the range of unsigned");
+  return static_cast<unsigned>(v);
+}
+
+template <>
+double ConfigNode::get<double>(const std::string& key) const {
+  const char* what = "a finite number";
+  bool ok = false;
+  const double v = convert<double>(valueNode(key, what), ok);
+  if (!ok || !std::isfinite(v)) fail(key, what);
+  return v;
+}
+
+template <>
+std::string ConfigNode::get<std::string>(const std::string& key) const {
+  const char* what = "a string";
+  const YAML::Node n = valueNode(key, what);
+  if (!n.IsScalar()) fail(key, what);
+  return n.Scalar();
+}
+
+// ---- lists -----------------------------------------------------------------------------------
+
+namespace {
+template <class T>
+std::vector<T> readList(const ConfigNode& cfg, const YAML::Node& n, const std::string& key, const char* what,
+                        const char* item_what) {
+  if (!n.IsSequence()) cfg.fail(key, what);
+  std::vector<T> out;
+  out.reserve(n.size());
+  for (std::size_t i = 0; i < n.size(); ++i) {
+    bool ok = false;
+    T v = convert<T>(n[i], ok);
+    if constexpr (std::is_floating_point_v<T>) ok = ok && std::isfinite(v);
+    if (!ok)
+      throw InvalidInput(markText(cfg.fileName(), n[i].Mark()) + ": key '" + cfg.keyPath(key) + "[" +
+                         std::to_string(i) + "]': expected " + item_what + ", got " + describe(n[i]));
+    out.push_back(v);
+  }
+  return out;
+}
+
+Eigen::VectorXd toEigen(const std::vector<double>& v) {
+  return Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size()));
+}
+}  // namespace
+
+template <>
+std::vector<double> ConfigNode::get<std::vector<double>>(const std::string& key) const {
+  const char* what = "a list of numbers, e.g. [1.0, 2.0]";
+  return readList<double>(*this, valueNode(key, what), key, what, "a finite number");
+}
+
+template <>
+std::vector<int> ConfigNode::get<std::vector<int>>(const std::string& key) const {
+  const char* what = "a list of integers, e.g. [1, 2]";
+  return readList<int>(*this, valueNode(key, what), key, what, "an integer");
+}
+
+template <>
+std::vector<std::string> ConfigNode::get<std::vector<std::string>>(const std::string& key) const {
+  const char* what = "a list of strings, e.g. [a, b]";
+  return readList<std::string>(*this, valueNode(key, what), key, what, "a string");
+}
+
+template <>
+Eigen::VectorXd ConfigNode::get<Eigen::VectorXd>(const std::string& key) const {
+  return toEigen(get<std::vector<double>>(key));
+}
+
+template <>
+Eigen::Vector2d ConfigNode::get<Eigen::Vector2d>(const std::string& key) const {
+  const std::vector<double> v = get<std::vector<double>>(key);
+  if (v.size() != 2) fail(key, "a list of 2 numbers [x, y]");
+  return {v[0], v[1]};
+}
+
+template <>
+Eigen::Vector3d ConfigNode::get<Eigen::Vector3d>(const std::string& key) const {
+  const std::vector<double> v = get<std::vector<double>>(key);
+  if (v.size() != 3) fail(key, "a list of 3 numbers [x, y, z]");
+  return {v[0], v[1], v[2]};
+}
+
+template <>
+Eigen::Matrix3d ConfigNode::get<Eigen::Matrix3d>(const std::string& key) const {
+  const char* what = "a 3x3 matrix as 3 rows of 3 numbers, e.g. [[1,0,0],[0,1,0],[0,0,1]]";
+  const YAML::Node n = valueNode(key, what);
+  if (!n.IsSequence() || n.size() != 3) fail(key, what);
+  Eigen::Matrix3d m;
+  for (std::size_t r = 0; r < 3; ++r) {
+    const auto row = readList<double>(*this, n[r], key, what, "a finite number");
+    if (row.size() != 3) fail(key, what);
+    for (std::size_t c = 0; c < 3; ++c) m(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(c)) = row[c];
+  }
+  return m;
+}
+
+// ---- helpers ---------------------------------------------------------------------------------
+
+double ConfigNode::getAngle(const std::string& key) const {
+  if (key.size() < 4 || key.compare(key.size() - 4, 4, "_deg") != 0)
+    throw core::Error("ConfigNode::getAngle('" + key + "'): angle keys must end in _deg");
+  return core::deg2rad(get<double>(key));
+}
+
+double ConfigNode::getAngleOr(const std::string& key, double fallback_rad) const {
+  return has(key) ? getAngle(key) : fallback_rad;
+}
+
+std::string ConfigNode::getChoice(const std::string& key, const std::vector<std::string>& choices) const {
+  const std::string v = get<std::string>(key);
+  if (std::find(choices.begin(), choices.end(), v) == choices.end()) {
+    std::string list;
+    for (const auto& c : choices) list += (list.empty() ? "" : ", ") + c;
+    fail(key, "one of: " + list);
+  }
+  return v;
+}
+
+std::string ConfigNode::getChoiceOr(const std::string& key, const std::vector<std::string>& choices,
+                                    const std::string& fallback) const {
+  return has(key) ? getChoice(key, choices) : fallback;
+}
+
+std::string ConfigNode::getPath(const std::string& key) const {
+  const std::string v = get<std::string>(key);
+  if (v.empty()) fail(key, "a non-empty file path");
+  const std::filesystem::path p(v);
+  if (p.is_absolute() || shared_->dir.empty()) return v;
+  return (std::filesystem::path(shared_->dir) / p).string();
+}
+
+ConfigNode ConfigNode::child(const std::string& key) const {
+  const char* what = "a map of keys";
+  if (!has(key)) {
+    std::string parent = path_.empty() ? "the top level" : "'" + path_ + "'";
+    throw InvalidInput(location() + ": missing required section '" + keyPath(key) + "' in " + parent +
+                       " (expected " + what + ")");
+  }
+  const YAML::Node n = node_[key];
+  if (n.IsNull()) {  // "section:" with nothing under it: an empty map
+    shared_->consumed.insert(keyPath(key));
+    return ConfigNode(shared_, YAML::Node(YAML::NodeType::Map), keyPath(key));
+  }
+  if (!n.IsMap()) fail(key, what);
+  shared_->read.insert(keyPath(key));
+  return ConfigNode(shared_, n, keyPath(key));
+}
+
+std::vector<ConfigNode> ConfigNode::childList(const std::string& key) const {
+  const char* what = "a list of maps";
+  if (!has(key)) {
+    std::string parent = path_.empty() ? "the top level" : "'" + path_ + "'";
+    throw InvalidInput(location() + ": missing required list '" + keyPath(key) + "' in " + parent +
+                       " (expected " + what + ")");
+  }
+  const YAML::Node n = node_[key];
+  if (!n.IsSequence()) fail(key, what);
+  shared_->read.insert(keyPath(key));
+  std::vector<ConfigNode> out;
+  for (std::size_t i = 0; i < n.size(); ++i) {
+    const std::string p = keyPath(key) + "[" + std::to_string(i) + "]";
+    if (!n[i].IsMap())
+      throw InvalidInput(markText(shared_->file, n[i].Mark()) + ": key '" + p + "': expected a map of keys, got " +
+                         describe(n[i]));
+    shared_->read.insert(p);
+    out.push_back(ConfigNode(shared_, n[i], p));
+  }
+  return out;
+}
+
+void ConfigNode::collectUnknown(const YAML::Node& node, const std::string& path,
+                                std::vector<std::string>& errors) const {
+  if (node.IsMap()) {
+    std::vector<std::string> known;
+    for (auto it = node.begin(); it != node.end(); ++it) {
+      const std::string k = it->first.Scalar();
+      const std::string p = path.empty() ? k : path + "." + k;
+      if (shared_->consumed.count(p) || shared_->read.count(p)) known.push_back(k);
+    }
+    for (auto it = node.begin(); it != node.end(); ++it) {
+      const std::string k = it->first.Scalar();
+      const std::string p = path.empty() ? k : path + "." + k;
+      if (shared_->consumed.count(p)) continue;
+      if (shared_->read.count(p)) {
+        collectUnknown(it->second, p, errors);
+        continue;
+      }
+      std::string msg = markText(shared_->file, it->first.Mark()) + ": unknown key '" + p + "'";
+      if (!known.empty()) {
+        msg += " (keys used here: ";
+        for (std::size_t i = 0; i < known.size(); ++i) msg += (i ? ", " : "") + known[i];
+        msg += ")";
+      }
+      errors.push_back(msg);
+    }
+  } else if (node.IsSequence()) {
+    for (std::size_t i = 0; i < node.size(); ++i) {
+      const std::string p = path + "[" + std::to_string(i) + "]";
+      if (shared_->read.count(p)) collectUnknown(node[i], p, errors);
+    }
+  }
+}
+
+void ConfigNode::finish() const {
+  std::vector<std::string> errors;
+  collectUnknown(node_, path_, errors);
+  if (errors.empty()) return;
+  std::string msg = errors.front();
+  for (std::size_t i = 1; i < errors.size(); ++i) msg += "\n" + errors[i];
+  throw InvalidInput(msg);
+}
+
+}  // namespace viewline::io

@@ -1,0 +1,159 @@
+#include <gtest/gtest.h>
+
+#include "temp_dir.h"
+#include "viewline/core/error.h"
+#include "viewline/io/config.h"
+
+using viewline::core::InvalidInput;
+using viewline::io::ConfigNode;
+using viewline::io::test::TempDir;
+
+namespace {
+// Runs f, expects InvalidInput, returns its message.
+template <class F>
+std::string errorOf(F&& f) {
+  try {
+    f();
+  } catch (const InvalidInput& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "no InvalidInput thrown";
+  return {};
+}
+
+const char* kScenario =
+    "rate_hz: 50\n"                    // line 1
+    "name: catching\n"                 // line 2
+    "seed: 42\n"                       // line 3
+    "pan_limit_deg: 90\n"              // line 4
+    "p0: [0, 0, 3]\n"                  // line 5
+    "tracker:\n"                       // line 6
+    "  sigma_px: 0.5\n"                // line 7
+    "  gate: mahalanobis\n"            // line 8
+    "cameras:\n"                       // line 9
+    "  - name: left\n"                 // line 10
+    "    fps: 50\n"                    // line 11
+    "  - name: right\n"                // line 12
+    "    fps: 40\n";                   // line 13
+}  // namespace
+
+TEST(Config, ReadsTypedValuesAndFinishesWhenAllUsed) {
+  TempDir dir;
+  const auto path = dir.write("s.yaml", kScenario);
+  const auto cfg = ConfigNode::loadFile(path);
+  EXPECT_DOUBLE_EQ(cfg.get<double>("rate_hz"), 50.0);
+  EXPECT_EQ(cfg.get<int>("rate_hz"), 50);
+  EXPECT_EQ(cfg.get<std::string>("name"), "catching");
+  EXPECT_EQ(cfg.get<std::uint64_t>("seed"), 42u);
+  EXPECT_NEAR(cfg.getAngle("pan_limit_deg"), 3.14159265358979 / 2, 1e-12);
+  EXPECT_EQ(cfg.get<Eigen::Vector3d>("p0"), Eigen::Vector3d(0, 0, 3));
+  EXPECT_EQ(cfg.getOr<double>("absent", 7.5), 7.5);
+  const auto tracker = cfg.child("tracker");
+  EXPECT_EQ(tracker.path(), "tracker");
+  EXPECT_DOUBLE_EQ(tracker.get<double>("sigma_px"), 0.5);
+  EXPECT_EQ(tracker.getChoice("gate", {"norm", "mahalanobis"}), "mahalanobis");
+  const auto cams = cfg.childList("cameras");
+  ASSERT_EQ(cams.size(), 2u);
+  EXPECT_EQ(cams[1].get<std::string>("name"), "right");
+  EXPECT_EQ(cams[0].get<unsigned>("fps"), 50u);
+  EXPECT_EQ(cams[0].get<std::string>("name"), "left");
+  cams[1].ignore("fps");
+  EXPECT_NO_THROW(cfg.finish());
+}
+
+TEST(Config, UnknownKeyNamesFileLineAndKeyPath) {
+  TempDir dir;
+  const auto path = dir.write("s.yaml", kScenario);
+  const auto cfg = ConfigNode::loadFile(path);
+  cfg.get<double>("rate_hz");
+  cfg.get<std::string>("name");
+  cfg.get<int>("seed");
+  cfg.getAngle("pan_limit_deg");
+  cfg.get<Eigen::Vector3d>("p0");
+  cfg.child("tracker").get<double>("sigma_px");  // "gate" never read
+  for (const auto& c : cfg.childList("cameras")) c.get<std::string>("name");  // "fps" never read
+  const std::string msg = errorOf([&] { cfg.finish(); });
+  EXPECT_NE(msg.find(path + ":8:3: unknown key 'tracker.gate'"), std::string::npos) << msg;
+  EXPECT_NE(msg.find(path + ":11:5: unknown key 'cameras[0].fps'"), std::string::npos) << msg;
+  EXPECT_NE(msg.find(path + ":13:5: unknown key 'cameras[1].fps'"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("keys used here: sigma_px"), std::string::npos) << msg;
+}
+
+TEST(Config, UnreadTopLevelSectionIsUnknown) {
+  const auto cfg = ConfigNode::fromString("a: 1\nrate_hx: 3\n", "typo.yaml");
+  cfg.get<int>("a");
+  const std::string msg = errorOf([&] { cfg.finish(); });
+  EXPECT_NE(msg.find("typo.yaml:2:1: unknown key 'rate_hx'"), std::string::npos) << msg;
+}
+
+TEST(Config, WrongTypeNamesFileLineKeyAndExpectation) {
+  const auto cfg = ConfigNode::fromString("a: 1\ntracker:\n  sigma_px: abc\n  n: 2.5\n  v: [1, x, 3]\n  u: -3\n",
+                                          "bad.yaml");
+  const auto t = cfg.child("tracker");
+  std::string msg = errorOf([&] { t.get<double>("sigma_px"); });
+  EXPECT_NE(msg.find("bad.yaml:3:3: key 'tracker.sigma_px': expected a finite number, got 'abc'"),
+            std::string::npos)
+      << msg;
+  msg = errorOf([&] { t.get<int>("n"); });
+  EXPECT_NE(msg.find("bad.yaml:4:3: key 'tracker.n': expected an integer"), std::string::npos) << msg;
+  msg = errorOf([&] { t.get<std::vector<double>>("v"); });
+  EXPECT_NE(msg.find("bad.yaml:5:10: key 'tracker.v[1]': expected a finite number, got 'x'"), std::string::npos)
+      << msg;
+  msg = errorOf([&] { t.get<unsigned>("u"); });
+  EXPECT_NE(msg.find("key 'tracker.u': expected a non-negative integer"), std::string::npos) << msg;
+  msg = errorOf([&] { t.get<Eigen::Vector2d>("v"); });
+  EXPECT_NE(msg.find("tracker.v"), std::string::npos) << msg;
+  msg = errorOf([&] { cfg.child("a"); });
+  EXPECT_NE(msg.find("bad.yaml:1:1: key 'a': expected a map of keys, got '1'"), std::string::npos) << msg;
+  msg = errorOf([&] { cfg.childList("tracker"); });
+  EXPECT_NE(msg.find("key 'tracker': expected a list of maps"), std::string::npos) << msg;
+}
+
+TEST(Config, MissingKeyNamesParentLineAndExpectation) {
+  const auto cfg = ConfigNode::fromString("a: 1\ntracker:\n  sigma_px: 1\n", "m.yaml");
+  const auto t = cfg.child("tracker");
+  const std::string msg = errorOf([&] { t.get<double>("gate_p"); });
+  EXPECT_NE(msg.find("m.yaml:3:3: missing required key 'tracker.gate_p' in 'tracker' (expected a finite number)"),
+            std::string::npos)
+      << msg;
+  const std::string msg2 = errorOf([&] { cfg.child("robot"); });
+  EXPECT_NE(msg2.find("missing required section 'robot' in the top level"), std::string::npos) << msg2;
+}
+
+TEST(Config, RejectsNonFiniteDuplicatesSyntaxAndBadChoices) {
+  auto cfg = ConfigNode::fromString("x: .nan\ny: .inf\nmode: fast\n", "n.yaml");
+  EXPECT_THROW(cfg.get<double>("x"), InvalidInput);
+  EXPECT_THROW(cfg.get<double>("y"), InvalidInput);
+  const std::string msg = errorOf([&] { cfg.getChoice("mode", {"slow", "exact"}); });
+  EXPECT_NE(msg.find("expected one of: slow, exact, got 'fast'"), std::string::npos) << msg;
+  const std::string dup = errorOf([] { ConfigNode::fromString("a: 1\nb: 2\na: 3\n", "d.yaml"); });
+  EXPECT_NE(dup.find("d.yaml:3:1: duplicate key 'a'"), std::string::npos) << dup;
+  const std::string syn = errorOf([] { ConfigNode::fromString("a: [1, 2\nb: 3\n", "syn.yaml"); });
+  EXPECT_NE(syn.find("syn.yaml:"), std::string::npos) << syn;
+  EXPECT_NE(syn.find("YAML syntax error"), std::string::npos) << syn;
+  EXPECT_THROW(ConfigNode::fromString("- 1\n- 2\n", "list.yaml"), InvalidInput);
+  EXPECT_THROW(ConfigNode::loadFile("/nonexistent/dir/x.yaml"), InvalidInput);
+}
+
+TEST(Config, FailAndPathsResolveAgainstConfigDirectory) {
+  TempDir dir;
+  const auto path = dir.write("c.yaml", "rate_hz: -5\nrig: rigs/a.yaml\nabs: /etc/x\n");
+  const auto cfg = ConfigNode::loadFile(path);
+  const double r = cfg.get<double>("rate_hz");
+  ASSERT_LT(r, 0.0);
+  const std::string msg = errorOf([&] { cfg.fail("rate_hz", "a positive number"); });
+  EXPECT_NE(msg.find(path + ":1:1: key 'rate_hz': expected a positive number, got '-5'"), std::string::npos) << msg;
+  EXPECT_EQ(cfg.getPath("rig"), (dir.path / "rigs/a.yaml").string());
+  EXPECT_EQ(cfg.getPath("abs"), "/etc/x");
+  EXPECT_NO_THROW(cfg.finish());
+}
+
+TEST(Config, MatrixAndEmptySection) {
+  const auto cfg = ConfigNode::fromString("R: [[1,0,0],[0,1,0],[0,0,1]]\nbad: [[1,0],[0,1]]\nempty:\n", "m.yaml");
+  EXPECT_TRUE(cfg.get<Eigen::Matrix3d>("R").isIdentity());
+  EXPECT_THROW(cfg.get<Eigen::Matrix3d>("bad"), InvalidInput);
+  const auto e = cfg.child("empty");
+  EXPECT_FALSE(e.has("x"));
+  EXPECT_EQ(e.getOr<int>("x", 3), 3);
+  EXPECT_NO_THROW(cfg.finish());
+}

@@ -1,0 +1,103 @@
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "temp_dir.h"
+#include "viewline/core/error.h"
+#include "viewline/io/files.h"
+#include "viewline/io/log.h"
+
+using namespace viewline::io;
+using viewline::core::InvalidInput;
+using viewline::io::test::TempDir;
+
+namespace {
+std::string slurp(const std::string& p) {
+  std::ifstream f(p);
+  std::stringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+}  // namespace
+
+TEST(Files, JsonSummaryIsWrittenAtomicallyAndReadsBack) {
+  TempDir dir;
+  const auto path = dir.file("sub/summary.json");
+  nlohmann::json j;
+  j["rmse_m"] = 0.0123;
+  j["catches"] = 7;
+  writeJsonFile(path, j);
+  EXPECT_EQ(readJsonFile(path), j);
+  // Overwrite keeps exactly one file (no temporaries left).
+  j["catches"] = 8;
+  writeJsonFile(path, j);
+  EXPECT_EQ(readJsonFile(path)["catches"], 8);
+  std::size_t n = 0;
+  for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator(dir.path / "sub")) ++n;
+  EXPECT_EQ(n, 1u);
+}
+
+TEST(Files, BadJsonNamesFile) {
+  TempDir dir;
+  const auto p = dir.write("b.json", "{\"a\": ");
+  try {
+    readJsonFile(p);
+    FAIL();
+  } catch (const InvalidInput& e) {
+    EXPECT_NE(std::string(e.what()).find(p), std::string::npos);
+  }
+}
+
+TEST(Files, StagedFilesAreAllOrNothing) {
+  TempDir dir;
+  {
+    StagedFiles out;
+    std::ofstream(out.stage(dir.file("a.txt"))) << "a";
+    std::ofstream(out.stage(dir.file("b.txt"))) << "b";
+    EXPECT_EQ(dir.count(), 2u);  // temporaries only
+    EXPECT_FALSE(std::filesystem::exists(dir.file("a.txt")));
+    // no commit: destructor removes the temporaries
+  }
+  EXPECT_EQ(dir.count(), 0u);
+  {
+    StagedFiles out;
+    std::ofstream(out.stage(dir.file("a.txt"))) << "a";
+    out.stage(dir.file("b.txt"));  // never written: commit must fail and leave nothing
+    EXPECT_THROW(out.commit(), InvalidInput);
+  }
+  EXPECT_EQ(dir.count(), 0u);
+  StagedFiles out;
+  std::ofstream(out.stage(dir.file("a.txt"))) << "a";
+  out.commit();
+  EXPECT_EQ(slurp(dir.file("a.txt")), "a");
+  EXPECT_EQ(dir.count(), 1u);
+}
+
+TEST(Log, CsvStreamsOnePerFileWithHeader) {
+  TempDir dir;
+  {
+    LogDirectory log(dir.file("log"));
+    auto& est = log.stream("estimates", {"t", "x", "note"});
+    est.row({0.5, 1.25, std::nan("")});
+    est.rowText({"1", "2", "a,b"});
+    EXPECT_THROW(est.row({1.0, 2.0}), InvalidInput);
+    EXPECT_EQ(&log.stream("estimates", {"t", "x", "note"}), &est);
+    EXPECT_THROW(log.stream("estimates", {"t"}), InvalidInput);
+    log.stream("truth", {"t"}).row({0.0});
+  }
+  EXPECT_EQ(slurp(dir.file("log/estimates.csv")), "t,x,note\n0.5,1.25,nan\n1,2,\"a,b\"\n");
+  EXPECT_EQ(slurp(dir.file("log/truth.csv")), "t\n0\n");
+}
+
+TEST(Log, DisabledLogWritesNothing) {
+  LogDirectory log;
+  EXPECT_FALSE(log.enabled());
+  auto& s = log.stream("x", {"a"});
+  s.row({1.0, 2.0, 3.0});  // ignored, even with a wrong count
+  EXPECT_FALSE(s.enabled());
+  TempDir dir;
+  const auto file = dir.write("plain_file", "x");
+  EXPECT_THROW(CsvWriter(file + "/a.csv", {"a"}), InvalidInput);  // parent is a file
+}
