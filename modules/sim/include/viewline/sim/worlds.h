@@ -1,0 +1,153 @@
+#pragma once
+// Ready-made worlds of the four scenarios (SPEC §2-§5). Each is a World (renderer.h): a static,
+// textured environment plus moving objects queried by time. Named objects (ground truth):
+//   BallFlightWorld  "ball"                       sphere, flights with quadratic drag ([L])
+//   DartWorld        "dart" (+ static "board")    dart frame: origin at the barrel's rear, z = tip
+//   TableWorld       "table", "ball", "tag<id>"   table frame: surface centre, z = surface normal
+//   ScreenWorld      "screen", "target"           screen frame: centre, x right, y down, z into it
+//   GroundWorld      "target"                     8x6 cm red box on the floor, x along its heading
+// Worlds that wrap physics hold a copy of precomputed trajectories (DragFlight, ScreenPath,
+// GroundTarget) or a reference to a TiltTable that the caller owns and steps (closed loop).
+
+#include <vector>
+
+#include "viewline/sim/physics.h"
+#include "viewline/sim/renderer.h"
+#include "viewline/sim/scene.h"
+
+namespace viewline::sim {
+
+/// A textured floor (z = 0, centred at the origin) and an optional back wall (the plane
+/// y = wall_y, facing -y), with seeded procedural textures.
+struct RoomParams {
+  double floor_size = 14.0;     ///< m
+  bool wall = true;
+  double wall_y = 7.0;          ///< m
+  double wall_width = 14.0;     ///< m
+  double wall_height = 6.0;     ///< m
+  NoiseTextureParams floor_texture{1024, 6, 6, 0.45, Eigen::Vector3d(0.35, 0.42, 0.45)};
+  NoiseTextureParams wall_texture{1024, 6, 4, 0.35, Eigen::Vector3d(0.62, 0.6, 0.55)};
+};
+Scene makeRoom(const RoomParams& params, core::Rng& rng);
+
+struct BallAppearance {
+  std::string name = "ball";
+  double radius = 0.025;                                        ///< m (the 5 cm ball)
+  Eigen::Vector3d albedo_bgr = Eigen::Vector3d(0.08, 0.45, 0.95);  ///< orange
+};
+
+/// One or more ball flights; at time t the ball of the flight covering t is drawn (none when no
+/// flight covers t). Flights must not overlap in time.
+class BallFlightWorld : public World {
+public:
+  BallFlightWorld(std::vector<DragFlight> flights, Scene environment, BallAppearance ball = {},
+                  Lighting lighting = {});
+  const Scene& staticScene() const override { return environment_; }
+  void dynamicObjects(double t, std::vector<Primitive>& out) const override;
+  Lighting lighting() const override { return lighting_; }
+  const std::vector<DragFlight>& flights() const { return flights_; }
+  /// The flight covering t, or nullptr.
+  const DragFlight* flightAt(double t) const;
+
+private:
+  std::vector<DragFlight> flights_;
+  Scene environment_;
+  BallAppearance ball_;
+  Lighting lighting_;
+};
+
+/// A dart in flight (oriented along its velocity, dartPose) towards a board on a wall.
+class DartWorld : public World {
+public:
+  /// board: pose of the board frame (z into the wall), radius 0.225 m, named "board".
+  DartWorld(DragFlight flight, Scene environment, const Eigen::Isometry3d& w_M_board, Lighting lighting = {});
+  const Scene& staticScene() const override { return environment_; }
+  void dynamicObjects(double t, std::vector<Primitive>& out) const override;
+  Lighting lighting() const override { return lighting_; }
+  const DragFlight& flight() const { return flight_; }
+
+private:
+  DragFlight flight_;
+  Scene environment_;
+  Lighting lighting_;
+};
+
+struct TableAppearance {
+  Eigen::Vector3d surface_bgr = Eigen::Vector3d(0.12, 0.1, 0.8);    ///< red
+  Eigen::Vector3d border_bgr = Eigen::Vector3d(0.05, 0.05, 0.05);   ///< black
+  double border_width = 0.02;                                       ///< m, outside the L square
+  double border_height = 0.02;                                      ///< m, above the surface
+  Eigen::Vector3d ball_bgr = Eigen::Vector3d(0.2, 0.7, 0.15);       ///< green
+  bool tags = false;            ///< four tag36h11 tags on a white plate around the borders
+  double tag_size = 0.05;       ///< m (black square)
+  int first_tag_id = 0;         ///< ids first_tag_id..+3 at corners (-,-), (+,-), (+,+), (-,+)
+};
+
+/// [M]'s scene: the tilting table (red surface, raised black borders) with the green ball,
+/// following a TiltTable that the caller owns and advances (state history interpolated for
+/// motion blur; querying a time outside the history clamps to it).
+class TableWorld : public World {
+public:
+  TableWorld(const TiltTable& table, Scene environment, TableAppearance appearance = {}, Lighting lighting = {});
+  const Scene& staticScene() const override { return environment_; }
+  void dynamicObjects(double t, std::vector<Primitive>& out) const override;
+  Lighting lighting() const override { return lighting_; }
+  /// Tag frame of the i-th table tag (i = 0..3) in the table frame.
+  Eigen::Isometry3d table_M_tag(int i) const;
+
+private:
+  const TiltTable& table_;
+  Scene environment_;
+  TableAppearance look_;
+  Lighting lighting_;
+};
+
+struct ScreenAppearance {
+  double width = 2.4, height = 1.8;                                  ///< m
+  Eigen::Vector3d screen_bgr = Eigen::Vector3d(0.85, 0.85, 0.85);    ///< lit by the projector (unlit)
+  double disc_radius = 0.06;                                         ///< m
+  Eigen::Vector3d disc_bgr = Eigen::Vector3d(0.08, 0.08, 0.08);      ///< the projected dark circle
+};
+
+/// [T]'s scene: a dark disc projected on a screen, moving along a ScreenPath (screen frame).
+class ScreenWorld : public World {
+public:
+  ScreenWorld(ScreenPath path, const Eigen::Isometry3d& w_M_screen, Scene environment,
+              ScreenAppearance appearance = {}, Lighting lighting = {});
+  const Scene& staticScene() const override { return scene_; }
+  void dynamicObjects(double t, std::vector<Primitive>& out) const override;
+  Lighting lighting() const override { return lighting_; }
+  const ScreenPath& path() const { return path_; }
+  /// World position of the target centre at time t.
+  Eigen::Vector3d target_w(double t) const;
+
+private:
+  ScreenPath path_;
+  Eigen::Isometry3d w_M_screen_;
+  Scene scene_;
+  ScreenAppearance look_;
+  Lighting lighting_;
+};
+
+struct GroundObjectAppearance {
+  Eigen::Vector3d extents = Eigen::Vector3d(0.08, 0.06, 0.05);      ///< m (8 x 6 cm footprint)
+  Eigen::Vector3d albedo_bgr = Eigen::Vector3d(0.1, 0.1, 0.85);     ///< red
+};
+
+/// [K]'s scene: a red object driven by a GroundTarget on a textured floor.
+class GroundWorld : public World {
+public:
+  GroundWorld(GroundTarget target, Scene environment, GroundObjectAppearance appearance = {}, Lighting lighting = {});
+  const Scene& staticScene() const override { return environment_; }
+  void dynamicObjects(double t, std::vector<Primitive>& out) const override;
+  Lighting lighting() const override { return lighting_; }
+  const GroundTarget& target() const { return target_; }
+
+private:
+  GroundTarget target_;
+  Scene environment_;
+  GroundObjectAppearance look_;
+  Lighting lighting_;
+};
+
+}  // namespace viewline::sim
