@@ -1,0 +1,80 @@
+#pragma once
+// Calibration targets and their detection in images.
+//
+// Board files (YAML, strict keys, read with io::ConfigNode):
+//   type: chessboard          # chessboard | circles_grid | asymmetric_circles_grid | apriltag_grid | apriltag
+//   cols: 9                   # inner corners (chessboard) or circles per row
+//   rows: 6                   # inner corners or circles per column
+//   spacing: 0.025            # metres between neighbouring corners / circle centres / tag centres
+//   tag_family: 36h11         # AprilTag family (apriltag*, default 36h11)
+//   tag_size: 0.053           # metres, black border edge (apriltag*)
+//   first_id: 0               # id of the top-left tag of an apriltag_grid (row-major)
+//   tag_ids: [0, 3]           # apriltag: only these tags (default: all)
+//
+// Board frame: origin at the first corner / circle / top-left tag centre, x along a row, y down
+// the columns, z into the board (away from a camera that sees it), as OpenCV and ViSP do.
+// `apriltag` is not a rigid board: each detected tag gets its own pose in ViSP's tag frame (origin
+// at the tag centre, x right and y up on the printed tag, z out of it, towards the viewer), used by
+// compute-board-poses and to anchor a world frame.
+
+#include <map>
+#include <opencv2/core.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "viewline/io/config.h"
+
+namespace viewline::calib {
+
+enum class BoardType { Chessboard, CirclesGrid, AsymmetricCirclesGrid, AprilTagGrid, AprilTag };
+
+struct BoardSpec {
+  BoardType type = BoardType::Chessboard;
+  int cols = 9;
+  int rows = 6;
+  double spacing = 0.025;
+  std::string tag_family = "36h11";
+  double tag_size = 0.0;
+  int first_id = 0;
+  std::vector<int> tag_ids;  ///< apriltag: restrict to these ids (empty = all)
+
+  /// Throws InvalidInput naming the field when inconsistent.
+  void validate(const std::string& where = "board") const;
+  /// Corners (chessboard), circle centres or tag corners, in the board frame (z = 0).
+  std::vector<cv::Point3f> objectPoints() const;
+  std::string describe() const;
+};
+
+std::string toString(BoardType t);
+/// Reads a board from a config node (keys above); marks them read.
+BoardSpec readBoard(const io::ConfigNode& node);
+/// Reads a board file and rejects unknown keys.
+BoardSpec loadBoard(const std::string& path);
+
+/// One detected view of a board: matching image and board points.
+struct BoardObservation {
+  std::vector<cv::Point2f> image_points;
+  std::vector<cv::Point3f> object_points;
+  std::vector<int> tag_ids;  ///< apriltag*: id of each group of 4 points (same order)
+};
+
+/// Detection outcome: observation when found, else a reason ("chessboard 9x6 not found").
+struct Detection {
+  std::optional<BoardObservation> observation;
+  std::string reason;
+};
+
+/// Detects the board in an 8-bit grey image. Chessboard corners are refined to sub-pixel.
+/// apriltag_grid: uses the tags of the grid that are seen (at least 2 tags).
+Detection detectBoard(const cv::Mat& gray, const BoardSpec& board);
+
+/// Every tag seen in the image (any id, or the spec's tag_ids): id -> 4 corners (ViSP order).
+std::map<int, std::vector<cv::Point2f>> detectAprilTags(const cv::Mat& gray, const std::string& family);
+/// The 4 corners of a single tag of edge `size` in its own frame (centre origin), ViSP's order.
+std::vector<cv::Point3f> tagCorners3d(double size);
+
+/// Reads an image as 8-bit grey; throws InvalidInput naming the file when unreadable.
+cv::Mat readGray(const std::string& path);
+
+}  // namespace viewline::calib
