@@ -1,0 +1,99 @@
+#pragma once
+// Colour-blob ball detector: threshold in HSV, open/close, external contours,
+// best round blob, sub-pixel centre, minimum enclosing circle.
+//
+// Centre: the first moments of the blob's outer contour polygon (Green's
+// theorem, cv::moments on the contour). The contour runs through the centres
+// of the boundary pixels of the thresholded mask, so it is symmetric about the
+// true centre for a round blob: no bias, and the quantisation error averages
+// over the whole boundary (holes such as a specular highlight do not matter).
+//
+// Pixel covariance. If the boundary is displaced radially by independent
+// errors δ(θ) of std σe per boundary pixel (edge noise, quantisation), the
+// centroid of a disc of radius R moves by δc_x = (1/π) ∫ cos θ δ(θ) dθ;
+// with one independent sample per pixel of arc (Δθ = 1/R, 2πR samples)
+//     var(c_x) = σe² / (π R)        (same for c_y, uncorrelated),
+// plus a floor σ_min² for everything else. A blob that is not round
+// (occluded, merged with clutter) is flagged Degraded and its variance grows
+// by (R (1 - roundness))², the order of the centroid shift such a cut causes.
+//
+// Radius: cv::minEnclosingCircle of the contour points (pixel centres) plus
+// edge_offset_px (0.5: the true edge lies half a pixel outside the outermost
+// pixel centres).
+//
+// Sphere correction: the image of a sphere is an ellipse whose centre is not
+// the image of the sphere's centre (perspective). When the detector knows the
+// camera, it reports as `pixel` the image of the cone axis: with the blob
+// centre c and radius ρ, the end points a, b = c ± ρ e of the major axis
+// (e = unit vector from the principal point to c) back-project to rays va, vb
+// and the sphere centre lies along va + vb (see table_geometry.h). Without a
+// camera, `pixel` is the blob centre. `blob_center` always holds the latter.
+//
+// Speed: with a predicted position the detector works in a square window
+// around it and only falls back to the full frame when the window shows no
+// ball or cuts it; buffers are reused between calls (one detector per
+// camera, not thread-safe).
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+#include <optional>
+#include <vector>
+
+#include "viewline/core/camera.h"
+#include "viewline/vision/color.h"
+#include "viewline/vision/detection.h"
+
+namespace viewline::vision {
+
+struct BallDetectorConfig {
+  ColorRange hsv{35, 85, 80, 255, 30, 255};  ///< HSV range of the ball (default: green)
+  int open_kernel_px = 3;      ///< elliptic opening kernel size (odd, 0 or 1 = none)
+  int close_kernel_px = 5;     ///< elliptic closing kernel size (odd, 0 or 1 = none)
+  double min_area_px = 12.0;   ///< blobs with fewer pixels are "too small"
+  double noise_area_px = 3.0;  ///< blobs below this are ignored altogether
+  double min_roundness = 0.45;   ///< area / (π ρ²) below which a blob is no ball
+  double good_roundness = 0.80;  ///< below: Quality::Degraded
+  double ambiguity_ratio = 0.7;  ///< runner-up score >= ratio * best score -> Ambiguous
+  double roi_half_size_px = 48.0;  ///< half side of the window around a predicted position
+  bool fallback_full_frame = true;  ///< search the full frame when the window fails
+  double edge_noise_px = 0.5;    ///< σe in var = σe² / (π R)
+  double min_sigma_px = 0.05;    ///< σ floor of the centre
+  double edge_offset_px = 0.5;   ///< added to the minEnclosingCircle radius
+
+  /// Throws core::InvalidInput naming the field.
+  void validate() const;
+};
+
+struct BallMeasurement : Measurement {
+  double radius_px = 0.0;  ///< minEnclosingCircle radius + edge offset
+  Eigen::Vector2d circle_center = Eigen::Vector2d::Zero();  ///< minEnclosingCircle centre (px)
+  double area_px = 0.0;    ///< blob area (contour polygon area + half its perimeter)
+  double roundness = 0.0;  ///< area / (π radius²)
+  bool used_roi = false;   ///< found in the window around the prediction
+  Eigen::Vector2d blob_center = Eigen::Vector2d::Zero();  ///< contour centroid (px)
+};
+
+class BallDetector {
+public:
+  /// With a camera, `pixel` is corrected to the image of the sphere centre (see above).
+  explicit BallDetector(BallDetectorConfig config = {}, std::optional<core::Camera> camera = std::nullopt);
+
+  /// Detect in a BGR CV_8UC3 image captured at `stamp`. With `predicted` (pixel) the search
+  /// starts in a window of half size config.roi_half_size_px around it.
+  Result<BallMeasurement> detect(const cv::Mat& bgr, core::Timestamp stamp,
+                                 const std::optional<Eigen::Vector2d>& predicted = std::nullopt);
+
+  const BallDetectorConfig& config() const { return config_; }
+
+private:
+  Result<BallMeasurement> detectIn(const cv::Mat& bgr, const cv::Rect& roi, core::Timestamp stamp,
+                                   const std::optional<Eigen::Vector2d>& predicted, bool& cut_by_roi);
+
+  BallDetectorConfig config_;
+  std::optional<core::Camera> camera_;
+  cv::Mat open_kernel_, close_kernel_;
+  cv::Mat hsv_, mask_;  // reused buffers
+  std::vector<std::vector<cv::Point>> contours_;
+};
+
+}  // namespace viewline::vision

@@ -1,0 +1,57 @@
+#pragma once
+// [T]'s detector of a dark disc projected on a bright screen (SPEC §5):
+// crop the margins, resize by 50 %, binarise, median filter, centroid.
+//
+// Coordinates: cv::resize with INTER_AREA and factor s = 1/2 makes half-
+// resolution pixel i the mean of full pixels 2i and 2i+1, whose centre is
+// 2i + 0.5. So a half-resolution position q maps back to
+//     u = crop_left + (q + 0.5) / s - 0.5      (= crop_left + 2 q + 0.5),
+// likewise v with crop_top.
+//
+// Covariance: the centroid of a disc of radius R whose boundary is displaced by
+// independent errors of std σe per boundary pixel has var σe² / (π R) per axis
+// (see ball_detector.h); at half resolution one boundary pixel is 2 full-res
+// pixels, so σe is taken as edge_noise_px / scale in full-resolution pixels and
+// the boundary sample count halves: var = (σe/s)² / (π R s).
+
+#include <opencv2/core.hpp>
+
+#include "viewline/vision/detection.h"
+
+namespace viewline::vision {
+
+struct ScreenTargetDetectorConfig {
+  int crop_left = 0, crop_top = 0, crop_right = 0, crop_bottom = 0;  ///< margins removed (px)
+  double scale = 0.5;      ///< resize factor ([T]: 50 %)
+  int threshold = -1;      ///< binarisation level on the grey image, or < 0 for Otsu
+  bool dark_target = true; ///< the target is darker than the screen
+  int median_ksize = 5;    ///< median filter aperture (odd >= 3, or 1 = none)
+  double min_area_px = 20.0;     ///< full-resolution pixels; fewer -> TooSmall
+  double min_fill = 0.5;         ///< foreground / bounding-box area below this -> Ambiguous
+  double edge_noise_px = 0.5;    ///< σe at the processing resolution
+  double min_sigma_px = 0.1;
+
+  void validate() const;  ///< throws core::InvalidInput naming the field
+};
+
+struct ScreenTargetMeasurement : Measurement {
+  double area_px = 0.0;  ///< foreground area in full-resolution pixels
+  double fill = 0.0;     ///< foreground / bounding-box area (π/4 for a disc)
+  int threshold_used = 0;
+};
+
+class ScreenTargetDetector {
+public:
+  explicit ScreenTargetDetector(ScreenTargetDetectorConfig config = {});
+
+  /// `image` is grey CV_8UC1 or BGR CV_8UC3, captured at `stamp`.
+  Result<ScreenTargetMeasurement> detect(const cv::Mat& image, core::Timestamp stamp);
+
+  const ScreenTargetDetectorConfig& config() const { return config_; }
+
+private:
+  ScreenTargetDetectorConfig config_;
+  cv::Mat gray_, small_, binary_, filtered_;
+};
+
+}  // namespace viewline::vision

@@ -1,0 +1,125 @@
+#pragma once
+// [M]'s table-ball image analysis (SPEC §3): table pose from the red surface
+// and ball position on the table from the green ball.
+//
+// Steps (both implementations): Gaussian blur; BGR -> HLS; threshold red;
+// morphological open and close; largest external contour; convex hull;
+// approxPolyDP (ε = 1 % of the image width); drop hull points near the ball;
+// four longest segments; pairwise intersections with |ta|·|tb| < 1.5; order;
+// solvePnP(SOLVEPNP_AP3P) against (±L/2, ±L/2, 0). Ball: threshold green (same
+// HLS image); open; largest external contour; minEnclosingCircle; viewing cone
+// and d = r / sin α (table_geometry.h), known- and unknown-radius variants.
+//
+// TableDetector is the production version, same steps, faster:
+//   - works in a window around the last table (and ball) found, with the full
+//     frame only for the first frame and when the window cuts the table;
+//     blur and morphology read the real neighbourhood of the window (OpenCV
+//     filters on a sub-matrix use the parent image), so inside the window the
+//     masks equal the full-frame ones;
+//   - the red and green masks come out of one pass over the HLS image through
+//     three 256-entry lookup tables (bit-exact with cv::inRange);
+//   - all buffers are reused between frames.
+// With `refine = false` it returns what the reference returns (tested). With
+// `refine = true` (default) it adds, after [M]'s steps: each side re-fitted by
+// least squares to the contour pixels along it (moved out by edge_offset_px,
+// the contour running through boundary pixel centres), corners re-intersected,
+// LM refinement of the AP3P pose, and the ball circle from a least-squares
+// ellipse fit (semi-major axis) instead of the pixel-quantised enclosing circle.
+//
+// referenceTableScene() is the plain speed baseline written the straightforward
+// way (as [M]'s Python): full frame at every step, fresh buffers, two inRange
+// calls per colour, no reuse.
+
+#include <Eigen/Geometry>
+#include <array>
+#include <opencv2/core.hpp>
+#include <optional>
+#include <vector>
+
+#include "viewline/core/camera.h"
+#include "viewline/vision/color.h"
+#include "viewline/vision/detection.h"
+#include "viewline/vision/table_geometry.h"
+
+namespace viewline::vision {
+
+struct TableDetectorConfig {
+  double side_m = 0.3;            ///< L, side of the red square (m)
+  double ball_radius_m = 0.025;   ///< r for the known-radius variant (m)
+  int blur_ksize = 5;             ///< Gaussian blur kernel (odd; 1 = none)
+  ColorRange red_hls{165, 12, 30, 225, 80, 255};   ///< (H, L, S) of the table surface
+  ColorRange green_hls{35, 90, 20, 235, 60, 255};  ///< (H, L, S) of the ball
+  int open_kernel_px = 5;         ///< table mask opening (odd; 1 = none)
+  int close_kernel_px = 5;        ///< table mask closing
+  int ball_open_kernel_px = 3;    ///< ball mask opening
+  CornerSearchParams corners;     ///< approxPolyDP ε, ball exclusion, |ta|·|tb|
+  double min_table_area_px = 300.0;
+  double min_ball_area_px = 8.0;
+  double roi_margin_fraction = 0.2;  ///< window = last table box grown by this fraction ...
+  int roi_margin_px = 12;            ///< ... plus this many pixels on each side
+  bool refine = true;                ///< production refinements (see above); false = [M] exactly
+  double edge_offset_px = 0.5;       ///< contour-to-edge offset used by the refinements
+  double corner_sigma_px = 0.5;      ///< corner noise used for the table "pixel" covariance
+  double ball_edge_noise_px = 0.5;   ///< σe of the ball circle centre: var = σe² / (π ρ)
+
+  void validate() const;  ///< throws core::InvalidInput naming the field
+};
+
+struct TableMeasurement : Measurement {  ///< pixel = mean of the four corners
+  Eigen::Isometry3d c_M_t = Eigen::Isometry3d::Identity();  ///< table frame in the camera frame
+  std::array<Eigen::Vector2d, 4> corners;  ///< image corners of P0..P3 (see orderTableCorners)
+  double reprojection_rms_px = 0.0;
+  bool used_roi = false;
+};
+
+struct BallOnTableMeasurement : Measurement {  ///< pixel = ball circle centre
+  Circle circle;                       ///< image circle used for the geometry
+  BallOnTableGeometry known_radius;    ///< with config.ball_radius_m
+  std::optional<BallOnTableGeometry> unknown_radius;  ///< radius solved from z = r
+};
+
+struct TableScene {
+  Result<TableMeasurement> table = Result<TableMeasurement>::fail(FailureReason::NotFound, "");
+  Result<BallOnTableMeasurement> ball =
+      Result<BallOnTableMeasurement>::fail(FailureReason::NotFound, "");
+  std::optional<Circle> ball_circle;  ///< the ball in the image, even without a table pose
+};
+
+class TableDetector {
+public:
+  TableDetector(core::Camera camera, TableDetectorConfig config = {});
+
+  /// Detect the table and the ball in a BGR CV_8UC3 image captured at `stamp`.
+  TableScene detect(const cv::Mat& bgr, core::Timestamp stamp);
+
+  /// Resolve the square's quarter-turn ambiguity with this pose (e.g. from the arm's
+  /// kinematics); afterwards each frame uses the previous estimate.
+  void setPrior(const Eigen::Isometry3d& c_M_t) { prior_ = c_M_t; }
+  /// Forget the window and the prior (next frame searches the full image).
+  void reset();
+
+  const TableDetectorConfig& config() const { return config_; }
+  const core::Camera& camera() const { return camera_; }
+
+private:
+  bool processWindow(const cv::Mat& bgr, const cv::Rect& roi);
+
+  core::Camera camera_;
+  TableDetectorConfig config_;
+  cv::Mat open_kernel_, close_kernel_, ball_kernel_;
+  std::array<unsigned char, 256> lut_h_{}, lut_l_{}, lut_s_{};
+  cv::Mat blurred_, hls_, red_, green_;
+  std::vector<std::vector<cv::Point>> contours_, ball_contours_;
+  std::vector<cv::Point> table_contour_;
+  std::optional<Circle> ball_circle_;
+  std::vector<cv::Point> ball_contour_;
+  std::optional<cv::Rect> window_;
+  std::optional<Eigen::Isometry3d> prior_;
+};
+
+/// The plain reference of [M]'s steps (speed baseline); see the file comment.
+TableScene referenceTableScene(const cv::Mat& bgr, core::Timestamp stamp, const core::Camera& camera,
+                               const TableDetectorConfig& config,
+                               const std::optional<Eigen::Isometry3d>& prior = std::nullopt);
+
+}  // namespace viewline::vision

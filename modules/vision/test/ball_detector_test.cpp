@@ -1,0 +1,150 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <opencv2/imgproc.hpp>
+
+#include "synthetic.h"
+#include "viewline/core/error.h"
+#include "viewline/core/frames.h"
+#include "viewline/vision/ball_detector.h"
+
+namespace viewline::vision {
+namespace {
+
+core::Camera camera656() {
+  core::Camera cam;
+  cam.width = 656;
+  cam.height = 480;
+  cam.intrinsics = core::intrinsicsFromFov(core::deg2rad(60.0), 656, 480);
+  return cam;  // c_M_w = identity: world = camera frame
+}
+
+const cv::Vec3b kGreen{40, 180, 40};
+
+TEST(BallDetector, SubPixelCentreOfARenderedSphere) {
+  const auto cam = camera656();
+  BallDetector det({}, cam);
+  core::Rng rng = core::makeRng(7);
+  double sq = 0.0;
+  int n = 0;
+  for (int i = 0; i < 12; ++i) {
+    const Eigen::Vector3d c(core::uniform(rng, -0.35, 0.35), core::uniform(rng, -0.25, 0.25),
+                            core::uniform(rng, 1.0, 1.6));
+    cv::Mat img = test::texturedBackground(656, 480, 100 + static_cast<unsigned>(i));
+    test::renderSphere(img, cam, c, 0.025, kGreen);
+    const auto truth = *cam.project(c);
+    const auto r = det.detect(img, 0.02 * i);
+    ASSERT_TRUE(r.ok()) << toString(r.failure().reason) << ": " << r.failure().message;
+    EXPECT_EQ(r->quality, Quality::Good);
+    EXPECT_DOUBLE_EQ(r->stamp, 0.02 * i);
+    const double err = (r->pixel - truth).norm();
+    sq += err * err;
+    ++n;
+    // Radius: the projected sphere's semi-major axis ≈ f r / sqrt(Z² - r²) (on axis).
+    const double rho = cam.focalPx() * 0.025 / std::sqrt(c.squaredNorm() - 0.025 * 0.025);
+    EXPECT_NEAR(r->radius_px, rho, 0.1 * rho + 0.6);
+    EXPECT_GT(r->pixel_covariance(0, 0), 0.0);
+    EXPECT_LT(r->pixel_covariance(0, 0), 0.1);
+  }
+  const double rms = std::sqrt(sq / n);
+  EXPECT_LT(rms, 0.3) << "centre RMS error " << rms << " px";
+}
+
+TEST(BallDetector, WindowAroundPredictionGivesTheFullFrameAnswer) {
+  const auto cam = camera656();
+  BallDetector det({}, cam);
+  cv::Mat img = test::texturedBackground(656, 480, 3);
+  test::renderSphere(img, cam, {0.1, 0.05, 1.2}, 0.025, kGreen);
+  const auto full = det.detect(img, 1.0);
+  const auto win = det.detect(img, 1.0, Eigen::Vector2d(full->pixel.x() + 10.0, full->pixel.y() - 7.0));
+  ASSERT_TRUE(full.ok());
+  ASSERT_TRUE(win.ok());
+  EXPECT_FALSE(full->used_roi);
+  EXPECT_TRUE(win->used_roi);
+  EXPECT_NEAR((full->pixel - win->pixel).norm(), 0.0, 1e-9);
+  // A wrong prediction falls back to the full frame.
+  const auto far = det.detect(img, 1.0, Eigen::Vector2d(20.0, 20.0));
+  ASSERT_TRUE(far.ok());
+  EXPECT_FALSE(far->used_roi);
+  EXPECT_NEAR((far->pixel - full->pixel).norm(), 0.0, 1e-9);
+}
+
+TEST(BallDetector, ReportsWhyItFoundNothing) {
+  const auto cam = camera656();
+  BallDetector det({}, cam);
+  cv::Mat empty = test::texturedBackground(656, 480, 4);
+  auto r = det.detect(empty, 0.0);
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.failure().reason, FailureReason::NotFound);
+
+  // Cut by the left image border.
+  cv::Mat clipped = empty.clone();
+  cv::circle(clipped, cv::Point(5, 200), 20, cv::Scalar(kGreen), cv::FILLED, cv::LINE_AA);
+  r = det.detect(clipped, 0.0);
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.failure().reason, FailureReason::Clipped);
+
+  // Tiny blob.
+  cv::Mat tiny = empty.clone();
+  cv::circle(tiny, cv::Point(300, 200), 1, cv::Scalar(kGreen), cv::FILLED);
+  BallDetectorConfig cfg;
+  cfg.open_kernel_px = 1;
+  BallDetector det_noopen(cfg);
+  r = det_noopen.detect(tiny, 0.0);
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.failure().reason, FailureReason::TooSmall);
+
+  // Two equal balls, no prediction: ambiguous. With a prediction: the near one.
+  cv::Mat two = empty.clone();
+  cv::circle(two, cv::Point(200, 200), 15, cv::Scalar(kGreen), cv::FILLED, cv::LINE_AA);
+  cv::circle(two, cv::Point(450, 260), 15, cv::Scalar(kGreen), cv::FILLED, cv::LINE_AA);
+  r = det.detect(two, 0.0);
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.failure().reason, FailureReason::Ambiguous);
+  BallDetector plain;
+  r = plain.detect(two, 0.0, Eigen::Vector2d(452.0, 258.0));
+  ASSERT_TRUE(r.ok());
+  EXPECT_NEAR(r->pixel.x(), 450.0, 0.3);
+  EXPECT_NEAR(r->pixel.y(), 260.0, 0.3);
+}
+
+TEST(BallDetector, HalfOccludedBallIsDegradedWithInflatedCovariance) {
+  BallDetector det;
+  cv::Mat img(480, 656, CV_8UC3, cv::Scalar(90, 90, 90));
+  cv::circle(img, cv::Point(300, 200), 20, cv::Scalar(kGreen), cv::FILLED, cv::LINE_AA);
+  const auto good = det.detect(img, 0.0);
+  cv::rectangle(img, cv::Point(300, 150), cv::Point(340, 250), cv::Scalar(90, 90, 90), cv::FILLED);
+  const auto half = det.detect(img, 0.0);
+  ASSERT_TRUE(good.ok());
+  ASSERT_TRUE(half.ok());
+  EXPECT_EQ(good->quality, Quality::Good);
+  EXPECT_EQ(half->quality, Quality::Degraded);
+  EXPECT_GT(half->pixel_covariance(0, 0), 10.0 * good->pixel_covariance(0, 0));
+  // The covariance covers the bias of the cut.
+  EXPECT_LT(std::abs(half->pixel.x() - 300.0), 3.0 * std::sqrt(half->pixel_covariance(0, 0)));
+}
+
+TEST(BallDetector, RejectsBadInputNamingTheField) {
+  BallDetector det;
+  EXPECT_THROW(det.detect(cv::Mat(), 0.0), core::InvalidInput);
+  EXPECT_THROW(det.detect(cv::Mat(10, 10, CV_8UC1), 0.0), core::InvalidInput);
+  EXPECT_THROW(det.detect(cv::Mat(10, 10, CV_8UC3), std::nan("")), core::InvalidInput);
+  BallDetectorConfig cfg;
+  cfg.open_kernel_px = 4;
+  try {
+    BallDetector bad(cfg);
+    FAIL();
+  } catch (const core::InvalidInput& e) {
+    EXPECT_NE(std::string(e.what()).find("open_kernel_px"), std::string::npos);
+  }
+  cfg = {};
+  cfg.min_roundness = 0.9;
+  cfg.good_roundness = 0.5;
+  EXPECT_THROW(BallDetector{cfg}, core::InvalidInput);
+  cfg = {};
+  cfg.hsv.hue_lo = 200;
+  EXPECT_THROW(BallDetector{cfg}, core::InvalidInput);
+}
+
+}  // namespace
+}  // namespace viewline::vision
