@@ -144,6 +144,14 @@ IntrinsicsResult calibrateIntrinsics(const std::vector<ViewInput>& views_in, cv:
     const double fx = f.K.at<double>(0, 0), fy = f.K.at<double>(1, 1);
     const double cx = f.K.at<double>(0, 2), cy = f.K.at<double>(1, 2);
     double err = 0.0;
+    // Full Gauss-Newton steps: started from OpenCV's solution the VVS converges in a few tens of
+    // iterations instead of thousands with ViSP's default gain (0.25).
+    const double gain = vpCalibration::getLambda();
+    vpCalibration::setLambda(1.0);
+    struct RestoreGain {
+      double g;
+      ~RestoreGain() { vpCalibration::setLambda(g); }
+    } restore{gain};
     vpCameraParameters cam;
     cam.initPersProjWithoutDistortion(fx, fy, cx, cy);
     if (vpCalibration::computeCalibrationMulti(vpCalibration::CALIB_VIRTUAL_VS, table, cam, err, false) != 0)
