@@ -125,9 +125,8 @@ TiltTable::TiltTable(const TiltTableParams& params, const TiltTableState& initia
 void TiltTable::command(double t, const Eigen::Vector2d& tilt) {
   core::requireFinite(t, "TiltTable::command: t");
   core::requireFinite(tilt, "TiltTable::command: tilt");
-  if (!commands_.empty() && t < commands_.back().first) {
-    throw InvalidInput("TiltTable::command: time goes backwards");
-  }
+  if (t < last_command_time_) throw InvalidInput("TiltTable::command: time goes backwards");
+  last_command_time_ = t;
   commands_.emplace_back(t, tilt);
 }
 
@@ -150,8 +149,8 @@ Eigen::Vector2d TiltTable::rollingAcceleration(const Eigen::Vector2d& tilt) cons
 
 void TiltTable::step(double dt) {
   const double t_new = state_.t + dt;
-  // Actuator: the command issued `delay` before now is the target.
-  while (!commands_.empty() && commands_.front().first + params_.delay <= t_new + 1e-12) {
+  // Actuator: the latest command issued at least `delay` before the start of the sub-step.
+  while (!commands_.empty() && commands_.front().first + params_.delay <= state_.t + 1e-12) {
     target_ = commands_.front().second;
     commands_.pop_front();
   }

@@ -21,24 +21,26 @@ namespace {
 constexpr double kNear = 1e-4;  // m: nothing closer to the camera centre is drawn
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-double kduOf(const vpCameraParameters& k) {
-  return k.get_projModel() == vpCameraParameters::perspectiveProjWithDistortion ? k.get_kdu() : 0.0;
+// Coefficient of ViSP's forward (meter -> pixel) model: vpMeterPixelConversion applies kud,
+// u = u0 + px x (1 + kud (x² + y²)) (vpPixelMeterConversion applies kdu the other way).
+double forwardDistortion(const vpCameraParameters& k) {
+  return k.get_projModel() == vpCameraParameters::perspectiveProjWithDistortion ? k.get_kud() : 0.0;
 }
 
-// Smallest rho >= 0 with rho (1 + kdu rho²) = rd; false when the model never reaches rd.
-bool undistortRadius(double rd, double kdu, double& rho) {
-  if (kdu == 0.0 || rd == 0.0) {
+// Smallest rho >= 0 with rho (1 + kd rho²) = rd; false when the model never reaches rd.
+bool undistortRadius(double rd, double kd, double& rho) {
+  if (kd == 0.0 || rd == 0.0) {
     rho = rd;
     return true;
   }
-  if (kdu < 0.0) {  // the forward map peaks at rho = 1/sqrt(-3 kdu)
-    const double rmax = 1.0 / std::sqrt(-3.0 * kdu);
-    if (rd > rmax * (1.0 + kdu * rmax * rmax)) return false;
+  if (kd < 0.0) {  // the forward map peaks at rho = 1/sqrt(-3 kd)
+    const double rmax = 1.0 / std::sqrt(-3.0 * kd);
+    if (rd > rmax * (1.0 + kd * rmax * rmax)) return false;
   }
-  double r = rd;  // Newton converges monotonically from rd (concave for kdu<0, convex for kdu>0)
+  double r = rd;  // Newton converges monotonically from rd (concave for kd<0, convex for kd>0)
   for (int i = 0; i < 50; ++i) {
-    const double f = r * (1.0 + kdu * r * r) - rd;
-    const double dr = f / (1.0 + 3.0 * kdu * r * r);
+    const double f = r * (1.0 + kd * r * r) - rd;
+    const double dr = f / (1.0 + 3.0 * kd * r * r);
     r -= dr;
     if (std::abs(dr) <= 1e-16 * (1.0 + r)) break;
   }
@@ -47,19 +49,19 @@ bool undistortRadius(double rd, double kdu, double& rho) {
 }
 
 struct Intrinsics {
-  double px, py, u0, v0, kdu;
+  double px, py, u0, v0, kd;
   explicit Intrinsics(const core::Camera& c)
       : px(c.intrinsics.get_px()), py(c.intrinsics.get_py()), u0(c.intrinsics.get_u0()),
-        v0(c.intrinsics.get_v0()), kdu(kduOf(c.intrinsics)) {}
+        v0(c.intrinsics.get_v0()), kd(forwardDistortion(c.intrinsics)) {}
   Eigen::Vector2d toPixel(double x, double y) const {
-    const double s = 1.0 + kdu * (x * x + y * y);
+    const double s = 1.0 + kd * (x * x + y * y);
     return {u0 + px * x * s, v0 + py * y * s};
   }
   Eigen::Vector2d toNormalized(double u, double v) const {
     const double xd = (u - u0) / px, yd = (v - v0) / py;
     const double rd = std::hypot(xd, yd);
     double rho = 0.0;
-    if (!undistortRadius(rd, kdu, rho)) return {std::nan(""), std::nan("")};
+    if (!undistortRadius(rd, kd, rho)) return {std::nan(""), std::nan("")};
     const double s = rd > 0.0 ? rho / rd : 1.0;
     return {xd * s, yd * s};
   }
@@ -464,8 +466,8 @@ cv::Rect projectedBox(const Prepared& p, const Intrinsics& k, int w, int h) {
       vmax = std::max(vmax, uv.y());
     }
   }
-  if (k.kdu < 0.0) {  // barrel distortion folds rays beyond rmax back: stay conservative there
-    const double rmax2 = 1.0 / (-3.0 * k.kdu);
+  if (k.kd < 0.0) {  // barrel distortion folds rays beyond rmax back: stay conservative there
+    const double rmax2 = 1.0 / (-3.0 * k.kd);
     const double r2 = std::max(xmin * xmin, xmax * xmax) + std::max(ymin * ymin, ymax * ymax);
     if (r2 >= 0.98 * rmax2) return full;
   }
@@ -537,7 +539,7 @@ CameraKey intrinsicsKey(const core::Camera& c) {
   k.v[1] = c.intrinsics.get_py();
   k.v[2] = c.intrinsics.get_u0();
   k.v[3] = c.intrinsics.get_v0();
-  k.v[4] = kduOf(c.intrinsics);
+  k.v[4] = forwardDistortion(c.intrinsics);
   return k;
 }
 

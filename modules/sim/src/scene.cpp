@@ -117,18 +117,35 @@ std::shared_ptr<const Texture> tag36h11Texture(int id) {
     s << "tag36h11Texture: id " << id << " outside the family (0.." << n - 1 << ")";
     throw InvalidInput(s.str());
   }
-  image_u8_t* im = apriltag_to_image(family, id);
+  // The code image as apriltag_to_image() draws it: a one-cell white ring (for the normal
+  // border), black elsewhere, white data bits at (bit_x, bit_y) inside the black border.
+  const int n = family->total_width;
+  const int ring = family->width_at_border + (family->reversed_border ? 0 : 2);
+  const int ring_start = (n - ring) / 2;
+  const int border_start = (n - family->width_at_border) / 2;
+  cv::Mat code(n, n, CV_8U, cv::Scalar(0));
+  for (int i = 0; i < ring - 1; ++i) {
+    code.at<uchar>(ring_start, ring_start + i) = 255;
+    code.at<uchar>(ring_start + i, n - 1 - ring_start) = 255;
+    code.at<uchar>(n - ring_start - 1, ring_start + i + 1) = 255;
+    code.at<uchar>(ring_start + 1 + i, ring_start) = 255;
+  }
+  const std::uint64_t word = family->codes[id];
+  for (std::uint32_t i = 0; i < family->nbits; ++i) {
+    if ((word >> (family->nbits - i - 1)) & 1u) {
+      code.at<uchar>(static_cast<int>(family->bit_y[i]) + border_start, static_cast<int>(family->bit_x[i]) + border_start) = 255;
+    }
+  }
   auto tex = std::make_shared<Texture>();
   tex->nearest = true;
-  tex->image = cv::Mat(im->height, im->width, CV_32FC3);
-  for (int j = 0; j < im->height; ++j) {
-    for (int i = 0; i < im->width; ++i) {
+  tex->image = cv::Mat(n, n, CV_32FC3);
+  for (int j = 0; j < n; ++j) {
+    for (int i = 0; i < n; ++i) {
       // Printed paper: white 0.92, black 0.06 reflectance.
-      const float v = im->buf[j * im->stride + i] > 127 ? 0.92f : 0.06f;
+      const float v = code.at<uchar>(j, i) > 127 ? 0.92f : 0.06f;
       tex->image.at<cv::Vec3f>(j, i) = cv::Vec3f(v, v, v);
     }
   }
-  image_u8_destroy(im);
   tag36h11_destroy(family);
   return tex;
 }

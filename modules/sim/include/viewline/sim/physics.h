@@ -17,7 +17,8 @@
 // * ScreenPath: a 2-D target on a screen moving at constant speed along a rectangle, a
 //   circle or a random polyline ([T]).
 // * GroundTarget: a unicycle on the floor driven by [K]'s speed and turn-rate profiles,
-//   integrated with [K]'s midpoint formula (SPEC §1.2, §4).
+//   (v, ω) constant over each profile step k (period profile_period) and integrated exactly as
+//   circular arcs ([K]'s midpoint formula δx = v dt cos(θ + ω dt/2) is its 2nd-order approximation).
 
 #include <Eigen/Geometry>
 #include <cstdint>
@@ -147,6 +148,7 @@ private:
   TiltTableState state_;
   std::deque<std::pair<double, Eigen::Vector2d>> commands_;
   Eigen::Vector2d target_ = Eigen::Vector2d::Zero();
+  double last_command_time_ = -1e300;
   std::deque<TiltTableState> history_;
 };
 

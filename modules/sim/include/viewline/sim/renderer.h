@@ -4,10 +4,11 @@
 // Image contract (what the detectors of module vision receive): cv::Mat CV_8UC3 (BGR), of the
 // camera's width x height, rendered through the camera's ViSP intrinsics *with* distortion: a
 // world point p_w appears at core::Camera::project(p_w), i.e. at
-//     u = u0 + px · x (1 + kdu (x² + y²)),  v = v0 + py · y (1 + kdu (x² + y²)),  (x, y) = (X/Z, Y/Z)
-// (vpMeterPixelConversion). Pixel centres are at integer (u, v); pixel (i, j) covers
+//     u = u0 + px · x (1 + kud (x² + y²)),  v = v0 + py · y (1 + kud (x² + y²)),  (x, y) = (X/Z, Y/Z)
+// (vpMeterPixelConversion of ViSP 3.5 applies kud in this direction; vpPixelMeterConversion
+// applies kdu in the other, an approximate inverse). Pixel centres are at integer (u, v); pixel (i, j) covers
 // [i-½, i+½] x [j-½, j+½]. Every pixel casts the exact ray of that model: the map pixel ->
-// normalised coordinates inverts the kdu model exactly (Newton on the radial polynomial), once
+// normalised coordinates inverts the kud model exactly (Newton on the radial polynomial), once
 // per camera, at pixel centres and corners.
 //
 // Anti-aliasing: a pixel is sampled at its four corners; when they hit different objects or
