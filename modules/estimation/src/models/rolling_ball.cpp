@@ -1,5 +1,6 @@
 #include "viewline/estimation/models/rolling_ball.h"
 
+#include <Eigen/LU>
 #include <cmath>
 #include <sstream>
 
