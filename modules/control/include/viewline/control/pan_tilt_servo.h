@@ -1,0 +1,259 @@
+#pragma once
+// Pan-tilt visual servoing ([T], SPEC §5): keep a moving target at the image centre.
+//
+// Baseline (ViSP's own PTU-46 / Biclops examples): a point feature s = (x, y)
+// (normalised image coordinates of the target, depth fixed at Z = 1), desired
+// s* = (0, 0), task EYEINHAND_L_cVe_eJe:
+//
+//     q̇ = −λ (L cVe eJe)⁺ (s − s*)                                      (1)
+//
+// with L the 2x6 interaction matrix of the point (at s* for "desired", at s for
+// "current"), cVe and eJe from the unit's kinematic model (vpPtu46). No
+// prediction: the law reacts to where the target *was* when the image was taken.
+//
+// Ours: the same law plus feed-forward of the target motion predicted by a
+// Kalman filter, with the latency compensated. The filter estimates the target
+// on its (known) plane, in plane coordinates (m), with a constant-velocity,
+// constant-acceleration (Wiener) or Singer model. At the issue time t of a
+// command that acts from t_e = t + latency (+ lead), it predicts the target
+// position P̂ and velocity V̂ at t_e, and the joints q_e at t_e (the drive model
+// with the commands still in flight, robots::predictJointState). With the
+// target in the camera at q_e, P_c = c_M_f(q_e) P̂ = (X, Y, Z), ŝ = (X/Z, Y/Z),
+// and V_c = c_R_f(q_e) V̂, the feature motion that the target alone causes is
+//
+//     ṡ_T = ((V_cx − x V_cz) / Z, (V_cy − y V_cz) / Z),
+//
+// and the command is
+//
+//     q̇ = −λ J⁺ (ŝ − s*) − J⁺ ṡ_T,    J = L cVe eJe(q_e)                (2)
+//
+// so that ṡ = J q̇ + ṡ_T = −λ (ŝ − s*): the error decays at rate λ instead of
+// settling at the lag ṡ_T / λ of law (1). J⁺ is vpServo's own pseudo-inverse.
+//
+// Both laws' outputs go through robots::limitVelocityCommand (rate limit, and
+// joint limits with braking from the predicted state at the effect time), so no
+// command outside the limits is ever issued.
+//
+// Target lost (ours): for `coast_time` after the last accepted measurement the
+// law keeps following the prediction (an occlusion shorter than that is
+// bridged); after it, a search: an Archimedean spiral in joint space around the
+// joints that pointed at the last prediction, growing at `search_growth` rad per
+// turn up to `search_radius`, at `search_speed` rad/s along the path. The first
+// detection after a loss re-initialises the filter at the measurement
+// (reacquisition). While tracking, a measurement whose NIS exceeds the
+// chi-square gate is rejected; `reinit_after` consecutive rejections also
+// re-initialise the filter. The baseline stops (zero velocity) when the target is
+// not detected, as the ViSP examples do.
+
+#include <Eigen/Geometry>
+#include <memory>
+#include <string>
+#include <vector>
+#include <visp3/core/vpMatrix.h>
+#include <visp3/core/vpVelocityTwistMatrix.h>
+
+#include "viewline/core/time.h"
+#include "viewline/estimation/discretization.h"
+#include "viewline/estimation/state.h"
+#include "viewline/robots/pan_tilt_kinematics.h"
+#include "viewline/robots/pan_tilt_unit.h"
+
+namespace viewline::control {
+
+// ---------------------------------------------------------------------------------------------
+// The ViSP law (1).
+
+struct PointServoConfig {
+  double gain = 0.2;                     ///< λ (1/s)
+  std::string interaction = "desired";   ///< "desired" (L at s*), "current" (L at s) or "mean"
+  void validate() const;                 ///< throws core::InvalidInput naming the field
+};
+
+class VispPointServo {
+public:
+  explicit VispPointServo(const PointServoConfig& config = {});
+  ~VispPointServo();
+  VispPointServo(const VispPointServo&) = delete;
+  VispPointServo& operator=(const VispPointServo&) = delete;
+
+  /// q̇ = −λ (L cVe eJe)⁺ (s − s*) for the normalised point s (depth 1), s* = (0, 0).
+  Eigen::Vector2d command(const Eigen::Vector2d& s, const vpVelocityTwistMatrix& cVe, const vpMatrix& eJe);
+  /// (L cVe eJe)⁺ (2 x 2) of the last command().
+  Eigen::Matrix2d jacobianPinv() const;
+  const PointServoConfig& config() const { return config_; }
+
+private:
+  struct Impl;
+  PointServoConfig config_;
+  std::unique_ptr<Impl> impl_;
+};
+
+// ---------------------------------------------------------------------------------------------
+// The planar target filter.
+
+enum class TargetModel { ConstantVelocity, ConstantAcceleration, Singer };
+TargetModel targetModelFromString(const std::string& name);  ///< "constant_velocity", "constant_acceleration", "singer"
+const char* toString(TargetModel model);
+
+struct TargetFilterConfig {
+  TargetModel model = TargetModel::ConstantVelocity;
+  double q = 0.05;                 ///< CV: acceleration density (m²/s³); CA: jerk density (m²/s⁵)
+  double singer_tau = 2.0;         ///< Singer manoeuvre time constant (s)
+  double singer_sigma = 0.2;       ///< Singer acceleration std (m/s²)
+  double init_velocity_sigma = 0.5;      ///< prior std of the velocity at (re)initialisation (m/s)
+  double init_acceleration_sigma = 0.5;  ///< prior std of the acceleration (m/s²), CA/Singer
+  double gate_probability = 0.9999;      ///< chi-square (2 dof) gate on the NIS
+  int reinit_after = 3;                  ///< consecutive gated-out measurements that re-initialise
+  void validate() const;
+};
+
+/// Kalman filter of a target moving on a plane, state (p, v[, a]) in plane coordinates (m),
+/// models built as continuous-time systems and discretised exactly (estimation::discretize,
+/// Van Loan) for the actual interval of every step:
+///   CV:     ṗ = v, v̇ = w,                 w ~ q I₂
+///   CA:     ṗ = v, v̇ = a, ȧ = w,          w ~ q I₂
+///   Singer: ṗ = v, v̇ = a, ȧ = −a/τ + w,   w ~ (2 σm² / τ) I₂
+/// Measurement: the position, y = [I 0] x + e, cov e = R.
+class PlanarTargetFilter {
+public:
+  explicit PlanarTargetFilter(const TargetFilterConfig& config = {});
+
+  struct Update {
+    bool accepted = false;
+    bool reinitialized = false;
+    double nis = 0.0;
+  };
+  bool initialized() const { return initialized_; }
+  void reset(core::Timestamp t, const Eigen::Vector2d& z, const Eigen::Matrix2d& R);
+  /// Predicts to t (>= the state's time) and fuses z (gated). Initialises on the first call.
+  Update update(core::Timestamp t, const Eigen::Vector2d& z, const Eigen::Matrix2d& R);
+
+  struct Kinematics {
+    Eigen::Vector2d p = Eigen::Vector2d::Zero(), v = Eigen::Vector2d::Zero(), a = Eigen::Vector2d::Zero();
+    Eigen::Matrix2d P_pos = Eigen::Matrix2d::Zero();
+  };
+  /// The state extrapolated to t (no change to the filter); t may be before the state's time
+  /// only by rounding (it is then evaluated at the state's time).
+  Kinematics at(core::Timestamp t) const;
+  const estimation::StateEstimate& state() const { return state_; }
+  const TargetFilterConfig& config() const { return config_; }
+  int stateDim() const { return config_.model == TargetModel::ConstantVelocity ? 4 : 6; }
+
+private:
+  TargetFilterConfig config_;
+  estimation::ContinuousLinearModel model_;
+  estimation::StateEstimate state_;
+  bool initialized_ = false;
+  int rejected_in_a_row_ = 0;
+  double gate_ = 0.0;
+};
+
+// ---------------------------------------------------------------------------------------------
+// Controllers (one interface for the scenario loop).
+
+/// What the camera saw in one image, time-stamped with the capture time.
+struct TargetObservation {
+  core::Timestamp stamp = 0.0;
+  bool detected = false;
+  Eigen::Vector2d feature = Eigen::Vector2d::Zero();    ///< normalised (x, y) in the capture camera
+  Eigen::Vector2d plane = Eigen::Vector2d::Zero();      ///< measured position on the target plane (m)
+  Eigen::Matrix2d plane_cov = Eigen::Matrix2d::Identity();  ///< its covariance (m²)
+};
+
+struct ControlInput {
+  core::Timestamp t = 0.0;              ///< issue time of the command
+  robots::JointState joints;            ///< measured joint state at t
+  std::vector<robots::IssuedCommand> recent;  ///< commands issued in the last latency + period
+  double period = 1.0 / 30.0;           ///< s until the next command (the hold time)
+};
+
+enum class TrackingMode { Tracking, Coasting, Searching, Idle };
+const char* toString(TrackingMode mode);
+
+struct ControlOutput {
+  Eigen::Vector2d qdot = Eigen::Vector2d::Zero();            ///< the command (limited)
+  Eigen::Vector2d qdot_unlimited = Eigen::Vector2d::Zero();  ///< before the limiter
+  TrackingMode mode = TrackingMode::Idle;
+  bool has_prediction = false;
+  Eigen::Vector2d predicted_feature = Eigen::Vector2d::Zero();  ///< ŝ at the effect time (normalised)
+  Eigen::Vector2d predicted_plane = Eigen::Vector2d::Zero();    ///< P̂ on the plane at the effect time
+};
+
+struct LimitConfig {
+  double margin = 0.0087;   ///< rad kept from the joint limits (0.5°)
+};
+
+class PanTiltController {
+public:
+  virtual ~PanTiltController() = default;
+  virtual std::string name() const = 0;
+  virtual void observe(const TargetObservation& observation) = 0;
+  virtual ControlOutput command(const ControlInput& input) = 0;
+};
+
+/// Law (1) on the raw measured feature; zero velocity when the target is not detected.
+class BaselinePanTiltController : public PanTiltController {
+public:
+  BaselinePanTiltController(const PointServoConfig& servo, const robots::PanTiltLimits& limits, double latency,
+                            const LimitConfig& limit_config = {});
+  std::string name() const override { return "visp_baseline"; }
+  void observe(const TargetObservation& observation) override { last_ = observation; }
+  ControlOutput command(const ControlInput& input) override;
+
+private:
+  robots::PanTiltKinematics kinematics_;
+  VispPointServo servo_;
+  robots::PanTiltLimits limits_;
+  double latency_;
+  LimitConfig limit_config_;
+  TargetObservation last_;
+};
+
+struct PredictiveConfig {
+  PointServoConfig servo;
+  TargetFilterConfig filter;
+  double lead = 0.0;              ///< s predicted beyond the command latency (e.g. half a period)
+  bool feed_forward = true;       ///< the −J⁺ ṡ_T term of (2)
+  double coast_time = 1.5;        ///< s of following the prediction without measurements
+  double search_speed = 0.6;      ///< rad/s along the search spiral
+  double search_growth = 0.12;    ///< rad of radius per turn
+  double search_radius = 0.8;     ///< rad, largest spiral radius (then it restarts)
+  double search_gain = 4.0;       ///< 1/s, pull towards the spiral point
+  LimitConfig limits;
+  void validate() const;
+};
+
+/// Law (2): prediction, feed-forward, latency compensation, search and reacquisition.
+class PredictivePanTiltController : public PanTiltController {
+public:
+  /// f_M_plane: pose of the target plane (x, y in the plane) in the unit's base frame.
+  PredictivePanTiltController(const PredictiveConfig& config, const robots::PanTiltLimits& limits, double latency,
+                              const Eigen::Isometry3d& f_M_plane);
+  std::string name() const override { return "predictive"; }
+  void observe(const TargetObservation& observation) override;
+  ControlOutput command(const ControlInput& input) override;
+
+  const PlanarTargetFilter& filter() const { return filter_; }
+  /// The filter's x(k|k) position after the last fused measurement (valid when lastUpdate().accepted).
+  const Eigen::Vector2d& filteredPlane() const { return filtered_; }
+  const PlanarTargetFilter::Update& lastUpdate() const { return last_update_; }
+  std::size_t reacquisitions() const { return reacquisitions_; }
+
+private:
+  PredictiveConfig config_;
+  robots::PanTiltKinematics kinematics_;
+  VispPointServo servo_;
+  robots::PanTiltLimits limits_;
+  double latency_;
+  Eigen::Isometry3d f_M_plane_;
+  PlanarTargetFilter filter_;
+  Eigen::Vector2d filtered_ = Eigen::Vector2d::Zero();
+  PlanarTargetFilter::Update last_update_;
+  core::Timestamp last_accepted_ = -1e300;
+  bool searching_ = false;
+  core::Timestamp search_start_ = 0.0;
+  Eigen::Vector2d search_center_ = Eigen::Vector2d::Zero();
+  std::size_t reacquisitions_ = 0;
+};
+
+}  // namespace viewline::control

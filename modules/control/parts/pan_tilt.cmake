@@ -1,0 +1,4 @@
+# Pan-tilt tracking ([T], issue 6): ViSP's point servo (baseline) and the predictive law with a
+# planar target Kalman filter (CV / CA / Singer), latency compensation, search and reacquisition.
+list(APPEND control_sources src/pan_tilt_servo.cpp)
+list(APPEND control_tests test/pan_tilt_servo_test.cpp)

@@ -1,0 +1,311 @@
+#include "viewline/control/pan_tilt_servo.h"
+
+#include <algorithm>
+#include <cmath>
+#include <visp3/core/vpColVector.h>
+#include <visp3/visual_features/vpFeaturePoint.h>
+#include <visp3/vs/vpServo.h>
+
+#include "viewline/core/checks.h"
+#include "viewline/core/error.h"
+#include "viewline/core/frames.h"
+#include "viewline/core/statistics.h"
+#include "viewline/estimation/kalman_filter.h"
+
+namespace viewline::control {
+
+// ---------------------------------------------------------------------------------------------
+
+void PointServoConfig::validate() const {
+  core::requirePositive(gain, "servo.gain");
+  if (interaction != "desired" && interaction != "current" && interaction != "mean") {
+    throw core::InvalidInput("servo.interaction: expected desired, current or mean, got '" + interaction + "'");
+  }
+}
+
+struct VispPointServo::Impl {
+  vpServo task;
+  vpFeaturePoint s, sd;
+};
+
+VispPointServo::VispPointServo(const PointServoConfig& config) : config_(config), impl_(std::make_unique<Impl>()) {
+  config_.validate();
+  auto& task = impl_->task;
+  task.setServo(vpServo::EYEINHAND_L_cVe_eJe);
+  const vpServo::vpServoIteractionMatrixType type =
+      config_.interaction == "desired" ? vpServo::DESIRED
+                                       : (config_.interaction == "current" ? vpServo::CURRENT : vpServo::MEAN);
+  task.setInteractionMatrixType(type, vpServo::PSEUDO_INVERSE);
+  impl_->sd.buildFrom(0.0, 0.0, 1.0);
+  impl_->s.buildFrom(0.0, 0.0, 1.0);
+  task.addFeature(impl_->s, impl_->sd);
+  task.setLambda(config_.gain);
+}
+
+VispPointServo::~VispPointServo() = default;
+
+Eigen::Vector2d VispPointServo::command(const Eigen::Vector2d& s, const vpVelocityTwistMatrix& cVe, const vpMatrix& eJe) {
+  core::requireFinite(s, "VispPointServo: s");
+  impl_->s.buildFrom(s.x(), s.y(), 1.0);  // depth fixed at 1, as in ViSP's pan-tilt examples
+  impl_->task.set_cVe(cVe);
+  impl_->task.set_eJe(eJe);
+  const vpColVector v = impl_->task.computeControlLaw();
+  return {v[0], v[1]};
+}
+
+Eigen::Matrix2d VispPointServo::jacobianPinv() const {
+  const vpMatrix Jp = impl_->task.getTaskJacobianPseudoInverse();
+  Eigen::Matrix2d out;
+  for (unsigned i = 0; i < 2; ++i)
+    for (unsigned j = 0; j < 2; ++j) out(i, j) = Jp[i][j];
+  return out;
+}
+
+// ---------------------------------------------------------------------------------------------
+
+TargetModel targetModelFromString(const std::string& name) {
+  if (name == "constant_velocity") return TargetModel::ConstantVelocity;
+  if (name == "constant_acceleration") return TargetModel::ConstantAcceleration;
+  if (name == "singer") return TargetModel::Singer;
+  throw core::InvalidInput("target model: expected constant_velocity, constant_acceleration or singer, got '" +
+                           name + "'");
+}
+
+const char* toString(TargetModel model) {
+  switch (model) {
+    case TargetModel::ConstantVelocity: return "constant_velocity";
+    case TargetModel::ConstantAcceleration: return "constant_acceleration";
+    case TargetModel::Singer: return "singer";
+  }
+  return "?";
+}
+
+void TargetFilterConfig::validate() const {
+  if (!(q >= 0.0) || !std::isfinite(q)) throw core::InvalidInput("filter.q must be >= 0");
+  core::requirePositive(singer_tau, "filter.singer_tau");
+  if (!(singer_sigma >= 0.0)) throw core::InvalidInput("filter.singer_sigma must be >= 0");
+  core::requirePositive(init_velocity_sigma, "filter.init_velocity_sigma");
+  core::requirePositive(init_acceleration_sigma, "filter.init_acceleration_sigma");
+  if (!(gate_probability > 0.0 && gate_probability < 1.0)) throw core::InvalidInput("filter.gate_probability must be in (0, 1)");
+  if (reinit_after < 1) throw core::InvalidInput("filter.reinit_after must be >= 1");
+}
+
+PlanarTargetFilter::PlanarTargetFilter(const TargetFilterConfig& config) : config_(config) {
+  config_.validate();
+  const int n = stateDim();
+  const Eigen::Matrix2d I = Eigen::Matrix2d::Identity();
+  model_.A = Eigen::MatrixXd::Zero(n, n);
+  model_.G = Eigen::MatrixXd::Zero(n, 2);
+  model_.B = Eigen::MatrixXd(n, 0);
+  model_.A.block(0, 2, 2, 2) = I;
+  if (n == 4) {
+    model_.G.block(2, 0, 2, 2) = I;
+    model_.Qc = config_.q * I;
+  } else {
+    model_.A.block(2, 4, 2, 2) = I;
+    model_.G.block(4, 0, 2, 2) = I;
+    if (config_.model == TargetModel::Singer) {
+      model_.A.block(4, 4, 2, 2) = -I / config_.singer_tau;
+      model_.Qc = (2.0 * config_.singer_sigma * config_.singer_sigma / config_.singer_tau) * I;
+    } else {
+      model_.Qc = config_.q * I;
+    }
+  }
+  gate_ = core::chiSquareQuantile(2.0, config_.gate_probability);
+}
+
+void PlanarTargetFilter::reset(core::Timestamp t, const Eigen::Vector2d& z, const Eigen::Matrix2d& R) {
+  core::requireFinite(z, "PlanarTargetFilter: z");
+  const int n = stateDim();
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(n);
+  x.head<2>() = z;
+  Eigen::MatrixXd P = Eigen::MatrixXd::Zero(n, n);
+  P.block(0, 0, 2, 2) = R;
+  P.block(2, 2, 2, 2) = std::pow(config_.init_velocity_sigma, 2) * Eigen::Matrix2d::Identity();
+  if (n == 6) P.block(4, 4, 2, 2) = std::pow(config_.init_acceleration_sigma, 2) * Eigen::Matrix2d::Identity();
+  state_ = estimation::StateEstimate(x, P, t);
+  initialized_ = true;
+  rejected_in_a_row_ = 0;
+}
+
+PlanarTargetFilter::Update PlanarTargetFilter::update(core::Timestamp t, const Eigen::Vector2d& z,
+                                                      const Eigen::Matrix2d& R) {
+  Update out;
+  if (!initialized_) {
+    reset(t, z, R);
+    out.accepted = out.reinitialized = true;
+    return out;
+  }
+  const double dt = t - state_.t();
+  if (dt > 1e-9) estimation::predict(state_, estimation::discretize(model_, dt));
+  estimation::LinearMeasurement m;
+  m.C = Eigen::MatrixXd::Zero(2, stateDim());
+  m.C.block(0, 0, 2, 2) = Eigen::Matrix2d::Identity();
+  m.y = z;
+  m.R = R;
+  const Eigen::MatrixXd S = estimation::innovationCovariance(state_, m.C, m.R);
+  const Eigen::Vector2d d = z - state_.x().head<2>();
+  out.nis = d.dot(S.ldlt().solve(d));
+  if (out.nis > gate_) {
+    if (++rejected_in_a_row_ >= config_.reinit_after) {
+      reset(t, z, R);
+      out.accepted = out.reinitialized = true;
+    }
+    return out;
+  }
+  rejected_in_a_row_ = 0;
+  estimation::update(state_, m);
+  out.accepted = true;
+  return out;
+}
+
+PlanarTargetFilter::Kinematics PlanarTargetFilter::at(core::Timestamp t) const {
+  if (!initialized_) throw core::Error("PlanarTargetFilter::at: filter not initialised");
+  Kinematics k;
+  const double dt = t - state_.t();
+  Eigen::VectorXd x = state_.x();
+  Eigen::MatrixXd P = state_.P();
+  if (dt > 1e-9) {
+    const estimation::LinearTransition tr = estimation::discretize(model_, dt);
+    x = tr.Phi * x;
+    P = tr.Phi * P * tr.Phi.transpose() + tr.Q;
+  }
+  k.p = x.head<2>();
+  k.v = x.segment<2>(2);
+  if (stateDim() == 6) k.a = x.segment<2>(4);
+  k.P_pos = P.block(0, 0, 2, 2);
+  return k;
+}
+
+// ---------------------------------------------------------------------------------------------
+
+const char* toString(TrackingMode mode) {
+  switch (mode) {
+    case TrackingMode::Tracking: return "tracking";
+    case TrackingMode::Coasting: return "coasting";
+    case TrackingMode::Searching: return "searching";
+    case TrackingMode::Idle: return "idle";
+  }
+  return "?";
+}
+
+namespace {
+// The predicted state of the joints when a command issued now takes effect.
+robots::JointState effectState(const robots::PanTiltLimits& limits, const ControlInput& in, double latency) {
+  return robots::predictJointState(limits, in.joints, in.recent, latency, in.t + latency);
+}
+}  // namespace
+
+BaselinePanTiltController::BaselinePanTiltController(const PointServoConfig& servo, const robots::PanTiltLimits& limits,
+                                                     double latency, const LimitConfig& limit_config)
+    : servo_(servo), limits_(limits), latency_(latency), limit_config_(limit_config) {
+  limits_.validate();
+}
+
+ControlOutput BaselinePanTiltController::command(const ControlInput& in) {
+  ControlOutput out;
+  if (last_.detected) {
+    out.mode = TrackingMode::Tracking;
+    out.qdot_unlimited = servo_.command(last_.feature, kinematics_.cVe(), kinematics_.eJe(in.joints.q));
+  } else {
+    out.mode = TrackingMode::Idle;
+  }
+  const robots::JointState e = effectState(limits_, in, latency_);
+  out.qdot = robots::limitVelocityCommand(limits_, e.q, e.qdot, out.qdot_unlimited, in.period, limit_config_.margin);
+  return out;
+}
+
+void PredictiveConfig::validate() const {
+  servo.validate();
+  filter.validate();
+  if (!(lead >= 0.0)) throw core::InvalidInput("lead must be >= 0");
+  if (!(coast_time >= 0.0)) throw core::InvalidInput("coast_time must be >= 0");
+  core::requirePositive(search_speed, "search.speed");
+  core::requirePositive(search_growth, "search.growth");
+  core::requirePositive(search_radius, "search.radius");
+  core::requirePositive(search_gain, "search.gain");
+  if (!(limits.margin >= 0.0)) throw core::InvalidInput("limit margin must be >= 0");
+}
+
+PredictivePanTiltController::PredictivePanTiltController(const PredictiveConfig& config,
+                                                         const robots::PanTiltLimits& limits, double latency,
+                                                         const Eigen::Isometry3d& f_M_plane)
+    : config_(config), servo_(config.servo), limits_(limits), latency_(latency), f_M_plane_(f_M_plane),
+      filter_(config.filter) {
+  config_.validate();
+  limits_.validate();
+  core::requireFinite(f_M_plane.matrix(), "PredictivePanTiltController: f_M_plane");
+}
+
+void PredictivePanTiltController::observe(const TargetObservation& obs) {
+  last_update_ = {};
+  if (!obs.detected) return;
+  const bool lost = obs.stamp - last_accepted_ > config_.coast_time;
+  if (lost || !filter_.initialized()) {
+    if (filter_.initialized()) ++reacquisitions_;
+    filter_.reset(obs.stamp, obs.plane, obs.plane_cov);
+    last_update_.accepted = last_update_.reinitialized = true;
+  } else {
+    last_update_ = filter_.update(obs.stamp, obs.plane, obs.plane_cov);
+  }
+  if (last_update_.accepted) {
+    last_accepted_ = obs.stamp;
+    filtered_ = filter_.state().x().head<2>();
+    searching_ = false;
+  }
+}
+
+ControlOutput PredictivePanTiltController::command(const ControlInput& in) {
+  ControlOutput out;
+  const robots::JointState e = effectState(limits_, in, latency_);
+  const double t_e = in.t + latency_ + config_.lead;
+  if (filter_.initialized() && in.t - last_accepted_ <= config_.coast_time) {
+    out.mode = (in.t - last_accepted_ <= 2.5 * in.period) ? TrackingMode::Tracking : TrackingMode::Coasting;
+    const PlanarTargetFilter::Kinematics k = filter_.at(t_e);
+    const Eigen::Vector3d P_f = f_M_plane_ * Eigen::Vector3d(k.p.x(), k.p.y(), 0.0);
+    const Eigen::Vector3d V_f = f_M_plane_.linear() * Eigen::Vector3d(k.v.x(), k.v.y(), 0.0);
+    const Eigen::Isometry3d c_M_f = kinematics_.c_M_f(e.q);
+    const Eigen::Vector3d P_c = c_M_f * P_f;
+    const Eigen::Vector3d V_c = c_M_f.linear() * V_f;
+    out.predicted_plane = k.p;
+    if (P_c.z() > 1e-3) {
+      const double x = P_c.x() / P_c.z(), y = P_c.y() / P_c.z();
+      out.has_prediction = true;
+      out.predicted_feature = Eigen::Vector2d(x, y);
+      out.qdot_unlimited = servo_.command(out.predicted_feature, kinematics_.cVe(), kinematics_.eJe(e.q));
+      if (config_.feed_forward) {
+        const Eigen::Vector2d sdot_target((V_c.x() - x * V_c.z()) / P_c.z(), (V_c.y() - y * V_c.z()) / P_c.z());
+        out.qdot_unlimited -= servo_.jacobianPinv() * sdot_target;
+      }
+    }
+  } else if (filter_.initialized()) {
+    // Search: spiral in joint space around the joints that pointed at the last prediction.
+    out.mode = TrackingMode::Searching;
+    if (!searching_) {
+      searching_ = true;
+      search_start_ = in.t;
+      const PlanarTargetFilter::Kinematics k = filter_.at(std::max(in.t, filter_.state().t()));
+      const Eigen::Vector3d P_f = f_M_plane_ * Eigen::Vector3d(k.p.x(), k.p.y(), 0.0);
+      search_center_ = kinematics_.pointAt(P_f);
+    }
+    // Archimedean spiral r = b θ / 2π with arc-length speed ~ search_speed: dθ/dt = v / sqrt(r² + (b/2π)²).
+    const double b = config_.search_growth / (2.0 * core::kPi);
+    const double tau = in.t + latency_ - search_start_;
+    // Closed form of θ(t) for ds/dt = v with s(θ) ≈ b θ² / 2 (r >> b): θ = sqrt(2 v t / b).
+    double theta = std::sqrt(2.0 * config_.search_speed * tau / b);
+    const double theta_max = config_.search_radius / b;
+    theta = std::fmod(theta, theta_max);
+    const double r = b * theta;
+    const Eigen::Vector2d q_s = search_center_ + r * Eigen::Vector2d(std::cos(theta), std::sin(theta));
+    const double dtheta = config_.search_speed / std::sqrt(r * r + b * b);
+    const Eigen::Vector2d dq_s = dtheta * (b * Eigen::Vector2d(std::cos(theta), std::sin(theta)) +
+                                           r * Eigen::Vector2d(-std::sin(theta), std::cos(theta)));
+    Eigen::Vector2d q_goal = q_s;
+    for (int i = 0; i < 2; ++i) q_goal(i) = std::clamp(q_goal(i), limits_.q_min(i), limits_.q_max(i));
+    out.qdot_unlimited = dq_s + config_.search_gain * (q_goal - e.q);
+  }
+  out.qdot = robots::limitVelocityCommand(limits_, e.q, e.qdot, out.qdot_unlimited, in.period, config_.limits.margin);
+  return out;
+}
+
+}  // namespace viewline::control
