@@ -1,0 +1,28 @@
+// Loads a rig file written by calibrate-rig (or by hand) and prints each camera: this is all an
+// app does to get its calibrated cameras (io::loadRig -> std::vector<core::Camera>).
+#include <iostream>
+
+#include "viewline/core/error.h"
+#include "viewline/io/rig.h"
+
+int main(int argc, char** argv) {
+  if (argc != 2) {
+    std::cerr << "usage: load_rig RIG.yaml\n";
+    return 2;
+  }
+  try {
+    const std::vector<viewline::core::Camera> cameras = viewline::io::loadRig(argv[1]);
+    for (const auto& c : cameras) {
+      std::cout << c.name << ": " << c.width << "x" << c.height << ", px " << c.intrinsics.get_px() << ", py "
+                << c.intrinsics.get_py() << ", kud " << c.intrinsics.get_kud() << ", centre in world ["
+                << c.center_w().transpose() << "] m\n";
+      // Project a world point 1 m in front of the first camera.
+      const auto uv = c.project(cameras.front().c_M_w.inverse() * Eigen::Vector3d(0, 0, 1));
+      if (uv) std::cout << "  sees (0, 0, 1) of " << cameras.front().name << " at pixel [" << uv->transpose() << "]\n";
+    }
+  } catch (const viewline::core::InvalidInput& e) {
+    std::cerr << "load_rig: error: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}
