@@ -6,9 +6,11 @@
 // Frames (ViSP): camera x right, y down, z forward (optical axis).
 // c_M_w maps world coordinates to camera coordinates: p_c = c_M_w * p_w.
 // Normalised coordinates: (x, y) = (X/Z, Y/Z) of p_c; pixels (u, v) follow
-// ViSP's model: u = cx + px * x(1 + kdu r²) (kdu applied when the projection
-// type is with distortion), and back-projection uses kud
-// (x = (u - cx)/px * (1 + kud r_pix²)); see vpPixelMeterConversion.
+// ViSP's model (vpMeterPixelConversion / vpPixelMeterConversion, ViSP 3.5):
+// projection u = u0 + px x (1 + kud (x² + y²)), and back-projection
+// x = (u − u0)/px · (1 + kdu r_pix²) with r_pix² = ((u−u0)/px)² + ((v−v0)/py)²,
+// both applied only when the projection type is with distortion. The two
+// coefficients are separate approximations, not exact inverses.
 
 #include <Eigen/Geometry>
 #include <optional>
