@@ -1,7 +1,8 @@
 #include "viewline/estimation/square_root.h"
 
 #include <Eigen/Cholesky>
-#include <Eigen/QR>
+#include <algorithm>
+#include <cmath>
 #include <string>
 
 #include "viewline/core/checks.h"
@@ -22,19 +23,44 @@ Eigen::MatrixXd psdSqrt(const Eigen::MatrixXd& M, const char* what) {
   return F;
 }
 
+void lowerTriangularizeInPlace(Eigen::Ref<RowMatrixXd> A) {
+  const Eigen::Index r = A.rows();
+  const Eigen::Index c = A.cols();
+  const Eigen::Index k = std::min(r, c);
+  for (Eigen::Index i = 0; i < k; ++i) {
+    const Eigen::Index len = c - i;
+    auto x = A.row(i).segment(i, len);
+    const double tail = (len > 1) ? x.tail(len - 1).squaredNorm() : 0.0;
+    if (tail > 0.0) {
+      // Householder H = I − β v vᵀ with x H = α e₁ (row i): α = −sign(x₀) σ, v = x − α e₁,
+      // β = 2 / vᵀv = 1 / (σ (σ + |x₀|)) (no cancellation).
+      const double x0 = x[0];
+      const double sigma = std::sqrt(x0 * x0 + tail);
+      const double alpha = (x0 > 0.0) ? -sigma : sigma;
+      const double beta = 1.0 / (sigma * (sigma + std::abs(x0)));
+      x[0] = x0 - alpha;  // x now holds v
+      for (Eigen::Index j = i + 1; j < r; ++j) {
+        auto row = A.row(j).segment(i, len);
+        const double w = beta * row.dot(x);
+        row -= w * x;
+      }
+      x[0] = alpha;
+      x.tail(len - 1).setZero();
+    }
+    // Non-negative diagonal: flip column i (rows above i are already zero there).
+    if (A(i, i) < 0.0) A.col(i).tail(r - i) *= -1.0;
+  }
+}
+
 Eigen::MatrixXd lowerTriangularize(const Eigen::MatrixXd& A) {
   const Eigen::Index r = A.rows();
   const Eigen::Index c = A.cols();
   Eigen::MatrixXd T = Eigen::MatrixXd::Zero(r, r);
   if (r == 0) return T;
-  // Aᵀ = Q R  ->  A = Rᵀ Qᵀ, A Aᵀ = Rᵀ R; T = Rᵀ (first r rows of R).
-  Eigen::HouseholderQR<Eigen::MatrixXd> qr(A.transpose());
+  RowMatrixXd work = A;
+  lowerTriangularizeInPlace(work);
   const Eigen::Index k = std::min(r, c);
-  const Eigen::MatrixXd R = qr.matrixQR().topRows(k).template triangularView<Eigen::Upper>();
-  T.leftCols(k) = R.transpose();
-  for (Eigen::Index j = 0; j < k; ++j) {
-    if (T(j, j) < 0.0) T.col(j) = -T.col(j);
-  }
+  T.leftCols(k) = work.leftCols(k);
   return T;
 }
 

@@ -1,0 +1,158 @@
+// One predict + update of the 6-state ballistic filter (SPEC §1.1, issue 2)
+// with 2 and with 8 measurement rows, for our square-root filter and, in the
+// same run, for cv::KalmanFilter and ViSP's vpKalmanFilter doing the same work.
+//
+// The same Φ (BallisticModel, dt = 20 ms), Q, C and R are given to all three:
+// - ours: estimation::predict (x ← Φx + Γu, square-root time update) and
+//   estimation::update (square-root array measurement update, innovation
+//   covariance through its triangular factor), with full input validation
+//   (finite values, sizes, symmetric positive (semi-)definite Q and R) on
+//   every call;
+// - OpenCV: cv::KalmanFilter(6, m, 1, CV_64F), predict(control) with
+//   controlMatrix Γ and control u = 1 (gravity), then correct(y): covariance
+//   form P⁻ = Φ P Φᵀ + Q, K = P⁻Cᵀ(C P⁻Cᵀ + R)⁻¹ (cv::solve), P = P⁻ − K C P⁻;
+//   no validation;
+// - ViSP: vpKalmanFilter::init(6, m, 1) with its public F, H, Q, R, Xest, Pest
+//   set, then prediction() (Xpre = F Xest, Ppre = F Pest Fᵀ + Q) and
+//   filtering(y) (W = Ppre Hᵀ (H Ppre Hᵀ + R)⁻¹ with an explicit inverse,
+//   Pest = (I − W H) Ppre). vpKalmanFilter has no control input, so its step
+//   does not add Γu (slightly less work than the others); no validation.
+//
+// The rows C are viewline planes ([L] eq 26 with Δt ≠ 0, two per camera) of
+// 1 and 4 cameras. The measurement y is fixed; the state converges to it and
+// the work per step does not depend on the values.
+//
+// Run: build/bench/estimation_bench --benchmark_min_time=0.2
+
+#include <benchmark/benchmark.h>
+
+#include <Eigen/Geometry>
+#include <opencv2/core.hpp>
+#include <opencv2/core/eigen.hpp>
+#include <opencv2/video/tracking.hpp>
+#include <visp3/core/vpKalmanFilter.h>
+
+#include "viewline/estimation/kalman_filter.h"
+#include "viewline/estimation/models/ballistic.h"
+
+namespace {
+
+using namespace viewline;
+using namespace viewline::estimation;
+
+struct Problem {
+  LinearTransition tr;
+  LinearMeasurement meas;
+  Eigen::VectorXd x0;
+  Eigen::MatrixXd P0;
+};
+
+// m = 2 * cameras rows: the two viewline planes of each camera through a point near p = (0, 0, 3).
+Problem makeProblem(int rows) {
+  Problem pb;
+  BallisticModel model;
+  model.q = 1.0;
+  pb.tr = model.transition(0.02);
+  const int cameras = rows / 2;
+  pb.meas.C = Eigen::MatrixXd::Zero(rows, 6);
+  pb.meas.y = Eigen::VectorXd::Zero(rows);
+  pb.meas.R = Eigen::MatrixXd::Zero(rows, rows);
+  const Eigen::Vector3d target(0.0, 0.0, 3.0);
+  for (int c = 0; c < cameras; ++c) {
+    // Camera c on a circle looking at the target; its planes contain the viewline.
+    const double a = 2.0 * M_PI * c / cameras;
+    const Eigen::Vector3d centre(4.0 * std::cos(a), 4.0 * std::sin(a), 1.5);
+    const Eigen::Vector3d dir = (target - centre).normalized();
+    const Eigen::Vector3d n1 = dir.cross(Eigen::Vector3d::UnitZ()).normalized();
+    const Eigen::Vector3d n2 = dir.cross(n1).normalized();
+    const double dt_capture = 0.004 * c;  // unsynchronised cameras ([L] eq 26)
+    for (int k = 0; k < 2; ++k) {
+      const Eigen::Vector3d n = (k == 0) ? n1 : n2;
+      const int r = 2 * c + k;
+      pb.meas.C.block<1, 3>(r, 0) = n.transpose();
+      pb.meas.C.block<1, 3>(r, 3) = dt_capture * n.transpose();
+      pb.meas.y[r] = n.dot(target);
+      pb.meas.R(r, r) = std::pow(0.002 * (1.0 + 0.1 * r), 2);
+    }
+  }
+  pb.x0 = (Eigen::VectorXd(6) << 0.1, -0.1, 3.2, 0.0, 0.0, -8.0).finished();
+  pb.P0 = Eigen::MatrixXd::Identity(6, 6);
+  return pb;
+}
+
+void BM_Ours(benchmark::State& state) {
+  const Problem pb = makeProblem(static_cast<int>(state.range(0)));
+  StateEstimate s(pb.x0, pb.P0);
+  for (auto _ : state) {
+    predict(s, pb.tr);
+    const UpdateReport rep = update(s, pb.meas);
+    benchmark::DoNotOptimize(rep.nis);
+    benchmark::DoNotOptimize(s.x().data());
+  }
+}
+
+cv::Mat toCv(const Eigen::MatrixXd& m) {
+  cv::Mat out;
+  cv::eigen2cv(m, out);
+  return out;
+}
+
+void BM_OpenCV(benchmark::State& state) {
+  const int rows = static_cast<int>(state.range(0));
+  const Problem pb = makeProblem(rows);
+  cv::KalmanFilter kf(6, rows, 1, CV_64F);
+  kf.transitionMatrix = toCv(pb.tr.Phi);
+  kf.controlMatrix = toCv(pb.tr.Gamma);
+  kf.processNoiseCov = toCv(pb.tr.Q);
+  kf.measurementMatrix = toCv(pb.meas.C);
+  kf.measurementNoiseCov = toCv(pb.meas.R);
+  kf.statePost = toCv(pb.x0);
+  kf.errorCovPost = toCv(pb.P0);
+  const cv::Mat control = toCv(pb.tr.u);
+  const cv::Mat y = toCv(pb.meas.y);
+  for (auto _ : state) {
+    kf.predict(control);
+    const cv::Mat& x = kf.correct(y);
+    benchmark::DoNotOptimize(x.data);
+  }
+}
+
+vpMatrix toVp(const Eigen::MatrixXd& m) {
+  vpMatrix out(static_cast<unsigned int>(m.rows()), static_cast<unsigned int>(m.cols()));
+  for (Eigen::Index i = 0; i < m.rows(); ++i)
+    for (Eigen::Index j = 0; j < m.cols(); ++j) out[static_cast<unsigned int>(i)][static_cast<unsigned int>(j)] = m(i, j);
+  return out;
+}
+
+vpColVector toVpCol(const Eigen::VectorXd& v) {
+  vpColVector out(static_cast<unsigned int>(v.size()));
+  for (Eigen::Index i = 0; i < v.size(); ++i) out[static_cast<unsigned int>(i)] = v[i];
+  return out;
+}
+
+void BM_ViSP(benchmark::State& state) {
+  const int rows = static_cast<int>(state.range(0));
+  const Problem pb = makeProblem(rows);
+  vpKalmanFilter kf;
+  kf.init(6, static_cast<unsigned int>(rows), 1);
+  kf.F = toVp(pb.tr.Phi);
+  kf.H = toVp(pb.meas.C);
+  kf.Q = toVp(pb.tr.Q);
+  kf.R = toVp(pb.meas.R);
+  kf.Xest = toVpCol(pb.x0);
+  kf.Pest = toVp(pb.P0);
+  const vpColVector y = toVpCol(pb.meas.y);
+  for (auto _ : state) {
+    kf.prediction();
+    kf.filtering(y);
+    benchmark::DoNotOptimize(kf.Xest.data);
+  }
+}
+
+}  // namespace
+
+BENCHMARK(BM_Ours)->Arg(2)->Arg(8)->ArgName("rows");
+BENCHMARK(BM_OpenCV)->Arg(2)->Arg(8)->ArgName("rows");
+BENCHMARK(BM_ViSP)->Arg(2)->Arg(8)->ArgName("rows");
+
+BENCHMARK_MAIN();
