@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <Eigen/Eigenvalues>
 #include <opencv2/imgproc.hpp>
 
 #include "viewline/core/checks.h"
@@ -50,85 +51,177 @@ Eigen::Vector2d lineIntersection(const Eigen::Vector2d& p1, const Eigen::Vector2
   return p1 + t(0) * d1;
 }
 
-/// Production refinement of [M]'s corners: each side re-fitted by least squares to the contour
-/// pixels along its middle 80 % (away from the ball), moved out by the contour-to-edge offset,
-/// and adjacent sides re-intersected. Corners are kept when a side has too few points.
-std::array<Eigen::Vector2d, 4> refineCorners(const std::array<Eigen::Vector2d, 4>& ordered,
-                                             const std::vector<cv::Point>& contour,
-                                             const std::optional<Circle>& ball,
-                                             const TableDetectorConfig& cfg) {
-  Eigen::Vector2d centroid = Eigen::Vector2d::Zero();
-  for (const auto& c : ordered) centroid += 0.25 * c;
-  std::array<Eigen::Vector2d, 4> line_p, line_d;
-  std::array<bool, 4> fitted{};
-  std::vector<cv::Point2f> pts;
-  for (std::size_t k = 0; k < 4; ++k) {
-    const Eigen::Vector2d a = ordered[k], b = ordered[(k + 1) % 4];
-    const double len = (b - a).norm();
-    line_p[k] = a;
-    line_d[k] = (b - a) / std::max(len, 1e-9);
-    if (len < 8.0) continue;
-    const Eigen::Vector2d dir = line_d[k];
-    const Eigen::Vector2d nrm(-dir.y(), dir.x());
-    pts.clear();
-    for (const auto& q : contour) {
-      const Eigen::Vector2d p(q.x, q.y);
-      const double s = (p - a).dot(dir) / len;
-      if (s < 0.1 || s > 0.9) continue;
-      if (std::abs((p - a).dot(nrm)) > 3.0) continue;
-      if (ball && (p - ball->center).norm() < cfg.corners.ball_exclusion_factor * ball->radius + 2.0)
-        continue;
-      pts.emplace_back(static_cast<float>(p.x()), static_cast<float>(p.y()));
-    }
-    if (pts.size() < 6) continue;
-    cv::Vec4f l;
-    cv::fitLine(pts, l, cv::DIST_L2, 0, 0.01, 0.01);
-    Eigen::Vector2d d(static_cast<double>(l[0]), static_cast<double>(l[1]));
-    Eigen::Vector2d p(static_cast<double>(l[2]), static_cast<double>(l[3]));
-    Eigen::Vector2d n(-d.y(), d.x());
-    if (n.dot(p - centroid) < 0.0) n = -n;  // outward normal
-    line_p[k] = p + cfg.edge_offset_px * n;
-    line_d[k] = d;
-    fitted[k] = true;
-  }
-  std::array<Eigen::Vector2d, 4> out = ordered;
-  for (std::size_t k = 0; k < 4; ++k) {
-    // Corner k joins side k-1 (ending at corner k) and side k (starting there).
-    const std::size_t prev = (k + 3) % 4;
-    if (!fitted[k] && !fitted[prev]) continue;
-    bool ok = false;
-    const Eigen::Vector2d c = lineIntersection(line_p[prev], line_d[prev], line_p[k], line_d[k], ok);
-    if (ok && (c - ordered[k]).norm() < 5.0) out[k] = c;
-  }
-  return out;
+/// Bilinear sample of a colour feature of the raw BGR image: kChannel = 2 (red) gives
+/// R - max(G, B), kChannel = 1 (green) G - max(R, B). NaN outside the image.
+template <int kChannel>
+double featureAt(const cv::Mat& bgr, double u, double v) {
+  if (!(u >= 0.0 && v >= 0.0 && u <= bgr.cols - 1.001 && v <= bgr.rows - 1.001)) return std::nan("");
+  const int x = static_cast<int>(u), y = static_cast<int>(v);
+  const double fx = u - x, fy = v - y;
+  double f[3] = {0.0, 0.0, 0.0};
+  const cv::Vec3b& a = bgr.at<cv::Vec3b>(y, x);
+  const cv::Vec3b& b = bgr.at<cv::Vec3b>(y, x + 1);
+  const cv::Vec3b& c = bgr.at<cv::Vec3b>(y + 1, x);
+  const cv::Vec3b& d = bgr.at<cv::Vec3b>(y + 1, x + 1);
+  for (int k = 0; k < 3; ++k)
+    f[k] = (1 - fy) * ((1 - fx) * a[k] + fx * b[k]) + fy * ((1 - fx) * c[k] + fx * d[k]);
+  const int o1 = (kChannel + 1) % 3, o2 = (kChannel + 2) % 3;
+  return f[kChannel] - std::max(f[o1], f[o2]);
 }
 
-/// Ball circle: [M]'s minimum enclosing circle, or (refine) a least-squares ellipse fit whose
-/// semi-major axis is the radius of the ellipse's minimum enclosing circle.
-std::optional<Circle> ballCircle(const std::vector<cv::Point>& contour, bool refine,
-                                 double edge_offset) {
-  if (contour.empty()) return std::nullopt;
-  Circle c;
-  if (refine && contour.size() >= 8) {
-    const cv::RotatedRect e = cv::fitEllipse(contour);
-    const double a = 0.5 * static_cast<double>(std::max(e.size.width, e.size.height));
-    if (std::isfinite(a) && a > 0.0) {
-      c.center = {static_cast<double>(e.center.x), static_cast<double>(e.center.y)};
-      c.radius = a + edge_offset;
-      return c;
+/// Sub-pixel edge along p(s) = p0 + s n, s in [-reach, reach]: the crossing of the level half
+/// way between the inside plateau (first pixel of the profile) and the outside (last pixel),
+/// searched from the inside. False without enough contrast or without a crossing.
+template <int kChannel>
+bool edgeAlong(const cv::Mat& bgr, const Eigen::Vector2d& p0, const Eigen::Vector2d& n, double reach,
+               double min_contrast, double& s_edge) {
+  constexpr double kStep = 0.25;
+  const int count = static_cast<int>(2.0 * reach / kStep) + 1;
+  double prof[64];
+  if (count > 64 || count < 9) return false;
+  for (int i = 0; i < count; ++i) {
+    const Eigen::Vector2d p = p0 + (-reach + i * kStep) * n;
+    prof[i] = featureAt<kChannel>(bgr, p.x(), p.y());
+    if (std::isnan(prof[i])) return false;
+  }
+  const int plateau = 4;  // 1 px
+  double in = 0.0, out = 0.0;
+  for (int i = 0; i < plateau; ++i) {
+    in += prof[i];
+    out += prof[count - 1 - i];
+  }
+  in /= plateau;
+  out /= plateau;
+  if (in - out < min_contrast) return false;
+  const auto crossing = [&](double level, int from, int to, double& s) {
+    for (int i = std::max(from, 0); i + 1 < count && i < to; ++i) {
+      if (prof[i] >= level && prof[i + 1] < level) {
+        s = -reach + kStep * (i + (prof[i] - level) / (prof[i] - prof[i + 1]));
+        return true;
+      }
+    }
+    return false;
+  };
+  if (!crossing(0.5 * (in + out), 0, count, s_edge)) return false;
+  // Second pass with the levels just beside the edge (1.25 px either side): the plateaus far
+  // from it may differ from the edge's own colours (shading of a sphere, texture).
+  const int ie = static_cast<int>(std::lround((s_edge + reach) / kStep));
+  const int gap = 5;  // 1.25 px: the anti-aliased, bilinearly sampled step spans ±1 px
+  if (ie - gap >= 0 && ie + gap < count) {
+    const double in2 = prof[ie - gap], out2 = prof[ie + gap];
+    double s2 = 0.0;
+    if (in2 - out2 >= min_contrast && crossing(0.5 * (in2 + out2), ie - gap, ie + gap, s2)) s_edge = s2;
+  }
+  return true;
+}
+
+/// Total least-squares line through points (centroid + principal direction), then once more
+/// without the points farther than 1 px from the first line (outliers: clutter, the ball).
+bool fitLineRobust(std::vector<Eigen::Vector2d>& pts, Eigen::Vector2d& point, Eigen::Vector2d& dir) {
+  for (int round = 0; round < 2; ++round) {
+    if (pts.size() < 4) return false;
+    Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+    for (const auto& p : pts) mean += p;
+    mean /= static_cast<double>(pts.size());
+    Eigen::Matrix2d S = Eigen::Matrix2d::Zero();
+    for (const auto& p : pts) S += (p - mean) * (p - mean).transpose();
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es(S);
+    point = mean;
+    dir = es.eigenvectors().col(1);  // largest eigenvalue
+    if (round == 0) {
+      const Eigen::Vector2d n(-dir.y(), dir.x());
+      pts.erase(std::remove_if(pts.begin(), pts.end(), [&](const Eigen::Vector2d& p) { return std::abs((p - mean).dot(n)) > 1.0; }),
+                pts.end());
     }
   }
+  return true;
+}
+
+/// Production refinement of [M]'s corners: sub-pixel edge points of the red surface sampled
+/// along each side (middle 80 %, away from the ball) on the raw image, a robust line fit per
+/// side (up to 33 edge points), adjacent sides re-intersected. A side with too few edge points keeps its line.
+std::array<Eigen::Vector2d, 4> refineCorners(const cv::Mat& bgr, const std::array<Eigen::Vector2d, 4>& ordered,
+                                             const std::optional<Circle>& ball,
+                                             const TableDetectorConfig& cfg) {
+  std::array<Eigen::Vector2d, 4> corners = ordered;
+  std::vector<Eigen::Vector2d> pts;
+  for (int pass = 0; pass < 1; ++pass) {
+    Eigen::Vector2d centroid = Eigen::Vector2d::Zero();
+    for (const auto& c : corners) centroid += 0.25 * c;
+    std::array<Eigen::Vector2d, 4> line_p, line_d;
+    std::array<bool, 4> fitted{};
+    for (std::size_t k = 0; k < 4; ++k) {
+      const Eigen::Vector2d a = corners[k], b = corners[(k + 1) % 4];
+      const double len = (b - a).norm();
+      line_p[k] = a;
+      line_d[k] = (b - a) / std::max(len, 1e-9);
+      if (len < 8.0) continue;
+      Eigen::Vector2d n(-line_d[k].y(), line_d[k].x());
+      if (n.dot(a - centroid) < 0.0) n = -n;  // outward
+      pts.clear();
+      const int samples = std::clamp(static_cast<int>(len / 2.0), 4, 32);  // cost bound
+      for (int i = 0; i <= samples; ++i) {
+        const double s = 0.1 + 0.8 * i / std::max(samples, 1);
+        const Eigen::Vector2d p = a + s * (b - a);
+        if (ball && (p - ball->center).norm() < cfg.corners.ball_exclusion_factor * ball->radius + 4.0) continue;
+        double e = 0.0;
+        if (!edgeAlong<2>(bgr, p, n, 4.0, 25.0, e)) continue;
+        pts.push_back(p + e * n);
+      }
+      if (pts.size() < 6) continue;
+      fitted[k] = fitLineRobust(pts, line_p[k], line_d[k]);
+    }
+    std::array<Eigen::Vector2d, 4> next = corners;
+    for (std::size_t k = 0; k < 4; ++k) {
+      // Corner k joins side k-1 (ending at corner k) and side k (starting there).
+      const std::size_t prev = (k + 3) % 4;
+      if (!fitted[k] && !fitted[prev]) continue;
+      bool ok = false;
+      const Eigen::Vector2d c = lineIntersection(line_p[prev], line_d[prev], line_p[k], line_d[k], ok);
+      if (ok && (c - ordered[k]).norm() < 6.0) next[k] = c;
+    }
+    corners = next;
+  }
+  return corners;
+}
+
+/// Production refinement of the ball circle: sub-pixel edge points of the green ball on 32 rays
+/// from its centre, a least-squares ellipse through them; centre = ellipse centre, radius = its
+/// semi-major axis (the minimum enclosing circle of the true outline, which [M]'s step
+/// approximates from pixel contours). Kept as is when too many rays find no edge (occlusion).
+Circle refineBallCircle(const cv::Mat& bgr, const Circle& initial) {
+  std::vector<cv::Point2f> pts;
+  constexpr int kRays = 32;
+  const double reach = std::min(4.0, std::max(2.0, 0.45 * initial.radius));
+  for (int i = 0; i < kRays; ++i) {
+    const double th = 2.0 * core::kPi * i / kRays;
+    const Eigen::Vector2d n(std::cos(th), std::sin(th));
+    const Eigen::Vector2d p = initial.center + initial.radius * n;
+    double e = 0.0;
+    if (!edgeAlong<1>(bgr, p, n, reach, 25.0, e)) continue;
+    const Eigen::Vector2d q = p + e * n;
+    pts.emplace_back(static_cast<float>(q.x()), static_cast<float>(q.y()));
+  }
+  if (pts.size() < 24) return initial;  // occluded or clipped: keep [M]'s circle
+  const cv::RotatedRect el = cv::fitEllipse(pts);
+  const double a = 0.5 * static_cast<double>(std::max(el.size.width, el.size.height));
+  const Eigen::Vector2d c(static_cast<double>(el.center.x), static_cast<double>(el.center.y));
+  if (!std::isfinite(a) || std::abs(a - initial.radius) > 3.0 || (c - initial.center).norm() > 3.0) return initial;
+  return Circle{c, a};
+}
+
+/// Ball circle: [M]'s minimum enclosing circle of the ball contour.
+std::optional<Circle> ballCircle(const std::vector<cv::Point>& contour) {
+  if (contour.empty()) return std::nullopt;
   cv::Point2f center;
   float radius = 0.0F;
   cv::minEnclosingCircle(contour, center, radius);
-  c.center = {static_cast<double>(center.x), static_cast<double>(center.y)};
-  c.radius = static_cast<double>(radius) + (refine ? edge_offset : 0.0);
-  return c;
+  return Circle{{static_cast<double>(center.x), static_cast<double>(center.y)}, static_cast<double>(radius)};
 }
 
 /// The cheap part shared by the reference and the production pipeline: from the table contour
 /// and the ball contour to the measurements.
-TableScene finishScene(const std::vector<cv::Point>* table_contour, double table_area,
+TableScene finishScene(const cv::Mat& bgr, const std::vector<cv::Point>* table_contour, double table_area,
                        const std::vector<cv::Point>* ball_contour, double ball_area,
                        const cv::Size& image_size, core::Timestamp stamp, const core::Camera& camera,
                        const TableDetectorConfig& cfg, bool refine,
@@ -139,7 +232,8 @@ TableScene finishScene(const std::vector<cv::Point>* table_contour, double table
   bool ball_clipped = false;
   if (ball_contour && ball_area + 0.5 * cv::arcLength(*ball_contour, true) >= cfg.min_ball_area_px) {
     ball_clipped = touchesBorder(cv::boundingRect(*ball_contour), frame);
-    scene.ball_circle = ballCircle(*ball_contour, refine, cfg.edge_offset_px);
+    scene.ball_circle = ballCircle(*ball_contour);
+    if (refine && !ball_clipped && scene.ball_circle) scene.ball_circle = refineBallCircle(bgr, *scene.ball_circle);
   }
   // Table.
   if (!table_contour) {
@@ -157,7 +251,7 @@ TableScene finishScene(const std::vector<cv::Point>* table_contour, double table
       scene.table = corners.failure();
     } else {
       auto ordered = orderTableCorners(corners->corners);
-      if (refine) ordered = refineCorners(ordered, *table_contour, scene.ball_circle, cfg);
+      if (refine) ordered = refineCorners(bgr, ordered, scene.ball_circle, cfg);
       const auto pose = solveTablePose(ordered, camera, cfg.side_m, refine, prior);
       if (!pose) {
         scene.table = pose.failure();
@@ -229,7 +323,6 @@ void TableDetectorConfig::validate() const {
   if (!(roi_margin_fraction >= 0.0 && roi_margin_fraction <= 2.0))
     throw core::InvalidInput("TableDetectorConfig.roi_margin_fraction must be in [0, 2]");
   if (roi_margin_px < 0) throw core::InvalidInput("TableDetectorConfig.roi_margin_px must be >= 0");
-  core::requireFinite(edge_offset_px, "TableDetectorConfig.edge_offset_px");
   core::requirePositive(corner_sigma_px, "TableDetectorConfig.corner_sigma_px");
   core::requirePositive(ball_edge_noise_px, "TableDetectorConfig.ball_edge_noise_px");
 }
@@ -323,7 +416,7 @@ TableScene TableDetector::detect(const cv::Mat& bgr, core::Timestamp stamp) {
   const int b = largestContour(ball_contours_, &ball_area);
   const auto* table_contour = t >= 0 ? &contours_[static_cast<std::size_t>(t)] : nullptr;
   const auto* ball_contour = b >= 0 ? &ball_contours_[static_cast<std::size_t>(b)] : nullptr;
-  TableScene scene = finishScene(table_contour, table_area, ball_contour, ball_area, bgr.size(), stamp,
+  TableScene scene = finishScene(bgr, table_contour, table_area, ball_contour, ball_area, bgr.size(), stamp,
                                  camera_, config_, config_.refine, prior_, used_roi);
   if (scene.table) {
     prior_ = scene.table->c_M_t;
@@ -365,7 +458,7 @@ TableScene referenceTableScene(const cv::Mat& bgr, core::Timestamp stamp, const 
   double table_area = 0.0, ball_area = 0.0;
   const int t = largestContour(contours, &table_area);
   const int b = largestContour(ball_contours, &ball_area);
-  return finishScene(t >= 0 ? &contours[static_cast<std::size_t>(t)] : nullptr, table_area,
+  return finishScene(bgr, t >= 0 ? &contours[static_cast<std::size_t>(t)] : nullptr, table_area,
                      b >= 0 ? &ball_contours[static_cast<std::size_t>(b)] : nullptr, ball_area, bgr.size(),
                      stamp, camera, config, /*refine=*/false, prior, false);
 }

@@ -20,11 +20,16 @@
 //     three 256-entry lookup tables (bit-exact with cv::inRange);
 //   - all buffers are reused between frames.
 // With `refine = false` it returns what the reference returns (tested). With
-// `refine = true` (default) it adds, after [M]'s steps: each side re-fitted by
-// least squares to the contour pixels along it (moved out by edge_offset_px,
-// the contour running through boundary pixel centres), corners re-intersected,
-// LM refinement of the AP3P pose, and the ball circle from a least-squares
-// ellipse fit (semi-major axis) instead of the pixel-quantised enclosing circle.
+// `refine = true` (default) it adds, after [M]'s steps, sub-pixel edges: the
+// thresholded masks put the edges where a colour threshold happens to cut the
+// blurred transition (1-2 px off, depending on the neighbouring colour), so
+// each side is re-fitted (robust line fit) to sub-pixel edge points
+// found on the raw image along its normal (crossing of the mid level of the
+// "redness" R - max(G, B) profile), the corners re-intersected, the AP3P pose
+// refined by Levenberg-Marquardt on the four corners, and the ball circle
+// replaced by a least-squares ellipse through sub-pixel edge points of the
+// "greenness" G - max(R, B) on 32 rays (centre = ellipse centre, radius =
+// semi-major axis, i.e. the minimum enclosing circle of the true outline).
 //
 // referenceTableScene() is the plain speed baseline written the straightforward
 // way (as [M]'s Python): full frame at every step, fresh buffers, two inRange
@@ -55,10 +60,9 @@ struct TableDetectorConfig {
   CornerSearchParams corners;     ///< approxPolyDP ε, ball exclusion, |ta|·|tb|
   double min_table_area_px = 300.0;
   double min_ball_area_px = 8.0;
-  double roi_margin_fraction = 0.2;  ///< window = last table box grown by this fraction ...
-  int roi_margin_px = 12;            ///< ... plus this many pixels on each side
+  double roi_margin_fraction = 0.1;  ///< window = last table box grown by this fraction ...
+  int roi_margin_px = 10;            ///< ... plus this many pixels on each side
   bool refine = true;                ///< production refinements (see above); false = [M] exactly
-  double edge_offset_px = 0.5;       ///< contour-to-edge offset used by the refinements
   double corner_sigma_px = 0.5;      ///< corner noise used for the table "pixel" covariance
   double ball_edge_noise_px = 0.5;   ///< σe of the ball circle centre: var = σe² / (π ρ)
 
