@@ -46,30 +46,79 @@ Eigen::Vector3d illuminationGain(const Illumination& il, double t) {
   return g * il.white_balance_bgr;
 }
 
+namespace {
+
+// One pass over an 8-bit image: per-channel gain (Q8 fixed point, repeated along a row so the
+// loops vectorise) and/or additive noise values, saturated to [0, 255].
+void gainAndNoise(cv::Mat& img, const Eigen::Vector3d* gain, const std::int8_t* noise) {
+  const int ch = img.channels();
+  const auto row_len = static_cast<std::size_t>(img.cols) * static_cast<std::size_t>(ch);
+  std::vector<std::uint16_t> g(gain != nullptr ? row_len : 0);
+  for (std::size_t i = 0; i < g.size(); ++i) {
+    const double gi = (*gain)[static_cast<Eigen::Index>(i % static_cast<std::size_t>(ch) % 3)];
+    g[i] = static_cast<std::uint16_t>(std::clamp(std::lround(256.0 * gi), 0L, 65535L));
+  }
+  for (int j = 0; j < img.rows; ++j) {
+    uchar* p = img.ptr<uchar>(j);
+    const std::int8_t* q = noise != nullptr ? noise + static_cast<std::size_t>(j) * row_len : nullptr;
+    if (gain != nullptr && q != nullptr) {
+      const std::uint16_t* gr = g.data();
+      for (std::size_t i = 0; i < row_len; ++i) {
+        const int v = static_cast<int>((static_cast<std::uint32_t>(p[i]) * gr[i] + 128u) >> 8) + q[i];
+        p[i] = static_cast<uchar>(v < 0 ? 0 : (v > 255 ? 255 : v));
+      }
+    } else if (gain != nullptr) {
+      const std::uint16_t* gr = g.data();
+      for (std::size_t i = 0; i < row_len; ++i) {
+        const std::uint32_t v = (static_cast<std::uint32_t>(p[i]) * gr[i] + 128u) >> 8;
+        p[i] = static_cast<uchar>(v > 255u ? 255u : v);
+      }
+    } else if (q != nullptr) {
+      for (std::size_t i = 0; i < row_len; ++i) {
+        const int v = p[i] + q[i];
+        p[i] = static_cast<uchar>(v < 0 ? 0 : (v > 255 ? 255 : v));
+      }
+    }
+  }
+}
+
+bool unitGain(const Eigen::Vector3d& g) { return (g.array() - 1.0).abs().maxCoeff() < 1e-12; }
+
+}  // namespace
+
 void applyIllumination(cv::Mat& bgr8, const Illumination& il, double t) {
   if (bgr8.type() != CV_8UC3) throw InvalidInput("applyIllumination: image must be CV_8UC3");
   const Eigen::Vector3d g = illuminationGain(il, t);
-  if ((g.array() - 1.0).abs().maxCoeff() < 1e-12) return;
-  cv::Mat lut(1, 256, CV_8UC3);
-  for (int i = 0; i < 256; ++i) {
-    for (int c = 0; c < 3; ++c) lut.at<cv::Vec3b>(0, i)[c] = cv::saturate_cast<uchar>(g[c] * i);
-  }
-  cv::LUT(bgr8, lut, bgr8);
+  if (!unitGain(g)) gainAndNoise(bgr8, &g, nullptr);
 }
 
 NoisePool::NoisePool(const SensorNoise& noise, core::Rng& rng) : sigma_(noise.sigma) {
   requireRange(noise.sigma, 0.0, 255.0, false, "SensorNoise.sigma");
-  if (sigma_ <= 0.0) return;
+  if (noise.pool_size < 1024) throw InvalidInput("SensorNoise.pool_size must be >= 1024");
+  if (sigma_ <= 0.0 || sigma_ > kMaxPoolSigma) return;  // large sigma: cv::randn path
+  // OpenCV's Ziggurat sampler (local engine seeded from rng): millions of draws in milliseconds.
+  cv::Mat draws(1, static_cast<int>(noise.pool_size), CV_32F);
+  cv::RNG local(rng());
+  local.fill(draws, cv::RNG::NORMAL, 0.0, sigma_);
   pool_.resize(noise.pool_size);
-  std::normal_distribution<double> n(0.0, sigma_);
-  for (auto& v : pool_) v = static_cast<std::int16_t>(std::clamp(std::lround(n(rng)), -255L, 255L));
+  const float* d = draws.ptr<float>(0);
+  for (std::size_t i = 0; i < pool_.size(); ++i) {
+    pool_[i] = static_cast<std::int8_t>(std::clamp(std::lround(static_cast<double>(d[i])), -127L, 127L));
+  }
 }
 
-void NoisePool::apply(cv::Mat& image, core::Rng& rng) const {
-  if (sigma_ <= 0.0) return;
+void NoisePool::apply(cv::Mat& image, core::Rng& rng) const { applyWithGain(image, Eigen::Vector3d::Ones(), rng); }
+
+void NoisePool::applyWithGain(cv::Mat& image, const Eigen::Vector3d& gain, core::Rng& rng) const {
   if (image.depth() != CV_8U) throw InvalidInput("NoisePool::apply: image must be 8-bit");
+  const bool with_gain = !unitGain(gain);
+  if (sigma_ <= 0.0) {
+    if (with_gain) gainAndNoise(image, &gain, nullptr);
+    return;
+  }
   const std::size_t n = image.total() * static_cast<std::size_t>(image.channels());
   if (!image.isContinuous() || n > pool_.size()) {
+    if (with_gain) gainAndNoise(image, &gain, nullptr);
     cv::Mat noise(image.size(), CV_MAKETYPE(CV_16S, image.channels()));
     cv::RNG local(rng());
     local.fill(noise, cv::RNG::NORMAL, 0.0, sigma_);
@@ -80,12 +129,7 @@ void NoisePool::apply(cv::Mat& image, core::Rng& rng) const {
     return;
   }
   std::uniform_int_distribution<std::size_t> off(0, pool_.size() - n);
-  const std::int16_t* q = pool_.data() + off(rng);
-  uchar* p = image.data;
-  for (std::size_t i = 0; i < n; ++i) {
-    const int v = p[i] + q[i];
-    p[i] = static_cast<uchar>(v < 0 ? 0 : (v > 255 ? 255 : v));
-  }
+  gainAndNoise(image, with_gain ? &gain : nullptr, pool_.data() + off(rng));
 }
 
 double discSegmentFraction(double d) {

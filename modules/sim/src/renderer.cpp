@@ -288,13 +288,17 @@ inline Vector3d shade(const Prepared& p, const Hit& h, const Vector3d& d, const 
 }
 
 // Nearest hit closer than tmax among prims: its index (or -1), colour and depth.
-inline int trace(const std::vector<const Prepared*>& prims, double x, double y, double tmax,
+// Only primitives whose pixel box holds pixel (px, py) are tested (boxes have a 2 px margin, so
+// this is exact for sub-samples and corners of that pixel).
+inline int trace(const std::vector<const Prepared*>& prims, int px, int py, double x, double y, double tmax,
                  const Light& light, Vector3d& colour, double* depth) {
   if (!std::isfinite(x) || !std::isfinite(y)) return -1;
   const Vector3d d(x, y, 1.0);
+  const cv::Point pixel(px, py);
   Hit best, h;
   int id = -1;
   for (std::size_t i = 0; i < prims.size(); ++i) {
+    if (!prims[i]->bbox.contains(pixel)) continue;
     if (intersect(*prims[i], d, tmax, h)) {
       best = h;
       tmax = h.t;
@@ -338,7 +342,9 @@ void renderRegion(const cv::Rect& r, const std::vector<const Prepared*>& prims, 
       const std::size_t k = 2 * (static_cast<std::size_t>(j) * W1 + static_cast<std::size_t>(i));
       const double bd = base.depthAt(std::min(i, g.w - 1), std::min(j, g.h - 1));
       const auto a = static_cast<std::size_t>(i - r.x);
-      ids[a] = prims.empty() ? -1 : trace(prims, g.corner[k], g.corner[k + 1], bd, light, colours[a], nullptr);
+      ids[a] = prims.empty() ? -1
+                             : trace(prims, std::min(i, g.w - 1), std::min(j, g.h - 1), g.corner[k], g.corner[k + 1],
+                                     bd, light, colours[a], nullptr);
     }
   };
   cornerRow(r.y, id_top, col_top);
@@ -360,7 +366,7 @@ void renderRegion(const cv::Rect& r, const std::vector<const Prepared*>& prims, 
       if (uniform) {
         if (id < 0) {
           c = base.colour(i, j);
-        } else if (trace(prims, g.center[cidx], g.center[cidx + 1], bd, light, c, &dep) < 0) {
+        } else if (trace(prims, i, j, g.center[cidx], g.center[cidx + 1], bd, light, c, &dep) < 0) {
           c = base.colour(i, j);
         }
       } else {
@@ -376,11 +382,11 @@ void renderRegion(const cv::Rect& r, const std::vector<const Prepared*>& prims, 
             const double fx = (sx + 0.5) / n;
             const double x = (1 - fy) * ((1 - fx) * x00 + fx * x10) + fy * ((1 - fx) * x01 + fx * x11);
             const double y = (1 - fy) * ((1 - fx) * y00 + fx * y10) + fy * ((1 - fx) * y01 + fx * y11);
-            sum += trace(prims, x, y, bd, light, sc, nullptr) >= 0 ? sc : bc;
+            sum += trace(prims, i, j, x, y, bd, light, sc, nullptr) >= 0 ? sc : bc;
           }
         }
         c = sum / (n * n);
-        if (depth_out != nullptr) trace(prims, g.center[cidx], g.center[cidx + 1], bd, light, sc, &dep);
+        if (depth_out != nullptr) trace(prims, i, j, g.center[cidx], g.center[cidx + 1], bd, light, sc, &dep);
       }
       double* out = acc + 3 * (static_cast<std::size_t>(j - r.y) * static_cast<std::size_t>(r.width) + a);
       out[0] += weight * c[0];
@@ -419,33 +425,14 @@ void countCoverage(const cv::Rect& r, const std::vector<const Prepared*>& prims,
   }
 }
 
-// Conservative pixel bounding box of a primitive (empty when wholly behind the camera).
-cv::Rect projectedBox(const Prepared& p, const Intrinsics& k, int w, int h) {
-  Vector3d b_o = Vector3d::Zero();
-  double R = 0.0;
-  switch (p.shape) {
-    case Shape::Sphere: R = p.size.x(); break;
-    case Shape::Box: R = 0.5 * p.size.norm(); break;
-    case Shape::Cylinder:
-    case Shape::Cone:
-      b_o = Vector3d(0.0, 0.0, 0.5 * p.size.z());
-      R = std::hypot(p.size.x(), 0.5 * p.size.z());
-      break;
-    case Shape::Rectangle: R = 0.5 * std::hypot(p.size.x(), p.size.y()); break;
-    case Shape::Disc: R = p.size.x(); break;
-  }
+// Pixel bounding box of normalised-plane rectangle [xmin, xmax] x [ymin, ymax] (boundary sampled
+// through the distortion model, 2 px margin), clipped to the image.
+cv::Rect pixelBox(double xmin, double xmax, double ymin, double ymax, const Intrinsics& k, int w, int h) {
   const cv::Rect full(0, 0, w, h);
-  const Vector3d C = p.c_R_o * b_o + p.c_origin;
-  if (C.z() + R <= kNear) return {};
-  if (C.z() - R <= 1e-3) return full;
-  double xmin = kInf, xmax = -kInf, ymin = kInf, ymax = -kInf;
-  for (double sz : {-R, R}) {
-    for (double s : {-R, R}) {
-      xmin = std::min(xmin, (C.x() + s) / (C.z() + sz));
-      xmax = std::max(xmax, (C.x() + s) / (C.z() + sz));
-      ymin = std::min(ymin, (C.y() + s) / (C.z() + sz));
-      ymax = std::max(ymax, (C.y() + s) / (C.z() + sz));
-    }
+  if (k.kd < 0.0) {  // barrel distortion folds rays beyond rmax back: stay conservative there
+    const double rmax2 = 1.0 / (-3.0 * k.kd);
+    const double r2 = std::max(xmin * xmin, xmax * xmax) + std::max(ymin * ymin, ymax * ymax);
+    if (r2 >= 0.98 * rmax2) return full;
   }
   double umin = kInf, umax = -kInf, vmin = kInf, vmax = -kInf;
   constexpr int kSteps = 8;
@@ -466,11 +453,6 @@ cv::Rect projectedBox(const Prepared& p, const Intrinsics& k, int w, int h) {
       vmax = std::max(vmax, uv.y());
     }
   }
-  if (k.kd < 0.0) {  // barrel distortion folds rays beyond rmax back: stay conservative there
-    const double rmax2 = 1.0 / (-3.0 * k.kd);
-    const double r2 = std::max(xmin * xmin, xmax * xmax) + std::max(ymin * ymin, ymax * ymax);
-    if (r2 >= 0.98 * rmax2) return full;
-  }
   const double lim = 4.0 * (w + h);
   umin = std::clamp(umin, -lim, lim);
   umax = std::clamp(umax, -lim, lim);
@@ -479,6 +461,61 @@ cv::Rect projectedBox(const Prepared& p, const Intrinsics& k, int w, int h) {
   const int x0 = static_cast<int>(std::floor(umin)) - 2, x1 = static_cast<int>(std::ceil(umax)) + 3;
   const int y0 = static_cast<int>(std::floor(vmin)) - 2, y1 = static_cast<int>(std::ceil(vmax)) + 3;
   return cv::Rect(x0, y0, x1 - x0, y1 - y0) & full;
+}
+
+// Conservative pixel bounding box of a primitive (empty when wholly behind the camera): the
+// projection of its sphere (spheres) or of the corners of its object-frame bounding box (others;
+// the object is convex, so its image lies in the hull of the projected corners).
+cv::Rect projectedBox(const Prepared& p, const Intrinsics& k, int w, int h) {
+  const cv::Rect full(0, 0, w, h);
+  double xmin = kInf, xmax = -kInf, ymin = kInf, ymax = -kInf;
+  auto add = [&](const Vector3d& q) {
+    xmin = std::min(xmin, q.x() / q.z());
+    xmax = std::max(xmax, q.x() / q.z());
+    ymin = std::min(ymin, q.y() / q.z());
+    ymax = std::max(ymax, q.y() / q.z());
+  };
+  if (p.shape == Shape::Sphere) {
+    const Vector3d& C = p.c_origin;
+    const double R = p.size.x();
+    if (C.z() + R <= kNear) return {};
+    if (C.z() - R <= 1e-3) return full;
+    for (double sz : {-R, R}) {
+      for (double sx : {-R, R}) {
+        for (double sy : {-R, R}) add(C + Vector3d(sx, sy, sz));
+      }
+    }
+    return pixelBox(xmin, xmax, ymin, ymax, k, w, h);
+  }
+  Vector3d lo, hi;
+  switch (p.shape) {
+    case Shape::Box: lo = -0.5 * p.size; hi = 0.5 * p.size; break;
+    case Shape::Cylinder:
+    case Shape::Cone:
+      lo = Vector3d(-p.size.x(), -p.size.x(), 0.0);
+      hi = Vector3d(p.size.x(), p.size.x(), p.size.z());
+      break;
+    case Shape::Rectangle:
+      lo = Vector3d(-0.5 * p.size.x(), -0.5 * p.size.y(), 0.0);
+      hi = -lo;
+      break;
+    default:  // Disc
+      lo = Vector3d(-p.size.x(), -p.size.x(), 0.0);
+      hi = -lo;
+      break;
+  }
+  int behind = 0, near = 0;
+  Vector3d corners[8];
+  for (int i = 0; i < 8; ++i) {
+    const Vector3d q_o((i & 1) ? hi.x() : lo.x(), (i & 2) ? hi.y() : lo.y(), (i & 4) ? hi.z() : lo.z());
+    corners[i] = p.c_R_o * q_o + p.c_origin;
+    if (corners[i].z() <= kNear) ++behind;
+    if (corners[i].z() <= 1e-3) ++near;
+  }
+  if (behind == 8) return {};
+  if (near > 0) return full;
+  for (const auto& c : corners) add(c);
+  return pixelBox(xmin, xmax, ymin, ymax, k, w, h);
 }
 
 void accToImage(const std::vector<double>& acc, const cv::Rect& r, cv::Mat& img) {

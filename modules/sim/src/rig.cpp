@@ -123,8 +123,7 @@ std::optional<Frame> CameraRig::captureNext(const World& world) {
   exposure.duration = fx.blur.exposure;
   exposure.blur_samples = fx.blur.samples;
   frame.image = renderer_.render(world, frame.camera, exposure, &frame.truth, extra);
-  applyIllumination(frame.image, fx.illumination, cap.capture_time);
-  noise_[i].apply(frame.image, s.effect_rng);
+  noise_[i].applyWithGain(frame.image, illuminationGain(fx.illumination, cap.capture_time), s.effect_rng);
   return frame;
 }
 

@@ -162,3 +162,30 @@ TEST(Worlds, ScreenGroundDartAndBallWorldsPlaceTheirTargets) {
   std::vector<DragFlight> flights{DragFlight({}, 0.0, 1.0, DragBody{}), DragFlight({}, 0.5, 1.0, DragBody{})};
   EXPECT_THROW(BallFlightWorld(flights, Scene{}), core::InvalidInput);
 }
+
+TEST(Worlds, ClutterIsSeededAndStaysInItsBox) {
+  ClutterSettings c;
+  c.count = 25;
+  c.min_w = Eigen::Vector3d(-1.0, 0.5, 0.2);
+  c.max_w = Eigen::Vector3d(1.0, 1.5, 1.2);
+  c.colour_bgr = Eigen::Vector3d(0.1, 0.5, 0.95);
+  Scene a, b, d;
+  core::Rng r1 = core::makeRng(3), r2 = core::makeRng(3), r3 = core::makeRng(4);
+  addClutter(a, c, r1);
+  addClutter(b, c, r2);
+  addClutter(d, c, r3);
+  ASSERT_EQ(a.primitives.size(), 25u);
+  for (std::size_t i = 0; i < a.primitives.size(); ++i) {
+    const Primitive& p = a.primitives[i];
+    EXPECT_TRUE(p.name.empty());  // distractors are not in the truth
+    EXPECT_TRUE(((p.w_M_o.translation() - c.min_w).array() >= 0.0).all());
+    EXPECT_TRUE(((c.max_w - p.w_M_o.translation()).array() >= 0.0).all());
+    EXPECT_GE(p.size.x(), c.radius_min);
+    EXPECT_LE(p.size.x(), c.radius_max);
+    EXPECT_LT((p.material.albedo_bgr - c.colour_bgr).norm(), 0.3);
+    EXPECT_EQ(p.w_M_o.translation(), b.primitives[i].w_M_o.translation());
+  }
+  EXPECT_NE(a.primitives[0].w_M_o.translation(), d.primitives[0].w_M_o.translation());
+  c.radius_min = -1.0;
+  EXPECT_THROW(addClutter(a, c, r1), core::InvalidInput);
+}

@@ -3,7 +3,7 @@
 // config, and deterministic per seed (all draws come from the camera's own core::Rng streams).
 //
 // Order in a frame (CameraRig): render with motion blur (and the occluder) -> illumination and
-// white balance (per-channel gains, on 8-bit values through a LUT) -> sensor noise -> 8-bit.
+// white balance (per-channel gains on the 8-bit values) -> sensor noise -> 8-bit.
 // Frame faults (drops, time-stamp jitter) act on the schedule, not on the pixels.
 
 #include <Eigen/Core>
@@ -21,12 +21,12 @@ namespace viewline::sim {
 
 /// Additive Gaussian sensor noise, independent per pixel and channel: I' = sat(I + n),
 /// n ~ N(0, sigma²) rounded to integers. For speed the values come from a pool of
-/// `pool_size` seeded draws read at a random offset per frame (so any pixel's noise is a fresh
-/// N(0, σ²) draw; two frames share values only at different, shifted pixels). Images larger
-/// than the pool fall back to cv::randn.
+/// `pool_size` seeded draws (8-bit, clipped at ±127) read at a random offset per frame (so any
+/// pixel's noise is a fresh N(0, σ²) draw; two frames share values only at different, shifted
+/// pixels). Images larger than the pool, and sigma > 40, use cv::randn per frame instead.
 struct SensorNoise {
   double sigma = 0.0;            ///< grey levels (0..255 scale), >= 0
-  std::size_t pool_size = 1u << 22;
+  std::size_t pool_size = 1u << 21;  ///< >= 1024; images up to this many values use the pool
 };
 
 /// Motion blur: the moving objects are rendered at `samples` instants evenly spread over the
@@ -87,14 +87,17 @@ void applyIllumination(cv::Mat& bgr8, const Illumination& illumination, double t
 /// Seeded pool of rounded N(0, sigma²) values; apply() adds them at a random offset.
 class NoisePool {
 public:
+  static constexpr double kMaxPoolSigma = 40.0;  ///< above: per-frame cv::randn (no clipping)
   NoisePool(const SensorNoise& noise, core::Rng& rng);
-  /// Adds noise to a CV_8UC3 (or any 8-bit) image in place; the offset is drawn from rng.
+  /// Adds noise to an 8-bit image in place; the offset is drawn from rng.
   void apply(cv::Mat& image8, core::Rng& rng) const;
+  /// Per-channel gains (illuminationGain) then noise, in a single pass over the image.
+  void applyWithGain(cv::Mat& image8, const Eigen::Vector3d& gain_bgr, core::Rng& rng) const;
   double sigma() const { return sigma_; }
 
 private:
   double sigma_;
-  std::vector<std::int16_t> pool_;
+  std::vector<std::int8_t> pool_;
 };
 
 /// The occluder primitive for a target seen by `camera` (nullopt when the fraction is 0 or the
