@@ -1,0 +1,19 @@
+#pragma once
+// YAML (config/dart_tracking.yaml) <-> DartScenarioConfig, and the summary as JSON.
+// Keys are strict (io::ConfigNode): an unknown key is an error naming file:line and key path.
+
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "viewline/tracking/dart_scenario.h"
+
+namespace viewline::apps {
+
+/// Defaults of tracking::defaultDartScenario() overridden by the file's keys (every key optional).
+tracking::DartScenarioConfig loadDartScenario(const std::string& path);
+/// Same from YAML text (`name` stands for the file in messages).
+tracking::DartScenarioConfig dartScenarioFromString(const std::string& yaml, const std::string& name);
+
+nlohmann::json summaryToJson(const tracking::DartSummary& s, const tracking::DartScenarioConfig& cfg);
+
+}  // namespace viewline::apps

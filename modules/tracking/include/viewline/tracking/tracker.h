@@ -1,0 +1,199 @@
+#pragma once
+// Multi-view asynchronous viewline tracker ([L], SPEC §2).
+//
+//   std::vector<core::Camera> cams = ...;            // calibrated rig
+//   tracking::TrackerConfig cfg;                     // prior, model, gate, timing
+//   tracking::ViewlineTracker tracker(cams, cfg);
+//   auto r = tracker.submit({id, camera_index, capture_time, pixel, sigma_px});
+//   if (r != tracking::Refusal::None) ++refused[r]; // reason the caller can count
+//   tracker.state();                                 // x = (p, ṗ), P at the newest capture time
+//   tracker.predictAt(t);                            // e.g. for an interception planner
+//
+// Every measurement carries its own capture time. Two ways to use it:
+//  - TimeMode::Exact: the state is propagated exactly (ballistic.h) to every
+//    capture time and the image's two viewline rows are fused there;
+//  - TimeMode::DtOffset: the filter runs on a fixed grid of period T; an image
+//    captured Δt after the grid instant uses the Δt-offset rows of [L] eq 26.
+// Images are fused one at a time (R is block diagonal over images, so this
+// equals the stacked update and costs O(#images), not O(#rows³)); each image
+// is gated on its own, so one bad camera does not veto the others.
+//
+// Late data. Processed measurements stay in a buffer for `late_horizon`
+// seconds, each with a snapshot of the track state before it. A measurement
+// older than the newest one but within the horizon is inserted in capture-time
+// order and everything after it is re-processed from the snapshot: the result
+// equals in-order processing exactly (same operations in the same order). The
+// processing order is (t, camera, id).
+//
+// Refused (counted by reason, never fused): non-finite stamp or pixel, unknown
+// camera, pixel outside the image (+ margin), bad sigma, duplicate (same camera
+// and stamp, or same id, within the buffer), older than newest − horizon
+// (backwards beyond the horizon), or further than max_forward_gap in the future.
+//
+// Track start and loss. The first measurement (and any after a gap of
+// max_coast without a fused image) starts a track from the configured prior
+// at its capture time and is fused without gating (nothing to gate against).
+// After `restart_after_rejections` consecutive gated images of one camera
+// (counted per camera: a track seeded by an outlier of camera A can keep
+// agreeing with A while B disagrees) the track is judged to have been seeded
+// by a bad measurement: its seed (oldest
+// measurement of the track history) is dropped and a new track is started
+// from the prior and re-fed with the rest of the history and the current
+// image (gated as usual). The state therefore depends only on past
+// measurements (causal), which keeps the late-data replay exact.
+
+#include <array>
+#include <cstdint>
+#include <deque>
+#include <optional>
+#include <unordered_map>
+#include <vector>
+
+#include "viewline/core/camera.h"
+#include "viewline/core/time.h"
+#include "viewline/estimation/state.h"
+#include "viewline/tracking/ballistic.h"
+#include "viewline/tracking/gates.h"
+#include "viewline/tracking/viewline.h"
+
+namespace viewline::tracking {
+
+/// One detected image point with its capture time.
+struct ImageMeasurement {
+  std::uint64_t id = 0;          ///< unique per measurement (for outcome queries)
+  std::size_t camera = 0;        ///< index into the tracker's cameras
+  core::Timestamp t = 0.0;       ///< capture time, s
+  Eigen::Vector2d uv = Eigen::Vector2d::Zero();  ///< detected pixel (distorted, as in the image)
+  double sigma_px = 0.5;         ///< pixel noise std, px
+};
+
+enum class Refusal : int {
+  None = 0,
+  NonFinite,      ///< NaN/Inf stamp or pixel
+  UnknownCamera,  ///< camera index out of range
+  OutsideImage,   ///< pixel outside the image by more than the margin
+  BadNoise,       ///< sigma_px not a positive finite number
+  Duplicate,      ///< same camera and stamp (or same id) already buffered
+  TooOld,         ///< older than newest − late_horizon
+  FarFuture,      ///< more than max_forward_gap after the newest stamp
+  kCount
+};
+const char* toString(Refusal r);
+
+enum class TimeMode { Exact, DtOffset };
+const char* toString(TimeMode m);
+
+enum class Fate { Fused, Gated, DroppedOnRestart };
+const char* toString(Fate f);
+
+struct MeasurementOutcome {
+  ImageMeasurement m;
+  Fate fate = Fate::Fused;
+  GateReport gate;
+  bool seed = false;   ///< started a track (fused without gating)
+};
+
+struct TrackerConfig {
+  BallisticModel model;
+  Vector6 prior_mean = (Vector6() << 0.0, 0.0, 3.0, 0.0, 0.0, -8.0).finished();  ///< SPEC §2 ([L])
+  Matrix6 prior_cov = 100.0 * Matrix6::Identity();                              ///< 10² I
+  GateConfig gate;
+  TimeMode time_mode = TimeMode::Exact;
+  double sample_period = 0.01;        ///< s, grid of TimeMode::DtOffset
+  double late_horizon = 0.2;          ///< s
+  double max_forward_gap = 1.0;       ///< s
+  int restart_after_rejections = 3;   ///< consecutive gated images of one camera (a fused image
+                                      ///< of that camera resets its count)
+  double max_coast = 0.5;             ///< s without a fused image: the next one starts a new track
+  std::size_t history_capacity = 24;  ///< measurements kept per track for a restart
+  double min_depth = 0.05;            ///< m, floor of the predicted depth in the noise model
+  bool depth_variance_in_noise = true;  ///< row variance from Ẑ² + σ_Z² (true) or Ẑ² (false)
+  /// Young-track refit: while a track has at most this many fused images, after each fused image
+  /// the track is re-filtered from its prior over its history with every row's E[Z²] taken from
+  /// the CURRENT estimate (propagated back to that capture time) instead of the prediction at the
+  /// time. The depth, and so the row noise, is poorly known at first; without the refit the first
+  /// rows keep the huge variance of the prior's depth forever (information lost, slow single-camera
+  /// convergence). 0 disables it. Causal (uses only the track history), so late replay stays exact.
+  int refit_young_tracks = 8;
+  double image_margin_px = 0.5;       ///< pixels this far outside the image are still accepted
+  /// Throws core::InvalidInput naming the field.
+  void validate() const;
+};
+
+/// Track state: what a snapshot holds (the estimate and the track bookkeeping).
+struct TrackState {
+  estimation::StateEstimate est;
+  bool active = false;
+  int consecutive_rejections = 0;                ///< max over cameras of the per-camera count
+  std::vector<int> camera_rejections;            ///< consecutive gated images per camera
+  int fused_in_track = 0;
+  core::Timestamp last_fused_t = 0.0;
+  core::Timestamp track_start_t = 0.0;      ///< sample time of the track's prior
+  std::vector<MeasurementOutcome> history;  ///< since the track's seed (capped)
+  int tracks_started = 0;
+  int restarts = 0;
+};
+
+/// One image fused into an estimate at the estimate's time + dt_offset: builds the rows, gates
+/// them (unless `force`), updates when accepted. The estimate must already be at its sample time.
+MeasurementOutcome fuseImage(estimation::StateEstimate& s, const core::Camera& camera,
+                             const ImageMeasurement& m, const BallisticModel& model,
+                             const GateConfig& gate, double dt_offset, double min_depth, bool force,
+                             bool depth_variance_in_noise = true);
+
+class ViewlineTracker {
+public:
+  ViewlineTracker(std::vector<core::Camera> cameras, TrackerConfig cfg);
+
+  /// Validates, buffers and fuses one measurement (re-processing later ones when it is late).
+  Refusal submit(const ImageMeasurement& m);
+
+  bool initialised() const { return state_.active; }
+  /// The estimate after the newest processed measurement (time = its capture time, or its grid
+  /// instant in DtOffset mode).
+  const estimation::StateEstimate& state() const { return state_.est; }
+  const TrackState& trackState() const { return state_; }
+  /// The estimate propagated to t >= state().t() (no measurement fused).
+  estimation::StateEstimate predictAt(core::Timestamp t) const;
+
+  std::size_t refusalCount(Refusal r) const { return refusals_[static_cast<std::size_t>(r)]; }
+  std::size_t lateInserted() const { return late_inserted_; }
+  std::size_t bufferSize() const { return buffer_.size(); }
+
+  /// Current outcome of a processed measurement (it can change while the measurement is within
+  /// the horizon or in the current track's history).
+  std::optional<MeasurementOutcome> outcome(std::uint64_t id) const;
+  /// Outcomes of every processed measurement since the last clearOutcomes().
+  std::vector<MeasurementOutcome> outcomes() const;
+  void clearOutcomes() { final_.clear(); }
+
+  const std::vector<core::Camera>& cameras() const { return cameras_; }
+  const TrackerConfig& config() const { return cfg_; }
+  /// Forget everything (state, buffer, outcomes, counters).
+  void reset();
+
+private:
+  struct Entry {
+    ImageMeasurement m;
+    TrackState before;
+  };
+  Refusal check(const ImageMeasurement& m) const;
+  void step(TrackState& ts, const ImageMeasurement& m);
+  void startTrack(TrackState& ts, core::Timestamp t);
+  void restart(TrackState& ts);
+  void refit(TrackState& ts) const;
+  void evict(const MeasurementOutcome& o) { final_[o.m.id] = o; }
+  core::Timestamp sampleTime(core::Timestamp t) const;
+
+  std::vector<core::Camera> cameras_;
+  TrackerConfig cfg_;
+  TrackState state_;
+  std::deque<Entry> buffer_;
+  std::unordered_map<std::uint64_t, MeasurementOutcome> final_;
+  std::array<std::size_t, static_cast<std::size_t>(Refusal::kCount)> refusals_{};
+  bool any_ = false;
+  core::Timestamp newest_ = 0.0;
+  std::size_t late_inserted_ = 0;
+};
+
+}  // namespace viewline::tracking

@@ -1,0 +1,277 @@
+#include "viewline/tracking/tracker.h"
+
+#include <algorithm>
+#include <cmath>
+#include <tuple>
+
+#include "viewline/core/checks.h"
+#include "viewline/estimation/kalman_filter.h"
+
+namespace viewline::tracking {
+
+const char* toString(Refusal r) {
+  switch (r) {
+    case Refusal::None: return "none";
+    case Refusal::NonFinite: return "non_finite";
+    case Refusal::UnknownCamera: return "unknown_camera";
+    case Refusal::OutsideImage: return "outside_image";
+    case Refusal::BadNoise: return "bad_noise";
+    case Refusal::Duplicate: return "duplicate";
+    case Refusal::TooOld: return "too_old";
+    case Refusal::FarFuture: return "far_future";
+    case Refusal::kCount: break;
+  }
+  return "?";
+}
+
+const char* toString(TimeMode m) { return m == TimeMode::Exact ? "exact" : "dt_offset"; }
+
+const char* toString(Fate f) {
+  switch (f) {
+    case Fate::Fused: return "fused";
+    case Fate::Gated: return "gated";
+    case Fate::DroppedOnRestart: return "dropped_on_restart";
+  }
+  return "?";
+}
+
+void TrackerConfig::validate() const {
+  core::requireFinite(prior_mean, "tracker.prior_mean");
+  core::requireSymmetricPositiveDefinite(prior_cov, "tracker.prior_cov");
+  core::requireFinite(model.gravity_w, "tracker.model.gravity_w");
+  if (!(model.accel_psd >= 0.0) || !std::isfinite(model.accel_psd))
+    throw core::InvalidInput("tracker.model.accel_psd: expected a finite number >= 0");
+  if (time_mode == TimeMode::DtOffset) core::requirePositive(sample_period, "tracker.sample_period");
+  if (!(late_horizon >= 0.0) || !std::isfinite(late_horizon))
+    throw core::InvalidInput("tracker.late_horizon: expected a finite number >= 0");
+  core::requirePositive(max_forward_gap, "tracker.max_forward_gap");
+  if (restart_after_rejections < 1) throw core::InvalidInput("tracker.restart_after_rejections: expected >= 1");
+  core::requirePositive(max_coast, "tracker.max_coast");
+  if (history_capacity < 1) throw core::InvalidInput("tracker.history_capacity: expected >= 1");
+  core::requirePositive(min_depth, "tracker.min_depth");
+  if (!(image_margin_px >= 0.0)) throw core::InvalidInput("tracker.image_margin_px: expected >= 0");
+  if (!(gate.directional_p > 0.0)) throw core::InvalidInput("tracker.gate.directional_p: expected > 0");
+  if (!(gate.mahalanobis_alpha > 0.0 && gate.mahalanobis_alpha < 1.0))
+    throw core::InvalidInput("tracker.gate.mahalanobis_alpha: expected in (0, 1)");
+}
+
+MeasurementOutcome fuseImage(estimation::StateEstimate& s, const core::Camera& camera,
+                             const ImageMeasurement& m, const BallisticModel& model,
+                             const GateConfig& gate, double dt_offset, double min_depth, bool force,
+                             bool depth_variance_in_noise) {
+  MeasurementOutcome out;
+  out.m = m;
+  const Vector6 x = s.x();
+  const Matrix6 P = s.P();
+  const ViewlineRows rows = viewlineRows(camera, m.uv, m.sigma_px, x, P, dt_offset, model, min_depth,
+                                          depth_variance_in_noise);
+  estimation::LinearMeasurement meas{rows.C, rows.y, rows.R};
+  const Eigen::VectorXd d = rows.y - rows.C * x;
+  const Eigen::MatrixXd S = estimation::innovationCovariance(s, meas.C, meas.R);
+  out.gate = evaluateGate(d, S, gate);
+  if (force) out.gate.rejected = false;
+  if (out.gate.rejected) {
+    out.fate = Fate::Gated;
+  } else {
+    estimation::update(s, meas);
+    out.fate = Fate::Fused;
+  }
+  return out;
+}
+
+ViewlineTracker::ViewlineTracker(std::vector<core::Camera> cameras, TrackerConfig cfg)
+    : cameras_(std::move(cameras)), cfg_(std::move(cfg)) {
+  cfg_.validate();
+  if (cameras_.empty()) throw core::InvalidInput("tracker: at least one camera is needed");
+}
+
+void ViewlineTracker::reset() {
+  state_ = TrackState{};
+  buffer_.clear();
+  final_.clear();
+  refusals_.fill(0);
+  any_ = false;
+  newest_ = 0.0;
+  late_inserted_ = 0;
+}
+
+core::Timestamp ViewlineTracker::sampleTime(core::Timestamp t) const {
+  if (cfg_.time_mode == TimeMode::Exact) return t;
+  // Grid instant at or before t (a tiny tolerance so that stamps on the grid map to themselves).
+  return std::floor(t / cfg_.sample_period + 1e-9) * cfg_.sample_period;
+}
+
+Refusal ViewlineTracker::check(const ImageMeasurement& m) const {
+  if (!std::isfinite(m.t) || !m.uv.allFinite()) return Refusal::NonFinite;
+  if (m.camera >= cameras_.size()) return Refusal::UnknownCamera;
+  if (!(m.sigma_px > 0.0) || !std::isfinite(m.sigma_px)) return Refusal::BadNoise;
+  const core::Camera& cam = cameras_[m.camera];
+  const double g = cfg_.image_margin_px;
+  if (m.uv.x() < -g || m.uv.y() < -g || m.uv.x() > cam.width - 1.0 + g || m.uv.y() > cam.height - 1.0 + g)
+    return Refusal::OutsideImage;
+  if (any_) {
+    if (m.t < newest_ - cfg_.late_horizon) return Refusal::TooOld;
+    if (m.t > newest_ + cfg_.max_forward_gap) return Refusal::FarFuture;
+    for (const Entry& e : buffer_) {
+      if (e.m.id == m.id) return Refusal::Duplicate;
+      if (e.m.camera == m.camera && std::abs(e.m.t - m.t) <= 1e-9) return Refusal::Duplicate;
+    }
+  }
+  return Refusal::None;
+}
+
+void ViewlineTracker::startTrack(TrackState& ts, core::Timestamp t) {
+  for (const MeasurementOutcome& o : ts.history) evict(o);
+  ts.history.clear();
+  ts.est = estimation::StateEstimate(cfg_.prior_mean, cfg_.prior_cov, sampleTime(t));
+  ts.active = true;
+  ts.consecutive_rejections = 0;
+  ts.camera_rejections.assign(cameras_.size(), 0);
+  ts.fused_in_track = 0;
+  ts.last_fused_t = t;
+  ts.track_start_t = ts.est.t();
+  ++ts.tracks_started;
+}
+
+void ViewlineTracker::step(TrackState& ts, const ImageMeasurement& m) {
+  if (!ts.active || m.t - ts.last_fused_t > cfg_.max_coast) startTrack(ts, m.t);
+  const core::Timestamp ts_time = sampleTime(m.t);
+  if (ts_time > ts.est.t()) {
+    estimation::predict(ts.est, cfg_.model.transition(ts_time - ts.est.t()));
+    ts.est.setTime(ts_time);
+  }
+  const double dt_offset = (cfg_.time_mode == TimeMode::Exact) ? 0.0 : m.t - ts.est.t();
+  const bool seed = ts.fused_in_track == 0;
+  MeasurementOutcome o = fuseImage(ts.est, cameras_[m.camera], m, cfg_.model, cfg_.gate, dt_offset,
+                                   cfg_.min_depth, seed, cfg_.depth_variance_in_noise);
+  o.seed = seed;
+  int& count = ts.camera_rejections[m.camera];
+  if (o.fate == Fate::Fused) {
+    count = 0;
+    ts.last_fused_t = m.t;
+    ++ts.fused_in_track;
+  } else {
+    ++count;
+  }
+  ts.consecutive_rejections = *std::max_element(ts.camera_rejections.begin(), ts.camera_rejections.end());
+  const bool fused = o.fate == Fate::Fused;
+  ts.history.push_back(std::move(o));
+  if (fused && ts.fused_in_track >= 2 && ts.fused_in_track <= cfg_.refit_young_tracks) refit(ts);
+  if (ts.history.size() > cfg_.history_capacity) {
+    evict(ts.history.front());
+    ts.history.erase(ts.history.begin());
+  }
+  if (ts.consecutive_rejections >= cfg_.restart_after_rejections) restart(ts);
+}
+
+void ViewlineTracker::refit(TrackState& ts) const {
+  // Only when the whole track is in the history (not capped), else nothing to refit from.
+  if (ts.history.empty() || !ts.history.front().seed) return;
+  const Vector6 xk = ts.est.x();
+  const Matrix6 Pk = ts.est.P();
+  const core::Timestamp tk = ts.est.t();
+  estimation::StateEstimate s(cfg_.prior_mean, cfg_.prior_cov, ts.track_start_t);
+  for (const MeasurementOutcome& o : ts.history) {
+    if (o.fate != Fate::Fused) continue;
+    const core::Timestamp st = sampleTime(o.m.t);
+    if (st > s.t()) {
+      estimation::predict(s, cfg_.model.transition(st - s.t()));
+      s.setTime(st);
+    }
+    const double dt_offset = (cfg_.time_mode == TimeMode::Exact) ? 0.0 : o.m.t - s.t();
+    // Current estimate moved (noise-free) to the capture time: x(t) = Φ(t − tk) xk + Γ g,
+    // its covariance Φ Pk Φᵀ (backwards in time there is no process noise to add).
+    const double tau = o.m.t - tk;
+    const Vector6 xi = cfg_.model.propagate(xk, tau);
+    Matrix6 Phi = Matrix6::Identity();
+    Phi.topRightCorner<3, 3>() = tau * Eigen::Matrix3d::Identity();
+    const Matrix6 Pi = Phi * Pk * Phi.transpose();
+    const double depth_sq = expectedSquaredDepth(cameras_[o.m.camera], xi, Pi, 0.0, cfg_.model, cfg_.min_depth,
+                                                 cfg_.depth_variance_in_noise);
+    const ViewlineRows rows =
+        viewlineRowsWithDepth(cameras_[o.m.camera], o.m.uv, o.m.sigma_px, dt_offset, cfg_.model, depth_sq);
+    estimation::update(s, estimation::LinearMeasurement{rows.C, rows.y, rows.R});
+  }
+  if (tk > s.t()) {
+    estimation::predict(s, cfg_.model.transition(tk - s.t()));
+  }
+  s.setTime(tk);
+  ts.est = std::move(s);
+}
+
+void ViewlineTracker::restart(TrackState& ts) {
+  std::vector<MeasurementOutcome> items = std::move(ts.history);
+  ts.history.clear();
+  MeasurementOutcome dropped = items.front();
+  dropped.fate = Fate::DroppedOnRestart;
+  evict(dropped);
+  ts.active = false;
+  ++ts.restarts;
+  for (std::size_t i = 1; i < items.size(); ++i) step(ts, items[i].m);
+}
+
+Refusal ViewlineTracker::submit(const ImageMeasurement& m) {
+  const Refusal r = check(m);
+  if (r != Refusal::None) {
+    ++refusals_[static_cast<std::size_t>(r)];
+    return r;
+  }
+  auto key = [](const ImageMeasurement& a) { return std::make_tuple(a.t, a.camera, a.id); };
+  const auto pos = std::upper_bound(buffer_.begin(), buffer_.end(), m,
+                                    [&](const ImageMeasurement& a, const Entry& e) { return key(a) < key(e.m); });
+  if (pos == buffer_.end()) {
+    buffer_.push_back({m, state_});
+    step(state_, m);
+  } else {
+    // Late: insert in order and re-process everything after it from the snapshot.
+    const auto idx = static_cast<std::size_t>(pos - buffer_.begin());
+    TrackState ts = pos->before;
+    buffer_.insert(pos, Entry{m, TrackState{}});
+    for (std::size_t j = idx; j < buffer_.size(); ++j) {
+      buffer_[j].before = ts;
+      step(ts, buffer_[j].m);
+    }
+    state_ = std::move(ts);
+    ++late_inserted_;
+  }
+  newest_ = any_ ? std::max(newest_, m.t) : m.t;
+  any_ = true;
+  while (!buffer_.empty() && buffer_.front().m.t < newest_ - cfg_.late_horizon) buffer_.pop_front();
+  return Refusal::None;
+}
+
+estimation::StateEstimate ViewlineTracker::predictAt(core::Timestamp t) const {
+  if (!state_.active) throw core::InvalidInput("tracker: predictAt before any measurement");
+  core::requireFinite(t, "tracker: predictAt time");
+  if (t < state_.est.t()) throw core::InvalidInput("tracker: predictAt time is before the estimate's time");
+  estimation::StateEstimate s = state_.est;
+  if (t > s.t()) {
+    estimation::predict(s, cfg_.model.transition(t - s.t()));
+    s.setTime(t);
+  }
+  return s;
+}
+
+std::optional<MeasurementOutcome> ViewlineTracker::outcome(std::uint64_t id) const {
+  for (const MeasurementOutcome& o : state_.history)
+    if (o.m.id == id) return o;
+  const auto it = final_.find(id);
+  if (it != final_.end()) return it->second;
+  return std::nullopt;
+}
+
+std::vector<MeasurementOutcome> ViewlineTracker::outcomes() const {
+  std::vector<MeasurementOutcome> out;
+  out.reserve(final_.size() + state_.history.size());
+  std::unordered_map<std::uint64_t, bool> in_history;
+  for (const MeasurementOutcome& o : state_.history) in_history[o.m.id] = true;
+  for (const auto& kv : final_)
+    if (in_history.find(kv.first) == in_history.end()) out.push_back(kv.second);
+  for (const MeasurementOutcome& o : state_.history) out.push_back(o);
+  std::sort(out.begin(), out.end(), [](const MeasurementOutcome& a, const MeasurementOutcome& b) {
+    return std::make_tuple(a.m.t, a.m.camera, a.m.id) < std::make_tuple(b.m.t, b.m.camera, b.m.id);
+  });
+  return out;
+}
+
+}  // namespace viewline::tracking
