@@ -165,6 +165,7 @@ std::shared_ptr<const Texture> makeNoiseTexture(const NoiseTextureParams& params
   if (params.octaves < 1) throw InvalidInput("NoiseTextureParams.octaves must be >= 1");
   if (params.base_cells < 1) throw InvalidInput("NoiseTextureParams.base_cells must be >= 1");
   core::requireFinite(params.contrast, "NoiseTextureParams.contrast");
+  core::requirePositive(params.persistence, "NoiseTextureParams.persistence");
   requireColour(params.mean_bgr, "NoiseTextureParams.mean_bgr");
   const int res = params.resolution;
   cv::Mat lum = cv::Mat::zeros(res, res, CV_32F);
@@ -187,7 +188,7 @@ std::shared_ptr<const Texture> makeNoiseTexture(const NoiseTextureParams& params
     lum += amp * up;
     tint += 0.3f * amp * cup;
     total += amp;
-    amp *= 0.55f;
+    amp *= static_cast<float>(params.persistence);
   }
   auto tex = std::make_shared<Texture>();
   tex->image = cv::Mat(res, res, CV_32FC3);

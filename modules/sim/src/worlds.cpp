@@ -27,17 +27,25 @@ Scene makeRoom(const RoomParams& p, core::Rng& rng) {
   // Floor: seen from above; its z (normal) up.
   s.primitives.push_back(makeRectangle("", Eigen::Isometry3d::Identity(), p.floor_size, p.floor_size,
                                        Vector3d::Ones(), makeNoiseTexture(p.floor_texture, rng)));
-  if (p.wall) {
-    core::requirePositive(p.wall_width, "RoomParams.wall_width");
+  if (p.walls) {
     core::requirePositive(p.wall_height, "RoomParams.wall_height");
-    core::requireFinite(p.wall_y, "RoomParams.wall_y");
-    // Wall frame: x along world x, y down (world -z), z into the wall (world +y).
-    Eigen::Matrix3d R;
-    R.col(0) = Vector3d::UnitX();
-    R.col(1) = -Vector3d::UnitZ();
-    R.col(2) = Vector3d::UnitY();
-    s.primitives.push_back(makeRectangle("", pose(R, Vector3d(0.0, p.wall_y, 0.5 * p.wall_height)), p.wall_width,
-                                         p.wall_height, Vector3d::Ones(), makeNoiseTexture(p.wall_texture, rng)));
+    const auto texture = makeNoiseTexture(p.wall_texture, rng);
+    const double h = 0.5 * p.floor_size;
+    for (int i = 0; i < 4; ++i) {
+      // Wall frame: x along the wall, y down (world -z), z outwards (into the wall).
+      const Eigen::Matrix3d yaw = core::rotation(Vector3d::UnitZ(), i * core::kPi / 2.0);
+      Eigen::Matrix3d R;
+      R.col(0) = yaw * Vector3d::UnitX();
+      R.col(1) = -Vector3d::UnitZ();
+      R.col(2) = yaw * Vector3d::UnitY();
+      // Mirror the texture on alternate walls so that corners do not repeat the same pattern.
+      if (i % 2 == 1) {
+        R.col(0) = -R.col(0);
+        R.col(1) = -R.col(1);
+      }
+      s.primitives.push_back(makeRectangle("", pose(R, yaw * Vector3d(0.0, h, 0.0) + Vector3d(0.0, 0.0, 0.5 * p.wall_height)),
+                                           p.floor_size, p.wall_height, Vector3d::Ones(), texture));
+    }
   }
   return s;
 }

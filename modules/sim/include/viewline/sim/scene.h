@@ -90,13 +90,15 @@ Primitive makeTag36h11(const std::string& name, int id, double tag_size, const E
 /// outside the family.
 std::shared_ptr<const Texture> tag36h11Texture(int id);
 
-/// Procedural value-noise texture (seeded): `octaves` layers of random grids, smoothly upsampled,
-/// mixed around `mean_bgr` with relative contrast `contrast`.
+/// Procedural value-noise texture (seeded): `octaves` layers of random grids (base_cells · 2^k
+/// cells, amplitude persistence^k), bicubically upsampled, mixed around `mean_bgr` with relative
+/// contrast `contrast`.
 struct NoiseTextureParams {
   int resolution = 512;                                           ///< texels per side
   int octaves = 5;
   int base_cells = 4;                                             ///< cells of the coarsest octave
   double contrast = 0.35;                                         ///< relative amplitude
+  double persistence = 0.55;                                      ///< amplitude ratio of octave k+1 to k
   Eigen::Vector3d mean_bgr = Eigen::Vector3d(0.45, 0.5, 0.55);
 };
 std::shared_ptr<const Texture> makeNoiseTexture(const NoiseTextureParams& params, core::Rng& rng);

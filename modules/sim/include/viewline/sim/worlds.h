@@ -17,16 +17,16 @@
 
 namespace viewline::sim {
 
-/// A textured floor (z = 0, centred at the origin) and an optional back wall (the plane
-/// y = wall_y, facing -y), with seeded procedural textures.
+/// A closed room: a textured floor (z = 0, centred at the origin, side floor_size) and four
+/// textured walls standing on its edges (facing inwards, height wall_height), so every camera
+/// inside sees texture in all directions. Seeded procedural textures (value noise, finest cells
+/// of about floor_size / 1024).
 struct RoomParams {
   double floor_size = 14.0;     ///< m
-  bool wall = true;
-  double wall_y = 7.0;          ///< m
-  double wall_width = 14.0;     ///< m
+  bool walls = true;
   double wall_height = 6.0;     ///< m
-  NoiseTextureParams floor_texture{1024, 6, 6, 0.45, Eigen::Vector3d(0.35, 0.42, 0.45)};
-  NoiseTextureParams wall_texture{1024, 6, 4, 0.35, Eigen::Vector3d(0.62, 0.6, 0.55)};
+  NoiseTextureParams floor_texture{1024, 8, 8, 0.5, 0.75, Eigen::Vector3d(0.35, 0.42, 0.45)};
+  NoiseTextureParams wall_texture{1024, 8, 6, 0.45, 0.75, Eigen::Vector3d(0.62, 0.6, 0.55)};
 };
 Scene makeRoom(const RoomParams& params, core::Rng& rng);
 
