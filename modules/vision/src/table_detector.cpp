@@ -137,12 +137,87 @@ bool fitLineRobust(std::vector<Eigen::Vector2d>& pts, Eigen::Vector2d& point, Ei
   return true;
 }
 
+/// Raised borders ([M]'s table): seen from outside a side, the border's top inner edge hides the
+/// surface edge, so the visible red boundary of that side is the 3D line at height h
+/// (x or y = ±L/2, z = h), not the surface edge (z = 0); a side whose inner wall faces the
+/// camera shows the surface edge. Gauss-Newton on the pose over all sub-pixel edge points, the
+/// residual of a point being its distance (normalised image plane) to the projected 3D line of
+/// its side; the visibility of each wall is re-decided at every iteration.
+Eigen::Isometry3d refinePoseWithBorders(const Eigen::Isometry3d& c_M_t, const std::array<Eigen::Vector2d, 4>& ordered,
+                                        const std::array<Eigen::Vector2d, 4>& pose_corners,
+                                        const std::array<std::vector<Eigen::Vector2d>, 4>& edges,
+                                        const core::Camera& camera, double side, double height) {
+  const double h = 0.5 * side;
+  const std::array<Eigen::Vector3d, 4> P{Eigen::Vector3d(-h, -h, 0), Eigen::Vector3d(h, -h, 0), Eigen::Vector3d(h, h, 0),
+                                         Eigen::Vector3d(-h, h, 0)};
+  // Side j of `ordered` runs from object corner a(j) to a(j) + 1 in the pose's frame.
+  std::array<int, 4> first{};
+  for (int j = 0; j < 4; ++j) {
+    int best = 0;
+    for (int i = 0; i < 4; ++i)
+      if ((pose_corners[static_cast<std::size_t>(i)] - ordered[static_cast<std::size_t>(j)]).norm() <
+          (pose_corners[static_cast<std::size_t>(best)] - ordered[static_cast<std::size_t>(j)]).norm())
+        best = i;
+    first[static_cast<std::size_t>(j)] = best;
+  }
+  std::vector<std::pair<int, Eigen::Vector3d>> obs;  // (side j, homogeneous normalised point)
+  for (int j = 0; j < 4; ++j)
+    for (const auto& uv : edges[static_cast<std::size_t>(j)]) {
+      const Eigen::Vector2d xy = camera.pixelToNormalized(uv);
+      obs.emplace_back(j, Eigen::Vector3d(xy.x(), xy.y(), 1.0));
+    }
+  if (obs.size() < 12) return c_M_t;
+  auto residuals = [&](const Eigen::Isometry3d& M, Eigen::VectorXd& r) {
+    const Eigen::Vector3d cam_t = M.inverse().translation();
+    std::array<Eigen::Vector3d, 4> lines;
+    for (int j = 0; j < 4; ++j) {
+      const Eigen::Vector3d A = P[static_cast<std::size_t>(first[static_cast<std::size_t>(j)])];
+      const Eigen::Vector3d B = P[static_cast<std::size_t>((first[static_cast<std::size_t>(j)] + 1) % 4)];
+      Eigen::Vector3d mid = 0.5 * (A + B);
+      const Eigen::Vector3d out(mid.x(), mid.y(), 0.0);  // outward normal of the side (unnormalised)
+      const bool wall_faces_camera = (cam_t - mid).dot(out) < 0.0;
+      const Eigen::Vector3d dz(0.0, 0.0, wall_faces_camera ? 0.0 : height);
+      lines[static_cast<std::size_t>(j)] = (M * (A + dz)).cross(M * (B + dz));
+    }
+    r.resize(static_cast<Eigen::Index>(obs.size()));
+    for (std::size_t i = 0; i < obs.size(); ++i) {
+      const Eigen::Vector3d& l = lines[static_cast<std::size_t>(obs[i].first)];
+      r(static_cast<Eigen::Index>(i)) = l.dot(obs[i].second) / l.head<2>().norm();
+    }
+  };
+  auto perturb = [](const Eigen::Isometry3d& M, const Eigen::Matrix<double, 6, 1>& d) {
+    Eigen::Isometry3d out = M;
+    const double a = d.head<3>().norm();
+    if (a > 0.0) out.linear() = Eigen::AngleAxisd(a, d.head<3>() / a).toRotationMatrix() * M.linear();
+    out.translation() += d.tail<3>();
+    return out;
+  };
+  Eigen::Isometry3d M = c_M_t;
+  Eigen::VectorXd r0, r1;
+  for (int it = 0; it < 6; ++it) {
+    residuals(M, r0);
+    Eigen::MatrixXd J(r0.size(), 6);
+    for (int k = 0; k < 6; ++k) {
+      Eigen::Matrix<double, 6, 1> d = Eigen::Matrix<double, 6, 1>::Zero();
+      d(k) = 1e-6;
+      residuals(perturb(M, d), r1);
+      J.col(k) = (r1 - r0) / 1e-6;
+    }
+    const Eigen::Matrix<double, 6, 1> step = (J.transpose() * J).ldlt().solve(-J.transpose() * r0);
+    if (!step.allFinite()) return c_M_t;
+    M = perturb(M, step);
+    if (step.norm() < 1e-9) break;
+  }
+  return M;
+}
+
 /// Production refinement of [M]'s corners: sub-pixel edge points of the red surface sampled
 /// along each side (middle 80 %, away from the ball) on the raw image, a robust line fit per
 /// side (up to 33 edge points), adjacent sides re-intersected. A side with too few edge points keeps its line.
 std::array<Eigen::Vector2d, 4> refineCorners(const cv::Mat& bgr, const std::array<Eigen::Vector2d, 4>& ordered,
                                              const std::optional<Circle>& ball,
-                                             const TableDetectorConfig& cfg) {
+                                             const TableDetectorConfig& cfg,
+                                             std::array<std::vector<Eigen::Vector2d>, 4>* edge_points) {
   std::array<Eigen::Vector2d, 4> corners = ordered;
   std::vector<Eigen::Vector2d> pts;
   for (int pass = 0; pass < 1; ++pass) {
@@ -170,6 +245,7 @@ std::array<Eigen::Vector2d, 4> refineCorners(const cv::Mat& bgr, const std::arra
       }
       if (pts.size() < 6) continue;
       fitted[k] = fitLineRobust(pts, line_p[k], line_d[k]);
+      if (edge_points) (*edge_points)[k] = pts;  // inliers of the line fit
     }
     std::array<Eigen::Vector2d, 4> next = corners;
     for (std::size_t k = 0; k < 4; ++k) {
@@ -251,8 +327,12 @@ TableScene finishScene(const cv::Mat& bgr, const std::vector<cv::Point>* table_c
       scene.table = corners.failure();
     } else {
       auto ordered = orderTableCorners(corners->corners);
-      if (refine) ordered = refineCorners(bgr, ordered, scene.ball_circle, cfg);
-      const auto pose = solveTablePose(ordered, camera, cfg.side_m, refine, prior);
+      std::array<std::vector<Eigen::Vector2d>, 4> edges;
+      if (refine) ordered = refineCorners(bgr, ordered, scene.ball_circle, cfg, &edges);
+      auto pose = solveTablePose(ordered, camera, cfg.side_m, refine, prior);
+      if (pose && refine && cfg.border_height_m > 0.0)
+        pose.value().c_M_t = refinePoseWithBorders(pose->c_M_t, ordered, pose->corners, edges, camera, cfg.side_m,
+                                                   cfg.border_height_m);
       if (!pose) {
         scene.table = pose.failure();
       } else {
@@ -324,6 +404,8 @@ void TableDetectorConfig::validate() const {
     throw core::InvalidInput("TableDetectorConfig.roi_margin_fraction must be in [0, 2]");
   if (roi_margin_px < 0) throw core::InvalidInput("TableDetectorConfig.roi_margin_px must be >= 0");
   core::requirePositive(corner_sigma_px, "TableDetectorConfig.corner_sigma_px");
+  if (!(border_height_m >= 0.0 && border_height_m < side_m))
+    throw core::InvalidInput("TableDetectorConfig.border_height_m must be in [0, side_m)");
   core::requirePositive(ball_edge_noise_px, "TableDetectorConfig.ball_edge_noise_px");
 }
 

@@ -101,13 +101,6 @@ TEST(TableDetector, TablePoseAndBallOnTableFromRenderedScenes) {
     rot_sq += rot * rot;
     EXPECT_LT((scene.table->c_M_t.translation() - s.c_M_t.translation()).norm(), 0.01);
     known_sq += (scene.ball->known_radius.p_t - s.ball_t).squaredNorm();
-    if (std::getenv("VIEWLINE_DEBUG"))
-      std::printf("trans err %.2f mm (depth %.2f mm), rot %.3f deg, known err %s mm, d %.4f vs %.4f, rho %.3f\n",
-                  1e3 * (scene.table->c_M_t.translation() - s.c_M_t.translation()).norm(),
-                  1e3 * (scene.table->c_M_t.translation().norm() - s.c_M_t.translation().norm()), core::rad2deg(rot),
-                  [&] { static char b[64]; const Eigen::Vector3d e = 1e3 * (scene.ball->known_radius.p_t - s.ball_t);
-                        std::snprintf(b, sizeof b, "(%.2f %.2f %.2f)", e.x(), e.y(), e.z()); return b; }(),
-                  scene.ball->known_radius.distance_m, (s.c_M_t * s.ball_t).norm(), scene.ball->circle.radius);
     ASSERT_TRUE(scene.ball->unknown_radius.has_value());
     unknown_sq += (scene.ball->unknown_radius->p_t - s.ball_t).squaredNorm();
     EXPECT_NEAR(scene.ball->unknown_radius->radius_m, kBall, 0.004);

@@ -30,6 +30,8 @@
 // replaced by a least-squares ellipse through sub-pixel edge points of the
 // "greenness" G - max(R, B) on 32 rays (centre = ellipse centre, radius =
 // semi-major axis, i.e. the minimum enclosing circle of the true outline).
+// With raised borders (border_height_m > 0) the pose is then refined on the
+// edge points against the visible 3D boundary (see refinePoseWithBorders).
 //
 // referenceTableScene() is the plain speed baseline written the straightforward
 // way (as [M]'s Python): full frame at every step, fresh buffers, two inRange
@@ -50,6 +52,9 @@ namespace viewline::vision {
 
 struct TableDetectorConfig {
   double side_m = 0.3;            ///< L, side of the red square (m)
+  /// Height of raised borders around the red square (m); 0 = flat. With `refine`, sides seen
+  /// from outside are modelled by the border's top inner edge (which hides the surface edge).
+  double border_height_m = 0.0;
   double ball_radius_m = 0.025;   ///< r for the known-radius variant (m)
   int blur_ksize = 5;             ///< Gaussian blur kernel (odd; 1 = none)
   ColorRange red_hls{165, 12, 30, 225, 80, 255};   ///< (H, L, S) of the table surface
