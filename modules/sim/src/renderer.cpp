@@ -399,6 +399,28 @@ void renderRegion(const cv::Rect& r, const std::vector<const Prepared*>& prims, 
   }
 }
 
+// renderRegion over horizontal bands of r in parallel (cv::parallel_for_): every pixel is
+// computed independently from read-only inputs, so the result does not depend on the threads.
+void renderRegionParallel(const cv::Rect& r, const std::vector<const Prepared*>& prims, bool supersample_all,
+                          const RayGrid& g, const Base& base, const Light& light, const RenderSettings& s,
+                          double weight, double* acc, cv::Mat* depth_out) {
+  constexpr int kMinPixels = 16384;
+  constexpr int kBandRows = 16;
+  if (r.area() < kMinPixels || r.height < 2 * kBandRows) {
+    renderRegion(r, prims, supersample_all, g, base, light, s, weight, acc, depth_out);
+    return;
+  }
+  const int bands = (r.height + kBandRows - 1) / kBandRows;
+  cv::parallel_for_(cv::Range(0, bands), [&](const cv::Range& range) {
+    for (int b = range.start; b < range.end; ++b) {
+      const int y0 = r.y + b * kBandRows;
+      const cv::Rect band(r.x, y0, r.width, std::min(kBandRows, r.y + r.height - y0));
+      double* band_acc = acc + 3 * static_cast<std::size_t>(y0 - r.y) * static_cast<std::size_t>(r.width);
+      renderRegion(band, prims, supersample_all, g, base, light, s, weight, band_acc, depth_out);
+    }
+  });
+}
+
 // Pixel centres of r covered by each named primitive (footprint) and where it is the nearest
 // surface (visible), given the base depth.
 void countCoverage(const cv::Rect& r, const std::vector<const Prepared*>& prims, const RayGrid& g,
@@ -769,7 +791,7 @@ struct Renderer::Impl {
     base.background = scene.background_bgr;
     const bool thin = std::any_of(prims.begin(), prims.end(), [](const Prepared* p) { return p->thin; });
     // Thin static objects: supersample their boxes only.
-    renderRegion(full, prims, false, g, base, light, s, 1.0, acc.data(), &layer.depth);
+    renderRegionParallel(full, prims, false, g, base, light, s, 1.0, acc.data(), &layer.depth);
     if (thin) {
       for (const Prepared* p : prims) {
         if (!p->thin) continue;
@@ -892,7 +914,7 @@ cv::Mat Renderer::render(const World& world, const core::Camera& camera, const E
           thin = thin || p.thin;
         }
       }
-      renderRegion(r, prims, thin, g, base, light, settings_, 1.0 / n, acc.data(), nullptr);
+      renderRegionParallel(r, prims, thin, g, base, light, settings_, 1.0 / n, acc.data(), nullptr);
     }
     accToImage(acc, r, image);
   }
