@@ -1,0 +1,90 @@
+// Short seeded runs of the pan-tilt scenario library (the same code the app runs): each shipped
+// path for a few seconds, no command outside the limits, reacquisition after a 1 s occlusion.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "viewline/core/error.h"
+#include "viewline/core/frames.h"
+#include "viewline/io/config.h"
+#include "viewline/scenarios/pan_tilt_scenario.h"
+
+using namespace viewline;
+using scenarios::PanTiltControllerKind;
+
+namespace {
+scenarios::PanTiltScenarioConfig shipped(const std::string& name) {
+  // Tests run with the project root as working directory (viewline_add_test).
+  return scenarios::loadPanTiltScenarioConfig(io::ConfigNode::loadFile("config/pan_tilt_" + name + ".yaml"));
+}
+}  // namespace
+
+TEST(PanTiltScenario, EachShippedPathTracksForAFewSeconds) {
+  for (const std::string name : {"rectangle", "circle", "random"}) {
+    auto cfg = shipped(name);
+    cfg.duration = 3.0;
+    cfg.metrics_start = 1.5;
+    cfg.occlusion_start = -1.0;
+    const auto m = scenarios::runPanTilt(cfg, 1, PanTiltControllerKind::Predictive);
+    EXPECT_GE(m.detections, m.frames * 9 / 10) << name;
+    EXPECT_LT(m.detection_pixel_rmse_px, 1.0) << name;        // [T]'s centroid on the rendered disc
+    EXPECT_LT(m.image_error_rms_px, 40.0) << name;            // target held near the centre
+    EXPECT_LT(m.rmse_filtered_cm.x(), m.rmse_measured_cm.x()) << name;  // the filter helps
+    EXPECT_EQ(m.unsafe_commands + m.rate_violations + m.limit_hits, 0u) << name;
+    EXPECT_NEAR(m.noise_sigma_cm.x(), 100.0 * 0.1 * (name == "circle" ? cfg.path.radius : 0.5 * cfg.path.width),
+                name == "random" ? 1.0 : 1e-3) << name;
+  }
+}
+
+TEST(PanTiltScenario, NoCommandOutsideTheLimitsWhenTheTargetLeavesThem) {
+  // Pan limited to ±6°: the circle (±13° of pan) drives the unit into its limits repeatedly.
+  auto cfg = shipped("circle");
+  cfg.duration = 6.0;
+  cfg.metrics_start = 0.0;
+  cfg.occlusion_start = -1.0;
+  cfg.unit.limits.q_min.x() = core::deg2rad(-6.0);
+  cfg.unit.limits.q_max.x() = core::deg2rad(6.0);
+  cfg.initial_offset.setZero();
+  for (const auto kind : {PanTiltControllerKind::Predictive, PanTiltControllerKind::Baseline}) {
+    const auto m = scenarios::runPanTilt(cfg, 2, kind);
+    EXPECT_EQ(m.unsafe_commands, 0u) << m.controller;
+    EXPECT_EQ(m.rate_violations, 0u) << m.controller;
+    EXPECT_EQ(m.limit_hits, 0u) << m.controller;
+    EXPECT_LE(m.max_rate_fraction, 1.0) << m.controller;
+    EXPECT_GE(m.min_limit_distance_deg.x(), 0.0) << m.controller;
+    EXPECT_LT(m.min_limit_distance_deg.x(), 1.0) << m.controller;  // it did reach the limit region
+  }
+}
+
+TEST(PanTiltScenario, ReacquiresAfterAOneSecondOcclusion) {
+  auto cfg = shipped("circle");
+  cfg.duration = 5.0;
+  cfg.metrics_start = 0.5;
+  cfg.occlusion_start = 2.0;
+  cfg.occlusion_duration = 1.0;
+  cfg.run_baseline = false;
+  const auto m = scenarios::runPanTilt(cfg, 3, PanTiltControllerKind::Predictive);
+  ASSERT_TRUE(m.occlusion);
+  EXPECT_TRUE(m.reacquired);
+  EXPECT_LT(m.reacquisition_delay_s, 0.2);  // seen again within a few frames of reappearing
+  EXPECT_EQ(m.unsafe_commands + m.rate_violations + m.limit_hits, 0u);
+}
+
+TEST(PanTiltScenario, ConfigErrorsNameTheKey) {
+  const std::string base =
+      "path: {shape: circle, speed: 0.1}\nscreen: {distance: 1.3, center_height: -0.2, disc_radius: 0.03}\n"
+      "camera: {width: 640, height: 480, fx: 944, fy: 928, fps: 30}\nmeasurement_noise_fraction: 0.1\n"
+      "unit: {pan_limits_deg: [-150, 150], tilt_limits_deg: [-47, 31], max_speed_deg: 300, "
+      "max_acceleration_deg: 1200, latency: 0.03}\nprocessing_delay: 0.01\ndetector: {threshold: 110}\n"
+      "control: {gain: 4}\nfilter: {model: constant_velocity}\nrun: {duration: 10, metrics_start: 1}\n";
+  EXPECT_NO_THROW(scenarios::loadPanTiltScenarioConfig(io::ConfigNode::fromString(base, "t.yaml")));
+  try {
+    scenarios::loadPanTiltScenarioConfig(io::ConfigNode::fromString(base + "bogus_key: 1\n", "t.yaml"));
+    FAIL() << "unknown key accepted";
+  } catch (const core::InvalidInput& e) {
+    EXPECT_NE(std::string(e.what()).find("bogus_key"), std::string::npos) << e.what();
+  }
+  std::string bad = base;
+  bad.replace(bad.find("constant_velocity"), 17, "zigzag");
+  EXPECT_THROW(scenarios::loadPanTiltScenarioConfig(io::ConfigNode::fromString(bad, "t.yaml")), core::InvalidInput);
+}
