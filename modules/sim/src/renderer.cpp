@@ -602,12 +602,38 @@ CameraKey intrinsicsKey(const core::Camera& c) {
   return k;
 }
 
+// FNV-1a over the static scene's content: a world destroyed and another allocated at the same
+// address must not reuse the cached layer.
+std::uint64_t sceneHash(const Scene& scene) {
+  std::uint64_t h = 1469598103934665603ULL;
+  auto mix = [&h](const void* data, std::size_t n) {
+    const auto* b = static_cast<const unsigned char*>(data);
+    for (std::size_t i = 0; i < n; ++i) {
+      h ^= b[i];
+      h *= 1099511628211ULL;
+    }
+  };
+  mix(scene.background_bgr.data(), 3 * sizeof(double));
+  for (const Primitive& p : scene.primitives) {
+    const int shape = static_cast<int>(p.shape);
+    mix(&shape, sizeof(shape));
+    mix(p.w_M_o.matrix().data(), 16 * sizeof(double));
+    mix(p.size.data(), 3 * sizeof(double));
+    mix(p.material.albedo_bgr.data(), 3 * sizeof(double));
+    mix(&p.material.ambient, sizeof(double));
+    const Texture* t = p.texture.get();
+    mix(&t, sizeof(t));
+  }
+  return h;
+}
+
 CameraKey fullKey(const core::Camera& c, const World* world, std::uint64_t version, const Lighting& l) {
   CameraKey k = intrinsicsKey(c);
   const Eigen::Matrix4d m = c.c_M_w.matrix();
   for (int i = 0; i < 12; ++i) k.v[5 + i] = m(i % 3, i / 3);
   k.v[17] = static_cast<double>(reinterpret_cast<std::uintptr_t>(world));
-  k.v[18] = static_cast<double>(version);
+  const std::uint64_t content = sceneHash(world->staticScene()) ^ (version * 0x9E3779B97F4A7C15ULL);
+  std::memcpy(&k.v[18], &content, sizeof(content));
   for (int i = 0; i < 3; ++i) {
     k.v[19 + i] = l.direction_w[i];
   }

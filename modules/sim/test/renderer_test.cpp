@@ -258,3 +258,18 @@ TEST(Renderer, BadInputThrows) {
   bad.supersampling = 0;
   EXPECT_THROW(Renderer{bad}, core::InvalidInput);
 }
+
+TEST(Renderer, StaticCacheFollowsSceneChanges) {
+  const core::Camera cam = makeCamera(false);
+  Renderer renderer;
+  SceneWorld world(ballScene({0.0, 0.0, 1.0}, 0.2));
+  const cv::Mat a = renderer.render(world, cam, {0.0, 0.0, 1});
+  world.scene().primitives[0].material.albedo_bgr = Eigen::Vector3d(0.1, 0.9, 0.1);
+  const cv::Mat b = renderer.render(world, cam, {0.0, 0.0, 1});
+  const auto c = cam.project({0.0, 0.0, 1.0});
+  EXPECT_EQ(a.at<cv::Vec3b>(static_cast<int>(c->y()), static_cast<int>(c->x()))[0], 204);
+  EXPECT_EQ(b.at<cv::Vec3b>(static_cast<int>(c->y()), static_cast<int>(c->x()))[0], 26);
+  // A different world with the same content renders the same pixels.
+  const SceneWorld other(ballScene({0.0, 0.0, 1.0}, 0.2));
+  EXPECT_EQ(cv::norm(renderer.render(other, cam, {0.0, 0.0, 1}), a, cv::NORM_INF), 0.0);
+}
