@@ -39,7 +39,7 @@ int main(int argc, char** argv) {
   }
 
   std::printf("## Robustness: ball detector, 656x480, ball at 0.9 m/s, %d frames per case\n", n);
-  std::printf("| effect | strength | detection rate | wrong (> 3 px) | centre RMS (px) |\n|---|---|---|---|---|\n");
+  std::printf("| effect | strength | detection rate | wrong (> max(3 px, 3 sigma)) | centre RMS of the rest (px) |\n|---|---|---|---|---|\n");
   std::uint64_t k = 0;
   for (const auto& c : detection_scoring::robustnessCases()) {
     const auto s = detection_scoring::scoreBall(c.effects, c.clutter, n, seed + 10 + k++);

@@ -335,7 +335,13 @@ TableScene finishScene(const cv::Mat& bgr, const std::vector<cv::Point>* table_c
                                                    cfg.border_height_m);
       if (!pose) {
         scene.table = pose.failure();
-      } else {
+      } else if (pose->reprojection_rms_px > cfg.max_reprojection_px) {
+        // AP3P fits three corners exactly; a fourth far off means the four points are not the
+        // image of the square (a corner hidden by the ball, a cut, clutter): no pose.
+        scene.table = Result<TableMeasurement>::fail(
+            FailureReason::PoseFailed, "corners are not the image of the square (reprojection RMS " +
+                                           std::to_string(pose->reprojection_rms_px) + " px)");
+      } else if (pose) {
         TableMeasurement m;
         m.stamp = stamp;
         m.c_M_t = pose->c_M_t;
@@ -404,6 +410,7 @@ void TableDetectorConfig::validate() const {
     throw core::InvalidInput("TableDetectorConfig.roi_margin_fraction must be in [0, 2]");
   if (roi_margin_px < 0) throw core::InvalidInput("TableDetectorConfig.roi_margin_px must be >= 0");
   core::requirePositive(corner_sigma_px, "TableDetectorConfig.corner_sigma_px");
+  core::requirePositive(max_reprojection_px, "TableDetectorConfig.max_reprojection_px");
   if (!(border_height_m >= 0.0 && border_height_m < side_m))
     throw core::InvalidInput("TableDetectorConfig.border_height_m must be in [0, side_m)");
   core::requirePositive(ball_edge_noise_px, "TableDetectorConfig.ball_edge_noise_px");

@@ -68,6 +68,7 @@ struct TableDetectorConfig {
   double roi_margin_fraction = 0.1;  ///< window = last table box grown by this fraction ...
   int roi_margin_px = 10;            ///< ... plus this many pixels on each side
   bool refine = true;                ///< production refinements (see above); false = [M] exactly
+  double max_reprojection_px = 2.0;  ///< corner reprojection RMS above which the pose is refused
   double corner_sigma_px = 0.5;      ///< corner noise used for the table "pixel" covariance
   double ball_edge_noise_px = 0.5;   ///< σe of the ball circle centre: var = σe² / (π ρ)
 
