@@ -1,0 +1,53 @@
+#pragma once
+// One self-contained HTML report per session: tables, and plots rendered by gnuplot (Debian
+// gnuplot-nox) from data files + scripts written next to the report (plots/), embedded as base64
+// PNG data URIs so that the HTML file alone is the report. The .dat/.gp files stay for people who
+// want to re-plot. Without gnuplot the report says so where a plot would be (nothing else fails).
+
+#include <string>
+#include <vector>
+
+#include "viewline/tuning/scenario.h"
+
+namespace viewline::tuning {
+
+class HtmlReport {
+public:
+  /// Plots go to <dir>/plots.
+  HtmlReport(std::string title, std::string dir);
+
+  void heading(const std::string& text, int level = 2);
+  void paragraph(const std::string& html);
+  void preformatted(const std::string& text);
+  void table(const std::vector<std::string>& header, const std::vector<std::vector<std::string>>& rows,
+             const std::vector<std::string>& row_classes = {});
+  /// Writes `data` to plots/<name>.dat and `script` (gnuplot, may refer to '<name>.dat' and other
+  /// files written with dataFile()) to plots/<name>.gp, runs gnuplot, embeds plots/<name>.png.
+  /// Returns false (and notes it in the report) when gnuplot failed.
+  bool plot(const std::string& name, const std::string& script, const std::string& caption);
+  /// Writes a data file plots/<file>; returns its file name (relative to plots/).
+  std::string dataFile(const std::string& file, const std::string& content);
+
+  std::size_t plotCount() const { return plots_; }
+  std::string html() const;
+  /// Writes the HTML atomically.
+  void write(const std::string& path) const;
+
+private:
+  std::string title_, dir_, body_;
+  std::size_t plots_ = 0;
+};
+
+/// HTML-escapes text.
+std::string htmlEscape(const std::string& s);
+/// Base64 of bytes.
+std::string base64(const std::string& bytes);
+/// Whether gnuplot runs here.
+bool gnuplotAvailable();
+
+/// The standard run plots: error over time, NIS with its band, top-view trajectories.
+/// `prefix` names the files; returns the number of plots added.
+int addRunPlots(HtmlReport& report, const RunSeries& series, const std::string& prefix, const std::string& title,
+                double confidence);
+
+}  // namespace viewline::tuning

@@ -1,0 +1,70 @@
+#pragma once
+// Tuning sessions (what apps/viewline_tune runs; the app only parses the command line).
+//
+// Sweep session (runSweepSession), all outputs in one folder:
+//   results.jsonl      one JSON line per finished setting (appended + flushed as they finish)
+//   summary.json       the session's figures (keys documented in tutorials/tune_tracking_loop)
+//   best_config.yaml   the scenario config with the best setting's values (readable by the app)
+//   autotuned_config.yaml  (with autotune) the config with the auto-tuned noise values
+//   report.html        self-contained report (tables + gnuplot plots embedded)
+//   plots/             the plots' data files and gnuplot scripts
+// Single run (runSingleSession): one seeded run with its consistency and plots.
+// Auto-tune (runAutotuneSession): from the scenario app's --log folder or a live recording.
+
+#include <atomic>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "viewline/tuning/scenario.h"
+
+namespace viewline::tuning {
+
+struct SessionOptions {
+  std::string out_dir = "tune_out";
+  std::string config_override;        ///< scenario config instead of the sweep file's `config`
+  int workers = 0;                    ///< 0: all cores
+  int seeds_override = 0;             ///< > 0: seeds per setting instead of the file's
+  bool measure_speedup = false;       ///< also run the sweep with one worker: parallel_speedup
+  bool skip_autotune = false;
+  const std::atomic<bool>* stop = nullptr;
+  bool quiet = false;
+};
+
+/// Sweep (+ optional auto-tune) session; returns the summary (also written to summary.json).
+nlohmann::json runSweepSession(const AdapterRegistry& registry, const std::string& sweep_file,
+                               const SessionOptions& options);
+
+struct SingleRunOptions {
+  std::string scenario;      ///< adapter name
+  std::string config;        ///< scenario YAML
+  std::uint64_t seed = 1;
+  std::string out_dir = "tune_run";
+  std::string log_dir;       ///< scenario logs (CSV) of the run, "" = none
+  bool display = false;      ///< live curves (vpPlot) + the scenario's view
+  AdapterOptions adapter_options;
+  bool quiet = false;
+};
+nlohmann::json runSingleSession(const AdapterRegistry& registry, const SingleRunOptions& options);
+
+struct AutotuneSessionOptions {
+  std::string scenario;
+  std::string config;
+  std::string log_dir;        ///< the scenario app's --log folder; "" = record a live run
+  std::uint64_t record_seed = 1000;
+  int record_runs = 1;
+  double start_scale = 1.0;   ///< start from the config's noise values times this
+  double outlier_prior = 0.05;
+  double span_decades = 2.5;
+  int grid_points = 11;
+  int verify_runs = 0;        ///< > 0: live runs of the tuned config for NEES/NIS (seeds 1..n)
+  int workers = 0;
+  std::string out_dir = "tune_autotune";
+  AdapterOptions adapter_options;
+  bool quiet = false;
+};
+nlohmann::json runAutotuneSession(const AdapterRegistry& registry, const AutotuneSessionOptions& options);
+
+/// "1.23 0.98 0.50" (the 1, 5, 15 minute load averages) or "" when unavailable.
+std::string loadAverage();
+
+}  // namespace viewline::tuning

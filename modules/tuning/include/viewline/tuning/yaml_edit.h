@@ -1,0 +1,48 @@
+#pragma once
+// Dotted config keys ("tracker.accel_psd", "cameras[1].hfov_deg") on YAML trees, and writing a
+// scenario file back with some values replaced.
+//
+// rewriteYamlText() keeps the user's file as it is (comments, order, layout) and replaces only
+// the scalars of the given keys in place (found through the parser's line/column marks); when a
+// key is missing from the file, or its value is not a plain one-line scalar, the whole tree is
+// emitted instead (valid YAML with the same keys, comments lost) and a header comment says so.
+
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+#include <yaml-cpp/yaml.h>
+
+namespace viewline::tuning {
+
+struct KeySegment {
+  std::string key;
+  int index = -1;  ///< list index when the segment is "name[i]"
+};
+
+/// "a.b[1].c" -> {a}, {b, 1}, {c}. Throws core::InvalidInput on an empty or malformed key.
+std::vector<KeySegment> parseDottedKey(const std::string& dotted);
+
+/// The node at a dotted key, or nullopt when any segment is missing.
+std::optional<YAML::Node> findKey(const YAML::Node& root, const std::string& dotted);
+
+/// A deep copy of `root` with `value` at the dotted key (maps are created as needed; list items
+/// must exist). Throws core::InvalidInput naming the key when a segment is not a map/list.
+YAML::Node withValue(const YAML::Node& root, const std::string& dotted, const YAML::Node& value);
+
+/// A deep copy with every (key, value) applied.
+YAML::Node withValues(const YAML::Node& root, const std::vector<std::pair<std::string, YAML::Node>>& values);
+
+/// The text of a scalar node ("0.5", "mahalanobis"); "[...]" rendering of sequences.
+std::string scalarText(const YAML::Node& value);
+
+/// YAML text of a node (block style).
+std::string emitYaml(const YAML::Node& node);
+
+/// The scenario text with the values replaced (see the file comment). `header` is put in a
+/// comment at the top.
+std::string rewriteYamlText(const std::string& original_text,
+                            const std::vector<std::pair<std::string, YAML::Node>>& values,
+                            const std::string& header);
+
+}  // namespace viewline::tuning

@@ -1,0 +1,483 @@
+// Dart scenario adapter ([L] §VI, issue 3): runs flights of the measurement-level dart scenario
+// through the ViewlineTracker in-process (tracking::simulateFlight + ViewlineTracker), with the
+// scenario config read by the dart app's own loader (apps/dart_tracking/dart_config.h), so any
+// config the tuning tool accepts or writes is one dart_tracking reads.
+//
+// One run = `flights` throws (adapter option), flight f drawn from deriveSeed(seed, f).
+// Per measurement (in capture order) the innovation is computed from the tracker's prediction
+// at the capture time, exactly as the tracker forms it (viewlineRows at the predicted state):
+//   d = y − C x̂(t|t−),  S = R2 + C P Cᵀ  (2 rows),  NIS = dᵀ S⁻¹ d (2 dof).
+// NIS samples: fused, non-seed measurements once the track has `burn_in` fused images (the prior
+// dominates before). NEES: one 6-dof sample per flight, after the measurement of index
+// `experiments.nees_index` (independent samples, the dart scenario's convention).
+//
+// Noise parameters: process q = tracker.accel_psd (m²/s³) and measurement σ = the pixel noise
+// the tracker assumes (px). In the scenario file one key, pixel_noise_px, sets both the simulated
+// detector noise and what the tracker assumes (the tracker reads each measurement's sigma_px); the
+// adapter option `assumed_pixel_noise_px` (> 0) makes the tracker assume another value while the
+// simulation keeps the file's noise — that is how a session starts "10x off". The tuned σ is
+// written to pixel_noise_px: for a real rig that is the detector noise the tracker should assume.
+//
+// Outlier density for the likelihood mixture (autotune.h): a gross outlier is uniform over the
+// W x H image; the two rows map pixel errors to row residuals with |det| = sqrt(det R2) / σ²
+// (viewline.h: R2 = E[Z²] σ² D J Jᵀ D), so its density in innovation space is
+// u = σ² / (W H sqrt(det R2)) (independent of σ).
+
+#include <Eigen/Cholesky>
+#include <Eigen/LU>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include "dart_config.h"
+#include "viewline/core/error.h"
+#include "viewline/core/random.h"
+#include "viewline/estimation/consistency.h"
+#include "viewline/tracking/dart_scenario.h"
+#include "viewline/tracking/tracker.h"
+#include "viewline/tracking/viewline.h"
+#include "viewline/tuning/scenario.h"
+#include "viewline/tuning/yaml_edit.h"
+
+namespace viewline::tuning {
+
+namespace {
+
+using tracking::DartScenarioConfig;
+using tracking::ImageMeasurement;
+
+constexpr double kPi = 3.14159265358979323846;
+
+struct DartOptions {
+  int flights = 50;
+  tracking::ClockMode clock = tracking::ClockMode::FreeRunning;
+  bool outliers = true;
+  double assumed_sigma = 0.0;  ///< <= 0: the config's pixel_noise_px
+  int burn_in = 4;
+  std::string log_experiment = "A_alternating";
+};
+
+struct Flight {
+  std::vector<tracking::SimDetection> dets;  ///< truth valid only when has_truth
+  bool has_truth = true;
+};
+
+class DartReplayData : public ReplayData {
+public:
+  std::vector<Flight> flights;
+  std::string source;
+  std::size_t measurements() const override {
+    std::size_t n = 0;
+    for (const auto& f : flights) n += f.dets.size();
+    return n;
+  }
+  std::string describe() const override {
+    return std::to_string(flights.size()) + " dart flights, " + std::to_string(measurements()) + " detections (" + source + ")";
+  }
+};
+
+/// Everything one pass over flights accumulates.
+struct Accum {
+  double cost = 0.0;
+  std::size_t terms = 0;
+  Consistency nees, nis;
+  double sq_err = 0.0;
+  std::size_t err_n = 0;
+  double final_err = 0.0, pred_err = 0.0;
+  std::size_t flights = 0, pred_n = 0;
+  std::size_t outliers = 0, outliers_rejected = 0, inliers = 0, inliers_rejected = 0;
+  std::size_t restarts = 0;
+  std::size_t sample = 0;
+};
+
+class DartInstance final : public ScenarioInstance {
+public:
+  DartInstance(DartScenarioConfig cfg, DartOptions opt)
+      : cfg_(std::move(cfg)), opt_(std::move(opt)), cams_(tracking::makeDartCameras(cfg_)) {}
+
+  double confidence() const override { return cfg_.confidence; }
+  double sigma() const { return opt_.assumed_sigma > 0.0 ? opt_.assumed_sigma : cfg_.pixel_noise_px; }
+
+  RunResult run(std::uint64_t seed, const RunOptions& ro) const override {
+    RunResult r;
+    r.seed = seed;
+    std::shared_ptr<RunSeries> series;
+    if (ro.series) series = makeSeries();
+    io::CsvWriter* det_csv = nullptr;
+    io::CsvWriter* inn_csv = nullptr;
+    if (ro.log != nullptr && ro.log->enabled()) {
+      det_csv = &ro.log->stream("detections", {"experiment", "run", "id", "camera", "t", "u", "v", "outlier", "fate",
+                                               "true_x", "true_y", "true_z", "est_x", "est_y", "est_z", "est_vx",
+                                               "est_vy", "est_vz"});
+      inn_csv = &ro.log->stream("innovations", {"flight", "id", "camera", "t", "d0", "d1", "S00", "S01", "S11", "nis",
+                                                "fused", "in_statistics"});
+    }
+    Accum a;
+    for (int f = 0; f < opt_.flights; ++f) {
+      core::Rng rng = core::makeRng(core::deriveSeed(seed, static_cast<std::uint64_t>(f)));
+      Flight fl;
+      fl.dets = tracking::simulateFlight(cfg_, cams_, opt_.clock, opt_.outliers ? cfg_.outlier_rate : 0.0, rng, 1).detections;
+      processFlight(fl, f, cfg_.tracker.model.accel_psd, sigma(), 0.0, a, series.get(), det_csv, inn_csv, ro);
+      if (ro.progress) ro.progress(static_cast<double>(f + 1) / opt_.flights);
+    }
+    r.nees = a.nees;
+    r.nis = a.nis;
+    r.metrics["rmse_position_m"] = a.err_n ? std::sqrt(a.sq_err / static_cast<double>(a.err_n)) : std::nan("");
+    r.metrics["final_error_m"] = a.flights ? a.final_err / static_cast<double>(a.flights) : std::nan("");
+    r.metrics["prediction_error_m"] = a.pred_n ? a.pred_err / static_cast<double>(a.pred_n) : std::nan("");
+    r.metrics["nees_mean"] = a.nees.mean();
+    r.metrics["nis_mean"] = a.nis.mean();
+    r.metrics["outlier_rejected_fraction"] =
+        a.outliers ? static_cast<double>(a.outliers_rejected) / static_cast<double>(a.outliers) : std::nan("");
+    r.metrics["inlier_rejected_fraction"] =
+        a.inliers ? static_cast<double>(a.inliers_rejected) / static_cast<double>(a.inliers) : std::nan("");
+    r.metrics["restarts_per_flight"] = static_cast<double>(a.restarts) / std::max(1, opt_.flights);
+    r.verdict = combinedVerdict(r.nees, r.nis, cfg_.confidence);
+    r.series = series;
+    return r;
+  }
+
+  std::vector<NoiseParameter> noiseParameters() const override {
+    return {{"process", "q", "m^2/s^3", "tracker.accel_psd",
+             "white-acceleration density of the tracker's ballistic model", cfg_.tracker.model.accel_psd},
+            {"measurement", "sigma_px", "px", "pixel_noise_px", "pixel noise std the tracker assumes", sigma()}};
+  }
+
+  std::unique_ptr<ReplayData> record(std::uint64_t seed, int runs) const override {
+    auto d = std::make_unique<DartReplayData>();
+    for (int run = 0; run < runs; ++run) {
+      const std::uint64_t s = core::deriveSeed(seed, static_cast<std::uint64_t>(run));
+      for (int f = 0; f < opt_.flights; ++f) {
+        core::Rng rng = core::makeRng(core::deriveSeed(s, static_cast<std::uint64_t>(f)));
+        Flight fl;
+        fl.dets = tracking::simulateFlight(cfg_, cams_, opt_.clock, opt_.outliers ? cfg_.outlier_rate : 0.0, rng, 1).detections;
+        d->flights.push_back(std::move(fl));
+      }
+    }
+    d->source = "live: " + std::to_string(runs) + " run(s) from seed " + std::to_string(seed);
+    return d;
+  }
+
+  std::unique_ptr<ReplayData> loadLog(const std::string& dir) const override {
+    const std::string path = (std::filesystem::path(dir) / "detections.csv").string();
+    std::ifstream in(path);
+    if (!in) throw core::InvalidInput(path + ": cannot read (expected the detections.csv of dart_tracking --log)");
+    std::string line;
+    std::getline(in, line);
+    std::vector<std::string> header = split(line);
+    auto col = [&](const std::string& name) {
+      const auto it = std::find(header.begin(), header.end(), name);
+      if (it == header.end()) throw core::InvalidInput(path + ": missing column '" + name + "'");
+      return static_cast<std::size_t>(it - header.begin());
+    };
+    const std::size_t ce = col("experiment"), cr = col("run"), ci = col("id"), cc = col("camera"), ct = col("t"),
+                      cu = col("u"), cv = col("v");
+    auto d = std::make_unique<DartReplayData>();
+    std::map<std::string, std::size_t> index;
+    std::size_t line_no = 1;
+    while (std::getline(in, line)) {
+      ++line_no;
+      if (line.empty()) continue;
+      const std::vector<std::string> f = split(line);
+      if (f.size() != header.size()) throw core::InvalidInput(path + ":" + std::to_string(line_no) + ": wrong number of columns");
+      if (!opt_.log_experiment.empty() && f[ce] != opt_.log_experiment) continue;
+      const std::string key = f[ce] + "/" + f[cr];
+      auto it = index.find(key);
+      if (it == index.end()) {
+        it = index.emplace(key, d->flights.size()).first;
+        d->flights.emplace_back();
+        d->flights.back().has_truth = false;
+      }
+      tracking::SimDetection det;
+      det.truth.setZero();
+      try {
+        det.m.id = std::stoull(f[ci]);
+        det.m.camera = std::stoul(f[cc]);
+        det.m.t = std::stod(f[ct]);
+        det.m.uv = Eigen::Vector2d(std::stod(f[cu]), std::stod(f[cv]));
+      } catch (const std::exception&) {
+        throw core::InvalidInput(path + ":" + std::to_string(line_no) + ": expected numbers in id, camera, t, u, v");
+      }
+      if (det.m.camera >= cams_.size())
+        throw core::InvalidInput(path + ":" + std::to_string(line_no) + ": camera index beyond the config's cameras");
+      d->flights[it->second].dets.push_back(det);
+    }
+    for (auto& fl : d->flights)
+      std::stable_sort(fl.dets.begin(), fl.dets.end(), [](const auto& x, const auto& y) { return x.m.t < y.m.t; });
+    if (d->flights.empty())
+      throw core::InvalidInput(path + ": no rows of experiment '" + opt_.log_experiment + "' (adapter option log_experiment)");
+    d->source = path + " (" + opt_.log_experiment + ")";
+    return d;
+  }
+
+  ReplayResult replay(const ReplayData& data, const std::vector<double>& noise, double outlier_prior,
+                      bool want_series) const override {
+    const auto* d = dynamic_cast<const DartReplayData*>(&data);
+    if (d == nullptr) throw core::InvalidInput("dart replay: data of another scenario");
+    if (noise.size() != 2) throw core::InvalidInput("dart replay: expected (q, sigma_px)");
+    Accum a;
+    std::shared_ptr<RunSeries> series;
+    if (want_series) series = makeSeries();
+    RunOptions ro;
+    for (std::size_t f = 0; f < d->flights.size(); ++f)
+      processFlight(d->flights[f], static_cast<int>(f), noise[0], noise[1], outlier_prior, a, series.get(), nullptr,
+                    nullptr, ro);
+    ReplayResult r;
+    r.cost = a.cost;
+    r.terms = a.terms;
+    r.nis = a.nis;
+    r.series = series;
+    return r;
+  }
+
+  std::unique_ptr<ScenarioInstance> withNoise(const std::vector<double>& noise) const override {
+    if (noise.size() != 2) throw core::InvalidInput("dart: expected (q, sigma_px)");
+    DartScenarioConfig c = cfg_;
+    c.tracker.model.accel_psd = noise[0];
+    DartOptions o = opt_;
+    o.assumed_sigma = noise[1];
+    return std::make_unique<DartInstance>(c, o);
+  }
+
+private:
+  static std::vector<std::string> split(const std::string& line) {
+    std::vector<std::string> out;
+    std::string cur;
+    bool q = false;
+    for (char c : line) {
+      if (c == '"') q = !q;
+      else if (c == ',' && !q) {
+        out.push_back(cur);
+        cur.clear();
+      } else if (c != '\r') {
+        cur += c;
+      }
+    }
+    out.push_back(cur);
+    return out;
+  }
+
+  std::shared_ptr<RunSeries> makeSeries() const {
+    auto s = std::make_shared<RunSeries>();
+    s->time_label = "time since the first detection [s]";
+    s->error_label = "position error |p_hat - p| [m]";
+    s->nis_x_label = "innovation number (in the run)";
+    s->nis_dof = 2.0;
+    s->traj_x_label = "world x (towards the board) [m]";
+    s->traj_y_label = "world y [m]";
+    return s;
+  }
+
+  void processFlight(const Flight& fl, int f, double q, double sigma, double eps, Accum& a, RunSeries* series,
+                     io::CsvWriter* det_csv, io::CsvWriter* inn_csv, const RunOptions& ro) const {
+    if (fl.dets.empty()) return;
+    tracking::TrackerConfig tc = cfg_.tracker;
+    tc.model.accel_psd = q;
+    tracking::ViewlineTracker tracker(cams_, tc);
+    const bool keep = series != nullptr;
+    const bool keep_traj = keep && f < 5;
+    const bool keep_err = keep && f < 30;
+    Curve err{"flight " + std::to_string(f), {}, {}}, tru{"truth", {}, {}}, est{"estimate", {}, {}}, pre{"prediction", {}, {}};
+    const double t0 = fl.dets.front().m.t;
+    const std::size_t half = fl.dets.size() / 2;
+    std::optional<estimation::StateEstimate> half_state;
+    double last_err = std::nan("");
+    for (std::size_t k = 0; k < fl.dets.size(); ++k) {
+      const tracking::SimDetection& det = fl.dets[k];
+      ImageMeasurement m = det.m;
+      m.sigma_px = sigma;
+      // The innovation the tracker will see (prior at the capture time).
+      bool have = false;
+      Eigen::Vector2d dv = Eigen::Vector2d::Zero();
+      Eigen::Matrix2d S = Eigen::Matrix2d::Identity();
+      double nis = 0.0, u = 0.0;
+      const tracking::TrackState& ts0 = tracker.trackState();
+      const bool in_stats = tracker.initialised() && ts0.fused_in_track >= opt_.burn_in && m.t >= tracker.state().t();
+      if (in_stats) {
+        try {
+          const estimation::StateEstimate pred = tracker.predictAt(m.t);
+          const Eigen::MatrixXd P = pred.P();
+          const tracking::Vector6 x = pred.x();
+          const tracking::Matrix6 P6 = P;
+          const tracking::ViewlineRows rows = tracking::viewlineRows(cams_[m.camera], m.uv, sigma, x, P6, 0.0, tc.model,
+                                                                     tc.min_depth, tc.depth_variance_in_noise);
+          dv = rows.y - rows.C * x;
+          S = rows.R + rows.C * P6 * rows.C.transpose();
+          const Eigen::LLT<Eigen::Matrix2d> llt(S);
+          if (llt.info() == Eigen::Success) {
+            nis = dv.dot(llt.solve(dv));
+            const core::Camera& cam = cams_[m.camera];
+            u = sigma * sigma / (static_cast<double>(cam.width) * cam.height * std::sqrt(rows.R.determinant()));
+            have = std::isfinite(nis) && std::isfinite(u);
+          }
+        } catch (const core::Error&) {
+          have = false;
+        }
+      }
+      tracker.submit(m);
+      const auto out = tracker.outcome(m.id);
+      const bool fused = out && out->fate == tracking::Fate::Fused;
+      if (have) {
+        // −2 log[(1 − ε) N(d; 0, S) + ε u], by log-sum-exp.
+        const double log_gauss = -0.5 * nis - std::log(2.0 * kPi) - 0.5 * std::log(S.determinant());
+        double lp = log_gauss;
+        if (eps > 0.0) {
+          const double l1 = std::log1p(-eps) + log_gauss, l2 = std::log(eps) + std::log(u);
+          const double mx = std::max(l1, l2);
+          lp = mx + std::log(std::exp(l1 - mx) + std::exp(l2 - mx));
+        }
+        a.cost += -2.0 * lp;
+        ++a.terms;
+        if (fused && !out->seed) {
+          a.nis.add(nis, 2.0);
+          if (series != nullptr) {
+            series->nis_t.push_back(static_cast<double>(a.sample));
+            series->nis.push_back(nis);
+          }
+          ++a.sample;
+        }
+      }
+      if (inn_csv != nullptr) {
+        inn_csv->row({static_cast<double>(f), static_cast<double>(m.id), static_cast<double>(m.camera), m.t,
+                      have ? dv(0) : std::nan(""), have ? dv(1) : std::nan(""), have ? S(0, 0) : std::nan(""),
+                      have ? S(0, 1) : std::nan(""), have ? S(1, 1) : std::nan(""), have ? nis : std::nan(""),
+                      fused ? 1.0 : 0.0, have && fused ? 1.0 : 0.0});
+      }
+      if (!tracker.initialised()) continue;
+      const estimation::StateEstimate& s = tracker.state();
+      if (fl.has_truth) {
+        const double e = (s.x().head<3>() - det.truth.head<3>()).norm();
+        last_err = e;
+        if (k >= cfg_.settled_index) {
+          a.sq_err += e * e;
+          ++a.err_n;
+        }
+        if (k == cfg_.nees_index) a.nees.add(estimation::nees(s, det.truth), 6.0);
+        if (keep_err) {
+          err.x.push_back(m.t - t0);
+          err.y.push_back(e);
+        }
+        if (keep_traj) {
+          tru.x.push_back(det.truth(0));
+          tru.y.push_back(det.truth(1));
+        }
+        if (ro.live) ro.live({static_cast<double>(a.sample), e, have && fused ? nis : -1.0});
+      }
+      if (keep_traj) {
+        est.x.push_back(s.x()(0));
+        est.y.push_back(s.x()(1));
+      }
+      if (k == half) half_state = s;
+      if (det_csv != nullptr) {
+        const auto& x = s.x();
+        det_csv->rowText({"tune", std::to_string(f), std::to_string(m.id), std::to_string(m.camera), std::to_string(m.t),
+                          std::to_string(m.uv.x()), std::to_string(m.uv.y()), det.outlier ? "1" : "0",
+                          out ? tracking::toString(out->fate) : "refused", std::to_string(det.truth[0]),
+                          std::to_string(det.truth[1]), std::to_string(det.truth[2]), std::to_string(x[0]),
+                          std::to_string(x[1]), std::to_string(x[2]), std::to_string(x[3]), std::to_string(x[4]),
+                          std::to_string(x[5])});
+      }
+    }
+    // Outlier decisions (final fates) and restarts.
+    if (fl.has_truth) {
+      for (const tracking::MeasurementOutcome& o : tracker.outcomes()) {
+        const auto it = std::find_if(fl.dets.begin(), fl.dets.end(), [&](const auto& d) { return d.m.id == o.m.id; });
+        if (it == fl.dets.end()) continue;
+        const bool rejected = o.fate != tracking::Fate::Fused;
+        if (it->outlier) {
+          ++a.outliers;
+          a.outliers_rejected += rejected;
+        } else {
+          ++a.inliers;
+          a.inliers_rejected += rejected;
+        }
+      }
+      if (std::isfinite(last_err)) {
+        a.final_err += last_err;
+        ++a.flights;
+      }
+      // Prediction from the state at mid-flight to the last detection's time.
+      if (half_state && half_state->dim() == 6) {
+        const tracking::Vector6 x0 = half_state->x();
+        const double th = half_state->t();
+        const tracking::SimDetection& last = fl.dets.back();
+        if (last.m.t > th) {
+          a.pred_err += (tc.model.propagate(x0, last.m.t - th).head<3>() - last.truth.head<3>()).norm();
+          ++a.pred_n;
+          if (keep_traj) {
+            for (std::size_t k = half; k < fl.dets.size(); ++k) {
+              const tracking::Vector6 xp = tc.model.propagate(x0, std::max(0.0, fl.dets[k].m.t - th));
+              pre.x.push_back(xp(0));
+              pre.y.push_back(xp(1));
+            }
+          }
+        }
+      }
+    }
+    a.restarts += static_cast<std::size_t>(tracker.trackState().restarts);
+    if (series != nullptr) {
+      if (!err.x.empty()) series->error.push_back(err);
+      if (!tru.x.empty()) series->truth.push_back(tru);
+      if (!est.x.empty()) series->estimate.push_back(est);
+      if (!pre.x.empty()) series->prediction.push_back(pre);
+    }
+  }
+
+  DartScenarioConfig cfg_;
+  DartOptions opt_;
+  std::vector<core::Camera> cams_;
+};
+
+class DartAdapter final : public ScenarioAdapter {
+public:
+  std::string name() const override { return "dart"; }
+  std::string description() const override {
+    return "dart flights of [L] VI seen by the viewline tracker (measurement level; config/dart_tracking.yaml)";
+  }
+  std::string appCommand(const std::string& config_path) const override {
+    return "dart_tracking --config " + config_path + " --runs 500 --summary dart_summary.json";
+  }
+  std::string defaultMetric() const override { return "rmse_position_m"; }
+  std::vector<std::string> metricNames() const override {
+    return {"rmse_position_m", "final_error_m", "prediction_error_m", "nees_mean", "nis_mean",
+            "outlier_rejected_fraction", "inlier_rejected_fraction", "restarts_per_flight"};
+  }
+  std::vector<AdapterOption> options() const override {
+    return {{"flights", "50", {}, "throws per run"},
+            {"clock", "free_running", {"free_running", "alternating"},
+             "free-running unsynchronised cameras (the full scenario) or alternating 100 Hz steps ([L] VI.A)"},
+            {"outliers", "config", {"config", "none"}, "gross outliers at the config's outlier_rate, or none"},
+            {"assumed_pixel_noise_px", "0", {}, "> 0: pixel noise the tracker assumes (simulation keeps pixel_noise_px)"},
+            {"burn_in", "4", {}, "fused images of a track before its innovations count in NIS / likelihood"},
+            {"log_experiment", "A_alternating", {"A_alternating", "D_scenario"},
+             "which experiment of a dart_tracking --log folder the auto-tuner replays"}};
+  }
+  std::unique_ptr<ScenarioInstance> load(const YAML::Node& scenario, const std::string& name,
+                                         const AdapterOptions& options) const override {
+    DartScenarioConfig cfg = apps::dartScenarioFromString(emitYaml(scenario), name);
+    DartOptions o;
+    const double flights = optionNumber(options, "flights");
+    if (!(flights >= 1.0 && flights <= 1e6)) throw core::InvalidInput("adapter option 'flights': expected 1 to 1e6");
+    o.flights = static_cast<int>(flights);
+    o.clock = optionText(options, "clock") == "alternating" ? tracking::ClockMode::Alternating
+                                                            : tracking::ClockMode::FreeRunning;
+    o.outliers = optionText(options, "outliers") == "config";
+    o.assumed_sigma = optionNumber(options, "assumed_pixel_noise_px");
+    o.burn_in = static_cast<int>(optionNumber(options, "burn_in"));
+    if (o.burn_in < 1) throw core::InvalidInput("adapter option 'burn_in': expected >= 1");
+    o.log_experiment = optionText(options, "log_experiment");
+    if (o.clock == tracking::ClockMode::Alternating && cfg.cameras.size() < 2)
+      throw core::InvalidInput(name + ": adapter option clock: alternating needs two cameras");
+    return std::make_unique<DartInstance>(std::move(cfg), std::move(o));
+  }
+};
+
+}  // namespace
+
+void registerDartAdapter(AdapterRegistry& registry) { registry.add(std::make_unique<DartAdapter>()); }
+
+}  // namespace viewline::tuning

@@ -1,0 +1,107 @@
+#include "viewline/tuning/scenario.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+
+#include "viewline/core/error.h"
+
+namespace viewline::tuning {
+
+void Consistency::add(double value, double dof) {
+  sum += value;
+  dof_sum += dof;
+  ++count;
+}
+
+void Consistency::merge(const Consistency& o) {
+  sum += o.sum;
+  dof_sum += o.dof_sum;
+  count += o.count;
+}
+
+double Consistency::mean() const { return count ? sum / static_cast<double>(count) : std::nan(""); }
+double Consistency::meanDof() const { return count ? dof_sum / static_cast<double>(count) : std::nan(""); }
+
+core::Interval Consistency::bounds(double confidence) const {
+  if (count == 0) return {std::nan(""), std::nan("")};
+  return core::averagedChiSquareInterval(meanDof(), static_cast<double>(count), confidence);
+}
+
+std::string Consistency::verdict(double confidence) const {
+  if (count == 0) return "n/a";
+  const core::Interval b = bounds(confidence);
+  const double m = mean();
+  if (m > b.hi) return "overconfident";
+  if (m < b.lo) return "underconfident";
+  return "consistent";
+}
+
+std::string combinedVerdict(const Consistency& nees, const Consistency& nis, double confidence) {
+  const std::string a = nees.verdict(confidence), b = nis.verdict(confidence);
+  const bool over = a == "overconfident" || b == "overconfident";
+  const bool under = a == "underconfident" || b == "underconfident";
+  if (over && under) return "inconsistent";
+  if (over) return "overconfident";
+  if (under) return "underconfident";
+  if (a == "n/a" && b == "n/a") return "n/a";
+  return "consistent";
+}
+
+void AdapterRegistry::add(std::unique_ptr<ScenarioAdapter> adapter) {
+  if (has(adapter->name())) throw core::InvalidInput("adapter '" + adapter->name() + "' registered twice");
+  adapters_.push_back(std::move(adapter));
+}
+
+bool AdapterRegistry::has(const std::string& name) const {
+  return std::any_of(adapters_.begin(), adapters_.end(), [&](const auto& a) { return a->name() == name; });
+}
+
+const ScenarioAdapter& AdapterRegistry::get(const std::string& name) const {
+  for (const auto& a : adapters_)
+    if (a->name() == name) return *a;
+  std::string list;
+  for (const auto& a : adapters_) list += (list.empty() ? "" : ", ") + a->name();
+  throw core::InvalidInput("unknown scenario '" + name + "' (this build has: " + (list.empty() ? "none" : list) + ")");
+}
+
+std::vector<std::string> AdapterRegistry::names() const {
+  std::vector<std::string> n;
+  for (const auto& a : adapters_) n.push_back(a->name());
+  return n;
+}
+
+AdapterOptions readAdapterOptions(const ScenarioAdapter& adapter, const io::ConfigNode* node) {
+  AdapterOptions out;
+  for (const AdapterOption& o : adapter.options()) {
+    out[o.name] = o.default_value;
+    if (node == nullptr || !node->has(o.name)) continue;
+    if (o.choices.empty()) {
+      const double v = node->get<double>(o.name);
+      if (!std::isfinite(v)) node->fail(o.name, "a finite number");
+      std::string text = node->get<std::string>(o.name);
+      out[o.name] = text;
+    } else {
+      out[o.name] = node->getChoice(o.name, o.choices);
+    }
+  }
+  return out;
+}
+
+double optionNumber(const AdapterOptions& o, const std::string& name) {
+  const auto it = o.find(name);
+  if (it == o.end()) throw core::InvalidInput("adapter option '" + name + "' missing");
+  char* end = nullptr;
+  const double v = std::strtod(it->second.c_str(), &end);
+  if (end == it->second.c_str() || *end != '\0' || !std::isfinite(v))
+    throw core::InvalidInput("adapter option '" + name + "': expected a number, got '" + it->second + "'");
+  return v;
+}
+
+std::string optionText(const AdapterOptions& o, const std::string& name) {
+  const auto it = o.find(name);
+  if (it == o.end()) throw core::InvalidInput("adapter option '" + name + "' missing");
+  return it->second;
+}
+
+}  // namespace viewline::tuning

@@ -1,0 +1,99 @@
+#include <gtest/gtest.h>
+
+#include "toy_scenario.h"
+#include "viewline/core/error.h"
+#include "viewline/tuning/sweep_spec.h"
+#include "viewline/tuning/yaml_edit.h"
+
+using namespace viewline;
+using namespace viewline::tuning;
+
+namespace {
+
+std::string errorOf(const std::string& yaml) {
+  try {
+    sweepSpecFromString(yaml, "s.yaml", toy::registry());
+  } catch (const core::InvalidInput& e) {
+    return e.what();
+  }
+  return "";
+}
+
+}  // namespace
+
+TEST(SweepSpec, GridFromValuesAndRanges) {
+  const SweepSpec s = sweepSpecFromString(
+      "scenario: toy\nseeds: 2\nparameters:\n  - key: filter.q\n    range: [0.001, 0.1]\n    count: 3\n    scale: log\n"
+      "  - key: steps\n    values: [100, 200]\n",
+      "s.yaml", toy::registry());
+  ASSERT_EQ(s.parameters.size(), 2u);
+  EXPECT_EQ(s.metric, "rmse");
+  ASSERT_EQ(s.parameters[0].values.size(), 3u);
+  EXPECT_NEAR(s.parameters[0].values[1].as<double>(), 0.01, 1e-9);
+  const auto settings = generateSettings(s);
+  ASSERT_EQ(settings.size(), 6u);
+  EXPECT_EQ(settingLabel(s, settings[1]), "filter.q=0.001, steps=200");
+  EXPECT_EQ(settingLabel(s, settings[5]), "filter.q=0.1, steps=200");
+}
+
+TEST(SweepSpec, RandomModeIsSeeded) {
+  const std::string y =
+      "scenario: toy\nmode: random\nsamples: 5\nsample_seed: 3\nparameters:\n  - key: filter.r\n    range: [0.1, 10]\n"
+      "    scale: log\n";
+  const auto a = generateSettings(sweepSpecFromString(y, "s.yaml", toy::registry()));
+  const auto b = generateSettings(sweepSpecFromString(y, "s.yaml", toy::registry()));
+  ASSERT_EQ(a.size(), 5u);
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(a[i].numeric[0], b[i].numeric[0]);
+    EXPECT_GE(a[i].numeric[0], 0.1);
+    EXPECT_LE(a[i].numeric[0], 10.0);
+  }
+}
+
+TEST(SweepSpec, ErrorsNameLineAndKey) {
+  // Unknown key in the sweep file.
+  EXPECT_NE(errorOf("scenario: toy\nparameters:\n  - key: filter.q\n    values: [1]\n    scal: log\n")
+                .find("s.yaml:5:5: unknown key 'parameters[0].scal'"),
+            std::string::npos)
+      << errorOf("scenario: toy\nparameters:\n  - key: filter.q\n    values: [1]\n    scal: log\n");
+  // Empty range.
+  const std::string empty = errorOf("scenario: toy\nparameters:\n  - key: filter.q\n    range: [1, 0.5]\n    count: 3\n");
+  EXPECT_NE(empty.find("s.yaml:4:"), std::string::npos) << empty;
+  EXPECT_NE(empty.find("parameters[0].range"), std::string::npos) << empty;
+  EXPECT_NE(empty.find("empty range"), std::string::npos) << empty;
+  const std::string empty_list = errorOf("scenario: toy\nparameters:\n  - key: filter.q\n    values: []\n");
+  EXPECT_NE(empty_list.find("parameters[0].values"), std::string::npos) << empty_list;
+  // Wrong type.
+  const std::string type = errorOf("scenario: toy\nparameters:\n  - key: filter.q\n    range: [a, b]\n    count: 2\n");
+  EXPECT_NE(type.find("s.yaml:4:"), std::string::npos) << type;
+  EXPECT_NE(type.find("parameters[0].range"), std::string::npos) << type;
+  const std::string seeds = errorOf("scenario: toy\nseeds: many\nparameters:\n  - key: filter.q\n    values: [1]\n");
+  EXPECT_NE(seeds.find("s.yaml:2:"), std::string::npos) << seeds;
+  // Unknown metric and scenario.
+  EXPECT_NE(errorOf("scenario: toy\nmetric: speed\nparameters:\n  - key: filter.q\n    values: [1]\n").find("s.yaml:2:"),
+            std::string::npos);
+  EXPECT_NE(errorOf("scenario: nope\nparameters:\n  - key: filter.q\n    values: [1]\n").find("s.yaml:1:"),
+            std::string::npos);
+  // Duplicate parameter.
+  EXPECT_NE(errorOf("scenario: toy\nparameters:\n  - key: filter.q\n    values: [1]\n  - key: filter.q\n    values: [2]\n")
+                .find("listed twice"),
+            std::string::npos);
+}
+
+TEST(YamlEdit, RewriteKeepsCommentsAndReplacesInPlace) {
+  const std::string text = "# top\nq_true: 0.01   # truth\nfilter:\n  q: 0.5       # filter q\n  r: 2\n";
+  const std::string out = rewriteYamlText(text, {{"filter.q", YAML::Node("0.25")}}, "tuned");
+  EXPECT_NE(out.find("# tuned\n# top\n"), std::string::npos) << out;
+  EXPECT_NE(out.find("  q: 0.25       # filter q\n"), std::string::npos) << out;
+  EXPECT_EQ(YAML::Load(out)["filter"]["q"].as<double>(), 0.25);
+  // A key absent from the file: re-emitted with the value.
+  const std::string out2 = rewriteYamlText(text, {{"steps", YAML::Node("50")}}, "x");
+  EXPECT_EQ(YAML::Load(out2)["steps"].as<int>(), 50);
+  EXPECT_EQ(YAML::Load(out2)["filter"]["r"].as<int>(), 2);
+  // Dotted keys with list indices.
+  const YAML::Node n = withValue(YAML::Load("cams:\n  - {f: 1}\n  - {f: 2}\n"), "cams[1].f", YAML::Node("7"));
+  EXPECT_EQ(n["cams"][1]["f"].as<int>(), 7);
+  EXPECT_EQ(n["cams"][0]["f"].as<int>(), 1);
+  EXPECT_THROW(parseDottedKey("a..b"), core::InvalidInput);
+  EXPECT_THROW(parseDottedKey("a[x]"), core::InvalidInput);
+}
