@@ -281,7 +281,11 @@ PanTiltRunMetrics runPanTilt(const PanTiltScenarioConfig& cfg, std::uint64_t see
   const OccludedWorld world(screen_world, occ0, occ1);
 
   // [T] noise: σ = fraction × amplitude of the true path, per axis.
-  const Vector2d amplitude = pathAmplitude(path, cfg.duration);
+  // Closed paths: over one full lap (independent of the run's length); random: over the run.
+  double amplitude_span = cfg.duration;
+  if (pp.shape == sim::PathShape::Rectangle) amplitude_span = 2.0 * (pp.width + pp.height) / pp.speed;
+  if (pp.shape == sim::PathShape::Circle) amplitude_span = 2.0 * core::kPi * pp.radius / pp.speed;
+  const Vector2d amplitude = pathAmplitude(path, amplitude_span);
   const Vector2d sigma = cfg.noise_fraction * amplitude;
   Eigen::Matrix2d R = sigma.cwiseProduct(sigma).asDiagonal();
   if (R.determinant() <= 0.0) R += 1e-8 * Eigen::Matrix2d::Identity();
@@ -348,10 +352,9 @@ PanTiltRunMetrics runPanTilt(const PanTiltScenarioConfig& cfg, std::uint64_t see
 
   const auto n_frames = static_cast<std::size_t>(std::floor(cfg.duration * cfg.fps));
   for (std::size_t k = 0; k < n_frames; ++k) {
-    const sim::Capture& next = rig.peek();
     std::optional<sim::Frame> frame = rig.captureNext(world);
     if (!frame) continue;
-    const double tc = next.capture_time;
+    const double tc = frame->capture_time;  // (rig.peek() would already name the next capture)
     ++m.frames;
     const core::Camera& cam = frame->camera;
     const Vector2d truth = path.position(tc);

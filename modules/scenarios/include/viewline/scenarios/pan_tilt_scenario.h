@@ -18,7 +18,8 @@
 //      screen plane -> m_k (screen coordinates, m);
 //   3. add [T]'s measurement noise: m̃_k = m_k + n_k, n_k ~ N(0, diag(σx², σy²)),
 //      σ_axis = noise_fraction · A_axis, where A_axis = (max − min) / 2 of the
-//      true path along that axis ("white noise of 10 % of the signal amplitude");
+//      true path along that axis ("white noise of 10 % of the signal amplitude"),
+//      taken over one lap for the rectangle and circle, over the run for the random path;
 //      the noisy feature s̃_k is m̃_k projected into the capture-time camera;
 //   4. the controller observes (s̃_k, m̃_k, diag(σx², σy²)) stamped t_k, and at
 //      t_k + processing_delay issues a joint velocity command to the unit,
