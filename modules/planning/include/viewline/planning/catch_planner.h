@@ -1,0 +1,100 @@
+#pragma once
+// Interception planner of the ball catcher ([L] §VI.C, issue 5): moves the hole of a box to the
+// point where a tracked ball will cross the box-front plane, in time, under the robot's limits.
+//
+// Geometry: the hole centre h(t) is the robot's tool point; the box front is the plane through
+// h(t) with the fixed unit normal n (towards the thrower). The planner only moves the hole within
+// the plane through `home` (its n-coordinate stays at home's), so the plane the ball must cross
+// is the plane through home with normal n, and the predicted crossing point IS the target.
+//
+// At every tracker update (update(now, estimate)):
+//  1. predict the crossing (crossing.h) with the configured flight model (drag or ballistic) and
+//     its covariance; ignore it when there is none ahead;
+//  2. while the crossing point is too uncertain (largest std > start_sigma) do nothing; below it,
+//     re-plan a time-optimal synchronised profile (motion_profile.h) to the predicted point,
+//     starting from the CURRENT commanded position and velocity (no jump, no velocity step);
+//  3. the first time the largest std falls below commit_sigma (after at least commit_min_updates
+//     updates) the target is "committed" (decision time = commit − first update). At and after
+//     the commitment, if the box cannot be there by the crossing time (arrival = now + profile
+//     duration + command latency > crossing time + give_up_late), or the point is outside the
+//     workspace, the throw is declared unreachable: the planner stops chasing it and goes home
+//     (the early decision);
+//  4. `home_delay` after the predicted crossing the planner goes home (from the current state).
+// The control loop calls setpoint(t) every control period and streams the result to the robot.
+
+#include <Eigen/Core>
+#include <functional>
+#include <optional>
+
+#include "viewline/estimation/state.h"
+#include "viewline/planning/crossing.h"
+#include "viewline/planning/motion_profile.h"
+#include "viewline/robots/cartesian_robot.h"
+
+namespace viewline::planning {
+
+struct CatchPlannerConfig {
+  CrossingModel model;
+  Eigen::Vector3d home = Eigen::Vector3d(0.0, 0.0, 1.2);   ///< hole centre at rest, world, m
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitX();         ///< box-front normal (unit, towards the thrower)
+  robots::CartesianLimits limits;                            ///< per-axis limits of the hole
+  double latency = 0.0;           ///< robot command latency, s (the box follows set points this late)
+  double start_sigma = 0.15;      ///< m, start moving below this crossing-point std
+  double commit_sigma = 0.01;     ///< m, commit the target below this std
+  int commit_min_updates = 3;     ///< updates (fused images) before a commitment
+  double give_up_late = 0.02;     ///< s, a committed target reached later than crossing + this is unreachable
+  bool give_up = true;            ///< false: keep chasing unreachable targets (for comparisons)
+  double home_delay = 0.1;        ///< s after the predicted crossing before going home
+  double min_lead = 0.0;          ///< s, ignore crossings sooner than now + latency + this
+  /// Throws core::InvalidInput naming the field.
+  void validate() const;
+};
+
+enum class CatchPhase { Idle, Tracking, Committed, GaveUp, Homing };
+const char* toString(CatchPhase p);
+
+struct PlannerUpdate {
+  std::optional<Crossing> crossing;  ///< predicted crossing of this update (if any)
+  bool replanned = false;            ///< a new profile was started
+  bool feasible = false;             ///< the box can be at the target by the crossing time
+  double arrival = 0.0;              ///< predicted arrival of the box at the target (absolute, with latency)
+};
+
+class CatchPlanner {
+public:
+  /// `workspace(p)`: can the hole be at p (robot workspace / IK); empty = everywhere.
+  explicit CatchPlanner(CatchPlannerConfig cfg, std::function<bool(const Eigen::Vector3d&)> workspace = {});
+
+  /// New throw: the commanded state is (p, v) at time t, phase Idle.
+  void reset(double t, const Eigen::Vector3d& p, const Eigen::Vector3d& v = Eigen::Vector3d::Zero());
+  /// A tracker update available at `now` (the estimate may be at an earlier time).
+  PlannerUpdate update(double now, const estimation::StateEstimate& est);
+  /// The set point to stream at time t (non-decreasing); switches to homing after the crossing.
+  robots::CartesianState setpoint(double t);
+
+  CatchPhase phase() const { return phase_; }
+  bool committed() const { return commit_time_.has_value(); }
+  std::optional<double> firstUpdateTime() const { return first_update_; }
+  std::optional<double> commitTime() const { return commit_time_; }
+  std::optional<double> giveUpTime() const { return give_up_time_; }
+  /// The crossing the current plan aims at (last accepted prediction).
+  const std::optional<Crossing>& target() const { return target_; }
+  const SyncProfile& profile() const { return profile_; }
+  int updates() const { return updates_; }
+  int replans() const { return replans_; }
+  const CatchPlannerConfig& config() const { return cfg_; }
+  CrossingPlane plane() const { return {cfg_.home, cfg_.normal}; }
+
+private:
+  void planTo(double now, const Eigen::Vector3d& goal);
+  CatchPlannerConfig cfg_;
+  std::function<bool(const Eigen::Vector3d&)> workspace_;
+  CatchPhase phase_ = CatchPhase::Idle;
+  SyncProfile profile_;
+  double last_t_ = 0.0;
+  std::optional<Crossing> target_;
+  std::optional<double> first_update_, commit_time_, give_up_time_;
+  int updates_ = 0, replans_ = 0;
+};
+
+}  // namespace viewline::planning

@@ -1,0 +1,91 @@
+#pragma once
+// Time-optimal, synchronised point-to-point motion under per-axis velocity and acceleration
+// limits, starting from any state (position AND velocity), ending at rest.
+//
+// One axis (double integrator, |v| <= v_max, |a| <= a_max) from (p0, v0) at time 0 to (pf, 0)
+// at time T uses the three-phase family
+//
+//   phase 1  0 <= t < t1:        constant acceleration ±a_max from v0 to the cruise speed vc,
+//                                t1 = |vc − v0| / a_max
+//   phase 2  t1 <= t < t1 + tc:  constant velocity vc
+//   phase 3  t1 + tc <= t <= T:  constant acceleration ∓a_max from vc to 0, t3 = |vc| / a_max
+//
+// with tc = T − t1 − t3 >= 0 and |vc| <= v_max. vc may have either sign, so overshoot-and-return
+// (v0 towards the goal and too fast to stop) is in the family. The distance covered is
+//
+//   D(vc) = sign(vc − v0) (vc² − v0²) / (2 a) + vc tc + vc |vc| / (2 a)
+//
+// and dD/dvc = tc >= 0 (checked piecewise), so D is monotone on the feasible interval
+// vc ∈ [lo, hi], lo = max(−v_max, (v0 − a T)/2), hi = min(v_max, (v0 + a T)/2) (where tc >= 0;
+// empty when T < |v0| / a). Hence:
+//   - an arrival time T is feasible iff D(lo) <= pf − p0 <= D(hi); the feasible times form
+//     [T_min, ∞) and T_min (the bang-bang / trapezoidal time-optimal time) is found by bisection;
+//   - for a given feasible T, vc solves D(vc) = pf − p0 by bisection (monotone).
+// Synchronisation: T = max over axes of T_min,i; every axis then uses the vc that makes it arrive
+// exactly at T, so all axes arrive together (the path is not a straight line when the initial
+// velocity is not along the displacement, but every axis respects its limits and the arrival is
+// time-optimal for per-axis limits).
+// Replanning without jerks: a new profile starts from the current commanded position and
+// velocity, so position and velocity are continuous across replans (the acceleration may step,
+// as in any bang-bang profile).
+
+#include <Eigen/Core>
+#include <optional>
+
+namespace viewline::planning {
+
+struct AxisState {
+  double p = 0.0, v = 0.0, a = 0.0;
+};
+
+/// One axis of the family above. Valid for t in [0, ∞) (holds pf after T).
+class AxisProfile {
+public:
+  AxisProfile() = default;
+  /// The profile arriving exactly at T, or nothing when T is infeasible.
+  static std::optional<AxisProfile> forTime(double p0, double v0, double pf, double v_max, double a_max, double T);
+  /// Time-optimal arrival time (>= 0). v0 is clamped to ±v_max first. Throws InvalidInput on bad limits.
+  static double minimumTime(double p0, double v0, double pf, double v_max, double a_max);
+
+  AxisState at(double t) const;
+  double duration() const { return T_; }
+  double cruiseVelocity() const { return vc_; }
+
+private:
+  double p0_ = 0.0, v0_ = 0.0, pf_ = 0.0, a_ = 1.0, vc_ = 0.0;
+  double t1_ = 0.0, tc_ = 0.0, t3_ = 0.0, T_ = 0.0;
+  double s1_ = 0.0, s3_ = 0.0;  ///< accelerations of phases 1 and 3
+};
+
+/// Distance covered by the family for cruise speed vc (exposed for tests).
+double profileDistance(double v0, double vc, double a_max, double T);
+
+struct CartesianSample {
+  Eigen::Vector3d p = Eigen::Vector3d::Zero(), v = Eigen::Vector3d::Zero(), a = Eigen::Vector3d::Zero();
+};
+
+/// Three synchronised axes starting at absolute time t0.
+class SyncProfile {
+public:
+  SyncProfile() = default;
+  /// Time-optimal synchronised profile from (p0, v0) at t0 to (pf, 0). Throws InvalidInput for
+  /// non-finite input or bad limits.
+  static SyncProfile plan(double t0, const Eigen::Vector3d& p0, const Eigen::Vector3d& v0, const Eigen::Vector3d& pf,
+                          const Eigen::Vector3d& v_max, const Eigen::Vector3d& a_max);
+  /// Minimum synchronised duration (max over axes of T_min), without building the profile.
+  static double minimumDuration(const Eigen::Vector3d& p0, const Eigen::Vector3d& v0, const Eigen::Vector3d& pf,
+                                const Eigen::Vector3d& v_max, const Eigen::Vector3d& a_max);
+  /// Sample at absolute time t (before t0: the start state; after arrival: at rest at pf).
+  CartesianSample at(double t) const;
+  double startTime() const { return t0_; }
+  double arrivalTime() const { return t0_ + T_; }
+  double duration() const { return T_; }
+  const Eigen::Vector3d& goal() const { return pf_; }
+
+private:
+  double t0_ = 0.0, T_ = 0.0;
+  AxisProfile axes_[3];
+  Eigen::Vector3d pf_ = Eigen::Vector3d::Zero();
+};
+
+}  // namespace viewline::planning

@@ -1,0 +1,111 @@
+#include "viewline/planning/catch_planner.h"
+
+#include <cmath>
+
+#include "viewline/core/error.h"
+
+namespace viewline::planning {
+
+using core::InvalidInput;
+
+const char* toString(CatchPhase p) {
+  switch (p) {
+    case CatchPhase::Idle: return "idle";
+    case CatchPhase::Tracking: return "tracking";
+    case CatchPhase::Committed: return "committed";
+    case CatchPhase::GaveUp: return "gave_up";
+    case CatchPhase::Homing: return "homing";
+  }
+  return "?";
+}
+
+void CatchPlannerConfig::validate() const {
+  model.validate();
+  limits.validate();
+  if (!home.allFinite()) throw InvalidInput("planner.home: expected finite values");
+  if (!normal.allFinite() || std::abs(normal.norm() - 1.0) > 1e-9)
+    throw InvalidInput("planner.normal: expected a unit vector");
+  auto nonneg = [](double v, const char* key) {
+    if (!(std::isfinite(v) && v >= 0.0)) throw InvalidInput(std::string(key) + ": expected a finite value >= 0");
+  };
+  nonneg(latency, "robot.latency_s");
+  nonneg(give_up_late, "planner.give_up_late_s");
+  nonneg(home_delay, "planner.home_delay_s");
+  nonneg(min_lead, "planner.min_lead_s");
+  if (!(std::isfinite(start_sigma) && start_sigma > 0.0)) throw InvalidInput("planner.start_sigma_m: expected > 0");
+  if (!(std::isfinite(commit_sigma) && commit_sigma > 0.0)) throw InvalidInput("planner.commit_sigma_m: expected > 0");
+  if (commit_min_updates < 1) throw InvalidInput("planner.commit_min_updates: expected >= 1");
+}
+
+CatchPlanner::CatchPlanner(CatchPlannerConfig cfg, std::function<bool(const Eigen::Vector3d&)> workspace)
+    : cfg_(std::move(cfg)), workspace_(std::move(workspace)) {
+  cfg_.validate();
+  reset(0.0, cfg_.home);
+}
+
+void CatchPlanner::reset(double t, const Eigen::Vector3d& p, const Eigen::Vector3d& v) {
+  phase_ = CatchPhase::Idle;
+  profile_ = SyncProfile::plan(t, p, v, p, cfg_.limits.v_max, cfg_.limits.a_max);  // stop, return to p
+  last_t_ = t;
+  target_.reset();
+  first_update_.reset();
+  commit_time_.reset();
+  give_up_time_.reset();
+  updates_ = 0;
+  replans_ = 0;
+}
+
+void CatchPlanner::planTo(double now, const Eigen::Vector3d& goal) {
+  const CartesianSample s = profile_.at(now);
+  profile_ = SyncProfile::plan(now, s.p, s.v, goal, cfg_.limits.v_max, cfg_.limits.a_max);
+  ++replans_;
+}
+
+PlannerUpdate CatchPlanner::update(double now, const estimation::StateEstimate& est) {
+  PlannerUpdate out;
+  if (!std::isfinite(now)) throw InvalidInput("CatchPlanner::update: non-finite time");
+  if (phase_ == CatchPhase::GaveUp || phase_ == CatchPhase::Homing) return out;
+  if (!first_update_) first_update_ = now;
+  ++updates_;
+  out.crossing = predictCrossing(est, plane(), cfg_.model);
+  if (!out.crossing) return out;
+  const Crossing& c = *out.crossing;
+  if (c.t < now + cfg_.latency + cfg_.min_lead) return out;  // too late to act on
+  const double sigma = c.sigmaMax();
+  const bool in_workspace = !workspace_ || workspace_(c.p);
+  const CartesianSample s = profile_.at(now);
+  const double duration = SyncProfile::minimumDuration(s.p, s.v, c.p, cfg_.limits.v_max, cfg_.limits.a_max);
+  out.arrival = now + duration + cfg_.latency;
+  out.feasible = in_workspace && out.arrival <= c.t;
+  if (!commit_time_ && sigma <= cfg_.commit_sigma && updates_ >= cfg_.commit_min_updates) {
+    commit_time_ = now;
+    phase_ = CatchPhase::Committed;
+  }
+  if (commit_time_ && cfg_.give_up && (!in_workspace || out.arrival > c.t + cfg_.give_up_late)) {
+    give_up_time_ = now;
+    phase_ = CatchPhase::GaveUp;
+    planTo(now, cfg_.home);
+    out.replanned = true;
+    return out;
+  }
+  if (sigma > cfg_.start_sigma || !in_workspace) return out;
+  if (phase_ == CatchPhase::Idle) phase_ = CatchPhase::Tracking;
+  target_ = c;
+  planTo(now, c.p);
+  out.replanned = true;
+  return out;
+}
+
+robots::CartesianState CatchPlanner::setpoint(double t) {
+  if (t < last_t_) throw InvalidInput("CatchPlanner::setpoint: time goes backwards");
+  last_t_ = t;
+  if ((phase_ == CatchPhase::Tracking || phase_ == CatchPhase::Committed) && target_ &&
+      t >= target_->t + cfg_.home_delay) {
+    phase_ = CatchPhase::Homing;
+    planTo(t, cfg_.home);
+  }
+  const CartesianSample s = profile_.at(t);
+  return {t, s.p, s.v};
+}
+
+}  // namespace viewline::planning

@@ -1,0 +1,134 @@
+// Motion profiles: limits respected, exact arrival, synchronised arrival, optimality, continuity
+// of replanning from a moving state.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "viewline/core/error.h"
+#include "viewline/core/random.h"
+#include "viewline/planning/motion_profile.h"
+
+using namespace viewline;
+using planning::AxisProfile;
+using planning::SyncProfile;
+
+namespace {
+
+// Checks a sampled profile against the limits and the integration p' = v (finite differences).
+void expectWithinLimits(const SyncProfile& pr, const Eigen::Vector3d& vmax, const Eigen::Vector3d& amax) {
+  const double dt = 1e-4;
+  auto prev = pr.at(pr.startTime());
+  for (double t = pr.startTime() + dt; t <= pr.arrivalTime() + 0.05; t += dt) {
+    const auto s = pr.at(t);
+    for (int i = 0; i < 3; ++i) {
+      ASSERT_LE(std::abs(s.v(i)), vmax(i) * (1 + 1e-9)) << "axis " << i << " t " << t;
+      ASSERT_LE(std::abs(s.v(i) - prev.v(i)) / dt, amax(i) * (1 + 1e-6)) << "axis " << i << " t " << t;
+      // position consistent with the velocity: the trapezoid rule is exact for linear v and off
+      // by at most |Δa| dt² / 8 <= a_max dt² / 4 when the step contains a phase switch
+      ASSERT_NEAR(s.p(i) - prev.p(i), 0.5 * (s.v(i) + prev.v(i)) * dt, amax(i) * dt * dt / 4 + 1e-12)
+          << "axis " << i << " t " << t;
+    }
+    prev = s;
+  }
+}
+
+}  // namespace
+
+TEST(MotionProfile, RestToRestMatchesTrapezoidFormula) {
+  // 1-D rest to rest: T = D/v + v/a when D > v²/a, else 2 sqrt(D/a).
+  EXPECT_NEAR(AxisProfile::minimumTime(0, 0, 0.3, 0.5, 13), 0.3 / 0.5 + 0.5 / 13, 1e-9);
+  EXPECT_NEAR(AxisProfile::minimumTime(0, 0, 0.01, 0.5, 13), 2 * std::sqrt(0.01 / 13), 1e-9);
+  EXPECT_NEAR(AxisProfile::minimumTime(1, 0, 0.7, 0.5, 13), 0.3 / 0.5 + 0.5 / 13, 1e-9);
+  EXPECT_EQ(AxisProfile::minimumTime(0.2, 0, 0.2, 0.5, 13), 0.0);
+}
+
+TEST(MotionProfile, MovingStartNeedsOvershoot) {
+  // Moving at 0.5 m/s towards a goal 1 cm ahead: stopping takes 0.5²/26 = 9.6 mm... plus it must
+  // come back when the goal is closer than the stopping distance.
+  const double T = AxisProfile::minimumTime(0, 0.5, 0.005, 0.5, 13);
+  auto pr = AxisProfile::forTime(0, 0.5, 0.005, 0.5, 13, T);
+  ASSERT_TRUE(pr);
+  EXPECT_LT(pr->cruiseVelocity(), 0.0);  // comes back
+  EXPECT_NEAR(pr->at(T).p, 0.005, 1e-9);
+  EXPECT_NEAR(pr->at(T - 1e-9).v, 0.0, 1e-6);
+  // A slightly shorter time is infeasible.
+  EXPECT_FALSE(AxisProfile::forTime(0, 0.5, 0.005, 0.5, 13, T * 0.99));
+}
+
+TEST(MotionProfile, RandomProfilesRespectLimitsAndArriveTogether) {
+  core::Rng rng = core::makeRng(7);
+  const Eigen::Vector3d vmax(0.5, 0.4, 0.6), amax(13, 10, 8);
+  for (int k = 0; k < 200; ++k) {
+    Eigen::Vector3d p0, v0, pf;
+    for (int i = 0; i < 3; ++i) {
+      p0(i) = core::uniform(rng, -0.5, 0.5);
+      pf(i) = core::uniform(rng, -0.5, 0.5);
+      v0(i) = core::uniform(rng, -vmax(i), vmax(i));
+    }
+    const double t0 = core::uniform(rng, 0, 3);
+    const SyncProfile pr = SyncProfile::plan(t0, p0, v0, pf, vmax, amax);
+    // Starts at the given state.
+    EXPECT_LT((pr.at(t0).p - p0).norm(), 1e-12);
+    EXPECT_LT((pr.at(t0).v - v0).norm(), 1e-12);
+    // Every axis is at its goal at rest exactly at the common arrival time, none before.
+    const auto end = pr.at(pr.arrivalTime());
+    EXPECT_LT((end.p - pf).norm(), 1e-9);
+    for (int i = 0; i < 3; ++i) {
+      const double Ti = AxisProfile::minimumTime(p0(i), v0(i), pf(i), vmax(i), amax(i));
+      EXPECT_LE(Ti, pr.duration() + 1e-9);
+      const auto before = pr.at(pr.arrivalTime() - 1e-3);
+      if (std::abs(pf(i) - p0(i)) > 1e-3 || std::abs(v0(i)) > 1e-2) {
+        EXPECT_TRUE(std::abs(before.p(i) - pf(i)) > 1e-12 || std::abs(before.v(i)) > 1e-9)
+            << "axis " << i << " arrived early";
+      }
+    }
+    EXPECT_NEAR(pr.duration(), SyncProfile::minimumDuration(p0, v0, pf, vmax, amax), 1e-12);
+    expectWithinLimits(pr, vmax, amax);
+  }
+}
+
+TEST(MotionProfile, MinimumTimeIsOptimal) {
+  // No profile of the family is feasible at 0.999 T_min, for random starts.
+  core::Rng rng = core::makeRng(11);
+  for (int k = 0; k < 300; ++k) {
+    const double p0 = core::uniform(rng, -1, 1), pf = core::uniform(rng, -1, 1), v0 = core::uniform(rng, -0.5, 0.5);
+    const double T = AxisProfile::minimumTime(p0, v0, pf, 0.5, 13);
+    EXPECT_TRUE(AxisProfile::forTime(p0, v0, pf, 0.5, 13, T).has_value());
+    if (T > 1e-6) {
+      EXPECT_FALSE(AxisProfile::forTime(p0, v0, pf, 0.5, 13, 0.999 * T).has_value());
+    }
+    // Any longer time is feasible (the feasible set is [T_min, inf)).
+    EXPECT_TRUE(AxisProfile::forTime(p0, v0, pf, 0.5, 13, 1.5 * T + 0.01).has_value());
+  }
+}
+
+TEST(MotionProfile, ReplanningFromTheCurrentStateIsContinuous) {
+  const Eigen::Vector3d vmax = Eigen::Vector3d::Constant(0.5), amax = Eigen::Vector3d::Constant(13);
+  core::Rng rng = core::makeRng(3);
+  SyncProfile pr = SyncProfile::plan(0, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(),
+                                     Eigen::Vector3d(0, 0.3, -0.2), vmax, amax);
+  double t = 0;
+  const double dt = 1e-3;
+  auto prev = pr.at(0);
+  for (int step = 1; step < 1500; ++step) {
+    t = step * dt;
+    if (step % 20 == 0) {  // new goal every 20 ms, from the current commanded state
+      const auto s = pr.at(t);
+      pr = SyncProfile::plan(t, s.p, s.v,
+                             Eigen::Vector3d(0, core::uniform(rng, -0.3, 0.3), core::uniform(rng, -0.3, 0.3)), vmax,
+                             amax);
+    }
+    const auto s = pr.at(t);
+    for (int i = 0; i < 3; ++i) {
+      ASSERT_LE(std::abs(s.v(i) - prev.v(i)), amax(i) * dt * (1 + 1e-6)) << "velocity step at t " << t;
+      ASSERT_LE(std::abs(s.p(i) - prev.p(i)), vmax(i) * dt * (1 + 1e-6)) << "position jump at t " << t;
+    }
+    prev = s;
+  }
+}
+
+TEST(MotionProfile, RejectsBadInput) {
+  EXPECT_THROW(AxisProfile::minimumTime(0, 0, 1, 0.0, 13), core::InvalidInput);
+  EXPECT_THROW(AxisProfile::minimumTime(0, 0, 1, 0.5, -1), core::InvalidInput);
+  EXPECT_THROW(AxisProfile::minimumTime(0, 0, NAN, 0.5, 13), core::InvalidInput);
+}

@@ -1,0 +1,151 @@
+#pragma once
+// A robot that carries a tool (the catching box) and takes Cartesian set points: one interface
+// for the simulated back ends below and for a real arm (an ABB IRB 140 with a streaming
+// position interface such as EGM, or a Viper850 through vpRobotViper850, would implement the
+// same three calls).
+//
+// Frames and units: world frame w (z up), SI units. The tool point is the centre of the hole in
+// the box's front face; its orientation is fixed (the box front faces the thrower) and not part
+// of the command. A command is a set point (position and velocity of the tool point) stamped
+// with its issue time; a real controller streams one every control period and applies it after
+// the command latency. The limits are Cartesian and per axis ([L]: 0.5 m/s and 13 m/s²): the
+// planner (planning/motion_profile.h) produces set points that respect them; the simulated back
+// end counts every set point that does not (tests assert none does) instead of silently fixing it.
+//
+// Two kinematic back ends, chosen in the scenario config:
+//  - Stage: a Cartesian (gantry) stage; the workspace is an axis-aligned box.
+//  - Arm:   the tool carried by a ViSP vpViper850 (its DH model and joint limits). Every set
+//           point goes through the inverse kinematics (vpViper::getInverseKinematics, nearest
+//           solution to the current joints) and must respect the joint limits; a set point
+//           with no solution is refused (the arm holds its last valid set point, counted).
+
+#include <Eigen/Geometry>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "viewline/core/time.h"
+
+namespace viewline::robots {
+
+/// Per-axis Cartesian limits of the tool point.
+struct CartesianLimits {
+  Eigen::Vector3d v_max = Eigen::Vector3d::Constant(0.5);   ///< |ṗ_i| m/s
+  Eigen::Vector3d a_max = Eigen::Vector3d::Constant(13.0);  ///< |p̈_i| m/s²
+  /// [L]'s ball catcher (ABB IRB 140): 0.5 m/s and 13 m/s² on every axis.
+  static CartesianLimits linderoth() { return {}; }
+  /// Throws core::InvalidInput naming the field (positive and finite).
+  void validate() const;
+};
+
+/// Tool point position and velocity at time t.
+struct CartesianState {
+  core::Timestamp t = 0.0;
+  Eigen::Vector3d p = Eigen::Vector3d::Zero();
+  Eigen::Vector3d v = Eigen::Vector3d::Zero();
+};
+
+class CartesianRobot {
+public:
+  virtual ~CartesianRobot() = default;
+  virtual std::string name() const = 0;
+  virtual const CartesianLimits& limits() const = 0;
+  /// Delay between a set point's issue and its effect (s).
+  virtual double commandLatency() const = 0;
+  /// Can the tool point be at p (workspace; for the arm: an IK solution within the joint limits)?
+  virtual bool reachable(const Eigen::Vector3d& p_w) const = 0;
+  /// Streams one set point issued at t (non-decreasing times). Throws InvalidInput for NaN or
+  /// a time before the previous set point.
+  virtual void command(const CartesianState& setpoint) = 0;
+  /// Tool state at time t (simulation: any t; hardware: now).
+  virtual CartesianState read(core::Timestamp t) const = 0;
+};
+
+/// The vpViper850 holding the box: f = robot base frame, tool frame c = box frame (origin at
+/// the hole centre, z along the box-front normal). w_M_f places the base in the world.
+class ViperArmKinematics {
+public:
+  /// `tool_offset`: eMc translation (flange to hole centre, in the flange frame), m.
+  /// `w_R_box`: fixed orientation of the box in the world.
+  ViperArmKinematics(const Eigen::Isometry3d& w_M_f, const Eigen::Matrix3d& w_R_box,
+                     const Eigen::Vector3d& tool_offset);
+  ~ViperArmKinematics();
+  ViperArmKinematics(const ViperArmKinematics&);
+  ViperArmKinematics& operator=(const ViperArmKinematics&);
+
+  /// Joint solution (6) for the box at p_w, nearest to `q_seed`, within the joint limits
+  /// (checked again here, with `margin` rad), or nothing.
+  std::optional<Eigen::Matrix<double, 6, 1>> inverse(const Eigen::Vector3d& p_w,
+                                                     const Eigen::Matrix<double, 6, 1>& q_seed,
+                                                     double margin = 0.0) const;
+  /// Box pose in the world for joints q (forward kinematics, vpViper::get_fMc).
+  Eigen::Isometry3d forward(const Eigen::Matrix<double, 6, 1>& q) const;
+  Eigen::Matrix<double, 6, 1> jointMin() const;
+  Eigen::Matrix<double, 6, 1> jointMax() const;
+  const Eigen::Matrix3d& boxRotation() const { return w_R_box_; }
+
+private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  Eigen::Isometry3d w_M_f_;
+  Eigen::Matrix3d w_R_box_;
+};
+
+enum class CartesianBackEnd { Stage, Arm };
+const char* toString(CartesianBackEnd k);
+
+struct SimulatedCartesianConfig {
+  CartesianBackEnd kind = CartesianBackEnd::Stage;
+  CartesianLimits limits;
+  double latency = 0.008;          ///< s between a set point's issue and its effect
+  Eigen::Vector3d home = Eigen::Vector3d(0.0, 0.0, 1.2);      ///< tool point at rest, world
+  Eigen::Vector3d workspace_min = Eigen::Vector3d(-0.1, -0.6, 0.7);  ///< stage box (and arm bounds)
+  Eigen::Vector3d workspace_max = Eigen::Vector3d(0.1, 0.6, 1.7);
+  // Arm only.
+  Eigen::Isometry3d w_M_base = Eigen::Isometry3d::Identity();
+  Eigen::Matrix3d w_R_box = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d tool_offset = Eigen::Vector3d(0.0, 0.0, 0.2);
+  double joint_margin = 0.02;      ///< rad kept from each joint limit
+  /// Tolerance of the limit check of the streamed set points (relative).
+  double limit_tolerance = 1e-6;
+  void validate() const;
+};
+
+/// Simulated back end: the tool follows the streamed set points exactly, `latency` later
+/// (piecewise cubic Hermite between set points: position and velocity continuous). Set points
+/// are checked against the limits (velocity directly; acceleration as the velocity difference
+/// between consecutive set points over their interval) and the workspace / IK.
+class SimulatedCartesianRobot : public CartesianRobot {
+public:
+  explicit SimulatedCartesianRobot(SimulatedCartesianConfig cfg);
+  std::string name() const override;
+  const CartesianLimits& limits() const override { return cfg_.limits; }
+  double commandLatency() const override { return cfg_.latency; }
+  bool reachable(const Eigen::Vector3d& p_w) const override;
+  void command(const CartesianState& setpoint) override;
+  CartesianState read(core::Timestamp t) const override;
+
+  /// Forget the history; the tool is at `home` at rest (as if a set point (home, 0) was issued at t).
+  void reset(core::Timestamp t);
+  const SimulatedCartesianConfig& config() const { return cfg_; }
+  std::size_t setpoints() const { return setpoints_; }
+  std::size_t velocityViolations() const { return v_violations_; }
+  std::size_t accelerationViolations() const { return a_violations_; }
+  std::size_t refusedSetpoints() const { return refused_; }
+  double maxSpeedSeen() const { return max_v_; }       ///< max |v_i| over set points
+  double maxAccelerationSeen() const { return max_a_; } ///< max |Δv_i / Δt|
+  /// Last joint solution (arm back end), zeros for the stage.
+  const Eigen::Matrix<double, 6, 1>& joints() const { return q_; }
+  const ViperArmKinematics* arm() const { return arm_ ? &*arm_ : nullptr; }
+
+private:
+  SimulatedCartesianConfig cfg_;
+  std::optional<ViperArmKinematics> arm_;
+  std::vector<CartesianState> hist_;  ///< accepted set points (effect time = t + latency)
+  Eigen::Matrix<double, 6, 1> q_ = Eigen::Matrix<double, 6, 1>::Zero();
+  std::size_t setpoints_ = 0, v_violations_ = 0, a_violations_ = 0, refused_ = 0;
+  double max_v_ = 0.0, max_a_ = 0.0;
+};
+
+}  // namespace viewline::robots
