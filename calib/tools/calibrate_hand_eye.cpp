@@ -1,6 +1,10 @@
 // calibrate-hand-eye: vpHandEyeCalibration from robot poses and board poses.
 //   calibrate-hand-eye --setup eye-in-hand --robot-poses robot.yaml --camera-poses poses.yaml --output e_M_c.yaml
-// robot.yaml:  poses: [ {r_M_e: {translation: [..], rotation: [[..]..] | theta_u_deg: [..]}}, ... ]
+// robot.yaml:  poses: [ {r_M_e: {translation: [..], rotation: [[..]..] | theta_u_deg: [..]}, q_deg: [..]}, ... ]
+//              (q_deg, the joint angles, is optional and informative only)
+// --rig-output rig.yaml --intrinsics cam.xml: also writes a one-camera rig (io::saveRig) whose world
+// is the robot base frame, with the camera where it is at robot pose --rig-pose (eye-in-hand:
+// c_M_r = (r_M_e(k) e_M_c)^-1; eye-to-hand: c_M_r = r_M_c^-1, whatever --rig-pose).
 // poses.yaml:  the output of compute-board-poses (same order; pairs whose board was not found are dropped).
 #include <CLI/CLI.hpp>
 #include <iostream>
@@ -19,12 +23,24 @@ int main(int argc, char** argv) {
   app.add_option("--robot-poses", robot_file, "YAML list of r_M_e (end effector in robot base)")->required();
   app.add_option("--camera-poses", camera_file, "compute-board-poses output (c_M_o per image)")->required();
   app.add_option("--output", output, "YAML to write (e_M_c or r_M_c, residuals)");
+  std::string rig_output, intrinsics, camera_name = "camera";
+  std::size_t rig_pose = 0;
+  app.add_option("--rig-output", rig_output, "one-camera rig file to write (world = robot base frame)");
+  app.add_option("--intrinsics", intrinsics, "with --rig-output: ViSP camera XML (calibrate-camera's)");
+  app.add_option("--camera-name", camera_name, "with --rig-output: camera name in the XML and in the rig");
+  app.add_option("--rig-pose", rig_pose, "with --rig-output, eye-in-hand: index of the robot pose the rig is written at");
   CLI11_PARSE(app, argc, argv);
   return viewline::calib::tools::runTool("calibrate-hand-eye", [&] {
     using namespace viewline;
     const auto robot = io::ConfigNode::loadFile(robot_file);
     std::vector<Eigen::Isometry3d> r_M_e;
-    for (const auto& p : robot.childList("poses")) r_M_e.push_back(io::readPose(p.child("r_M_e")));
+    for (const auto& p : robot.childList("poses")) {
+      r_M_e.push_back(io::readPose(p.child("r_M_e")));
+      p.ignore("q_deg");
+    }
+    if (!rig_output.empty() && intrinsics.empty()) throw core::InvalidInput("--rig-output needs --intrinsics");
+    if (!rig_output.empty() && rig_pose >= r_M_e.size())
+      throw core::InvalidInput("--rig-pose " + std::to_string(rig_pose) + ": " + robot_file + " has " + std::to_string(r_M_e.size()) + " poses");
     robot.finish();
     const auto cams = io::ConfigNode::loadFile(camera_file);
     cams.ignore("board");
@@ -58,6 +74,20 @@ int main(int argc, char** argv) {
         << "\nrms_rotation_deg: " << core::rad2deg(r.rms_rotation_rad) << "\n";
       io::writeTextFileAtomic(output, y.str());
       std::cout << "wrote " << output << "\n";
+    }
+    if (!rig_output.empty()) {
+      core::Camera cam;
+      cam.name = camera_name;
+      const auto xml = io::loadVispCameraXml(intrinsics, camera_name, io::Projection::WithDistortion);
+      cam.intrinsics = xml.intrinsics;
+      cam.width = xml.width;
+      cam.height = xml.height;
+      const bool in = s == calib::HandEyeSetup::EyeInHand;
+      cam.c_M_w = in ? (r_M_e[rig_pose] * r.X).inverse() : r.X.inverse();
+      std::ostringstream comment;
+      comment << "calibrate-hand-eye (" << setup << ", " << rm.size() << " poses): world = robot base frame"
+              << (in ? ", camera at robot pose " + std::to_string(rig_pose) : std::string());
+      for (const auto& f : io::saveRig(rig_output, {cam}, comment.str())) std::cout << "wrote " << f << "\n";
     }
     return 0;
   });

@@ -14,6 +14,9 @@
 //     tag_id: 0                       # apriltag: id, tag_size, tag_family (default 36h11)
 //     tag_size: 0.1
 //     frame: ground                   # board/apriltag: ground (z up) | board (the board's own frame)
+//     w_M_anchor:                     # optional: the anchor's (surveyed) pose in the world, when the
+//       translation: [..]             # world origin is not on the anchor (default: identity, world =
+//       rotation: [[..], [..], [..]]  # anchor frame); {translation, rotation | theta_u_deg}
 #include <CLI/CLI.hpp>
 #include <filesystem>
 #include <iostream>
@@ -76,6 +79,8 @@ int main(int argc, char** argv) {
       tag.tag_family = world.getChoiceOr("tag_family", {"36h11", "25h9", "16h5", "circle21h7"}, "36h11");
       tag.tag_ids = {tag_id};
     }
+    const Eigen::Isometry3d w_M_anchor = world.has("w_M_anchor") ? io::readPose(world.child("w_M_anchor")) : Eigen::Isometry3d::Identity();
+    if (anchor == "camera" && world.has("w_M_anchor")) world.fail("w_M_anchor", "no anchor pose with anchor: camera (the world is that camera's frame)");
     cfg.finish();
 
     const std::size_t nk = images.front().size();
@@ -113,6 +118,7 @@ int main(int argc, char** argv) {
       // A single tag's ViSP frame already has z out of the paper (up, on the floor).
       ref_M_w = r.c_M_ref[anchor_cam].inverse() * *c_M_anchor;
     }
+    ref_M_w = ref_M_w * w_M_anchor.inverse();
     for (std::size_t i = 0; i < cameras.size(); ++i) {
       cameras[i].c_M_w = r.c_M_ref[i] * ref_M_w;
       std::cout << cameras[i].name << ": " << r.views_used[i] << " views, RMS " << r.camera_rms_px[i]

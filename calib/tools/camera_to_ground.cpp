@@ -2,12 +2,16 @@
 // or an AprilTag lying flat on it, printed side up.
 //   camera-to-ground --board tag.yaml --intrinsics cam.xml --camera-name cam --output ground.yaml images...
 #include <CLI/CLI.hpp>
+#include <algorithm>
+#include <cctype>
+#include <filesystem>
 #include <iomanip>
 #include <iostream>
 
 #include "tool_common.h"
 #include "viewline/core/frames.h"
 #include "viewline/io/files.h"
+#include "viewline/io/rig.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"Camera-to-ground rotation (and height) from a board or tag lying on the floor."};
@@ -20,10 +24,33 @@ int main(int argc, char** argv) {
   app.add_option("--projection", projection, "XML model: with_distortion | without_distortion");
   app.add_option("--tag-id", tag_id, "board type apriltag: the tag on the floor (default: the only one seen)");
   app.add_option("--output", output, "YAML to write (c_M_g, g_R_c, height, pitch, roll)");
+  std::string rig_output;
+  std::string ground_origin_text = "0,0";
+  double ground_yaw_deg = 0.0;
+  app.add_option("--rig-output", rig_output, "one-camera rig file to write (world: z up on the floor; ViSP XML only)");
+  app.add_option("--ground-origin", ground_origin_text, "with --rig-output: the board's origin in the world floor, \"x,y\" (m)");
+  app.add_option("--ground-yaw", ground_yaw_deg, "with --rig-output: the board's x axis, deg from world x about z");
+  std::string x_hint;
+  app.add_option("--board-x-hint", x_hint, "chessboard: direction of the board's x axis in the image (right|left|up|down); "
+                 "the corners are renumbered from the other end when the detection runs the other way (180° symmetry)")
+      ->check(CLI::IsMember({"right", "left", "up", "down"}));
   app.add_option("images", images, "image files (camera still, board still)")->required();
   CLI11_PARSE(app, argc, argv);
   return viewline::calib::tools::runTool("camera-to-ground", [&] {
     using namespace viewline;
+    std::vector<double> ground_origin;
+    {
+      std::istringstream in(ground_origin_text);
+      for (std::string v; std::getline(in, v, ',');) {
+        try {
+          ground_origin.push_back(std::stod(v));
+        } catch (const std::exception&) {
+          ground_origin.clear();
+          break;
+        }
+      }
+      if (ground_origin.size() != 2) throw core::InvalidInput("--ground-origin: expected \"x,y\" in metres, got '" + ground_origin_text + "'");
+    }
     const calib::BoardSpec board = calib::loadBoard(board_file);
     const calib::PoseCamera cam = calib::tools::loadPoseCamera(intrinsics, camera_name, projection);
     std::vector<Eigen::Isometry3d> poses;
@@ -37,8 +64,15 @@ int main(int argc, char** argv) {
         if (it == tags.end()) throw core::InvalidInput(file + ": the floor tag was not found");
         poses.push_back(it->second.c_M_o);
       } else {
-        const calib::Detection d = calib::detectBoard(gray, board);
+        calib::Detection d = calib::detectBoard(gray, board);
         if (!d.observation) throw core::InvalidInput(file + ": " + d.reason);
+        auto& pts = d.observation->image_points;
+        if (!x_hint.empty() && board.type == calib::BoardType::Chessboard) {
+          const cv::Point2f ax = pts[static_cast<std::size_t>(board.cols - 1)] - pts[0];
+          const cv::Point2f want = x_hint == "right" ? cv::Point2f(1, 0) : x_hint == "left" ? cv::Point2f(-1, 0)
+                                   : x_hint == "up" ? cv::Point2f(0, -1) : cv::Point2f(0, 1);
+          if (ax.dot(want) < 0.f) std::reverse(pts.begin(), pts.end());  // the same corners, numbered from the other end
+        }
         poses.push_back(calib::estimatePose(cam, d.observation->object_points, d.observation->image_points).c_M_o);
       }
     }
@@ -58,6 +92,27 @@ int main(int argc, char** argv) {
         << "\nroll_deg: " << core::rad2deg(g.roll_rad) << "\n";
       io::writeTextFileAtomic(output, y.str());
       std::cout << "wrote " << output << "\n";
+    }
+    if (!rig_output.empty()) {
+      const auto lower = [](std::string e) { for (auto& ch : e) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch))); return e; };
+      if (lower(std::filesystem::path(intrinsics).extension().string()) != ".xml")
+        throw core::InvalidInput("--rig-output needs ViSP XML intrinsics (--intrinsics " + intrinsics + ")");
+      core::Camera rig_cam;
+      rig_cam.name = camera_name;
+      const auto xml = io::loadVispCameraXml(intrinsics, camera_name,
+                                             projection == "without_distortion" ? io::Projection::WithoutDistortion
+                                                                                 : io::Projection::WithDistortion);
+      rig_cam.intrinsics = xml.intrinsics;
+      rig_cam.width = xml.width;
+      rig_cam.height = xml.height;
+      Eigen::Isometry3d w_M_g = Eigen::Isometry3d::Identity();
+      w_M_g.linear() = core::rotation(Eigen::Vector3d::UnitZ(), core::deg2rad(ground_yaw_deg));
+      w_M_g.translation() = Eigen::Vector3d(ground_origin[0], ground_origin[1], 0.0);
+      rig_cam.c_M_w = g.c_M_g * w_M_g.inverse();
+      std::ostringstream comment;
+      comment << "camera-to-ground from " << poses.size() << " images: world z up on the floor, board origin at ("
+              << ground_origin[0] << ", " << ground_origin[1] << ") m, yaw " << ground_yaw_deg << " deg";
+      for (const auto& f : io::saveRig(rig_output, {rig_cam}, comment.str())) std::cout << "wrote " << f << "\n";
     }
     return 0;
   });
