@@ -54,6 +54,27 @@ TEST(MobileCapture, FindsAnObjectBehindTheRobot) {
   EXPECT_GT(r.detections, 0);
 }
 
+TEST(MobileCapture, FindsTheTargetAgainAfterLosingIt) {
+  // Camera covered for 4 s mid-chase: the filter predicts, the head follows the prediction, then
+  // the search sweeps; the object must be found again and still be captured.
+  MobileCaptureConfig cfg = shipped();
+  cfg.max_time = 60.0;
+  cfg.blackout_start = 6.0;
+  cfg.blackout_duration = 4.0;
+  int seen_after = 0;
+  bool swept = false;
+  MobileCaptureHooks hooks;
+  hooks.on_frame = [&](const MobileCaptureFrame& f) {
+    if (f.t >= 10.0 && f.detected) ++seen_after;
+    if (f.t > 6.0 && f.t < 10.0 && f.mode == control::SearchMode::Sweeping) swept = true;
+  };
+  const MobileCaptureRun r = runMobileCapture(cfg, 7, &hooks);
+  EXPECT_TRUE(swept);
+  EXPECT_GE(r.longest_lost, 3.9);
+  EXPECT_GT(seen_after, 10);
+  EXPECT_TRUE(r.captured);
+}
+
 TEST(MobileCapture, OracleIsDeterministicPerSeed) {
   const MobileCaptureConfig cfg = shipped();
   const OracleResult a = runOracle(cfg, 11), b = runOracle(cfg, 11);

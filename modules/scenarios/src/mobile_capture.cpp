@@ -132,6 +132,9 @@ MobileCaptureConfig loadMobileCaptureConfig(const io::ConfigNode& root) {
     positive(w, "max_time", c.max_time);
     readOpt(w, "floor_size", c.floor_size);
     positive(w, "floor_size", c.floor_size);
+    readOpt(w, "blackout_start", c.blackout_start);
+    readOpt(w, "blackout_duration", c.blackout_duration);
+    if (c.blackout_duration < 0.0) w.fail("blackout_duration", "a duration >= 0 s");
   }
   if (root.has("timing")) {
     const auto t = root.child("timing");
@@ -576,6 +579,9 @@ MobileCaptureRun runMobileCapture(const MobileCaptureConfig& cfg, std::uint64_t 
         const Vector2d p = filter.positionAt(t);
         predicted_px = camera.project(Vector3d(p.x(), p.y(), plane_z));
       }
+      const bool blackout = cfg.blackout_start >= 0.0 && t >= cfg.blackout_start &&
+                            t < cfg.blackout_start + cfg.blackout_duration;
+      if (blackout) image.setTo(cv::Scalar(0, 0, 0));
       const auto det = detector.detect(image, t, predicted_px);
       bool detected = false, fused = false;
       Vector2d pixel = Vector2d::Zero();

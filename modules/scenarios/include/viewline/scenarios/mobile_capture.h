@@ -70,6 +70,9 @@ struct MobileCaptureConfig {
   bool object_noise = true;             ///< ξv, ξω on (else the nominal profile)
   double max_time = 90.0;               ///< s; a run without capture by then is a failure
   double floor_size = 30.0;             ///< m (textured floor square centred at the origin)
+  /// Camera blackout (lens covered: frames give no detection) on [start, start + duration), s;
+  /// start < 0: none. Exercises losing the target and finding it again.
+  double blackout_start = -1.0, blackout_duration = 0.0;
 
   // Timing.
   double vision_period = 0.1;           ///< s ([K]); also the profile step and the planner's T
