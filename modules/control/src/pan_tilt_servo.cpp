@@ -11,6 +11,7 @@
 #include "viewline/core/frames.h"
 #include "viewline/core/statistics.h"
 #include "viewline/estimation/kalman_filter.h"
+#include "viewline/estimation/models/coordinated_turn.h"
 
 namespace viewline::control {
 
@@ -64,11 +65,13 @@ Eigen::Matrix2d VispPointServo::jacobianPinv() const {
 // ---------------------------------------------------------------------------------------------
 
 TargetModel targetModelFromString(const std::string& name) {
-  if (name == "constant_velocity") return TargetModel::ConstantVelocity;
-  if (name == "constant_acceleration") return TargetModel::ConstantAcceleration;
+  if (name == "constant_velocity" || name == "cv") return TargetModel::ConstantVelocity;
+  if (name == "constant_acceleration" || name == "ca") return TargetModel::ConstantAcceleration;
   if (name == "singer") return TargetModel::Singer;
-  throw core::InvalidInput("target model: expected constant_velocity, constant_acceleration or singer, got '" +
-                           name + "'");
+  if (name == "coordinated_turn" || name == "ct") return TargetModel::CoordinatedTurn;
+  if (name == "imm") return TargetModel::Imm;
+  throw core::InvalidInput("target model: expected constant_velocity (cv), constant_acceleration (ca), singer, "
+                           "coordinated_turn (ct) or imm, got '" + name + "'");
 }
 
 const char* toString(TargetModel model) {
@@ -76,6 +79,8 @@ const char* toString(TargetModel model) {
     case TargetModel::ConstantVelocity: return "constant_velocity";
     case TargetModel::ConstantAcceleration: return "constant_acceleration";
     case TargetModel::Singer: return "singer";
+    case TargetModel::CoordinatedTurn: return "coordinated_turn";
+    case TargetModel::Imm: return "imm";
   }
   return "?";
 }
@@ -88,6 +93,42 @@ void TargetFilterConfig::validate() const {
   core::requirePositive(init_acceleration_sigma, "filter.init_acceleration_sigma");
   if (!(gate_probability > 0.0 && gate_probability < 1.0)) throw core::InvalidInput("filter.gate_probability must be in (0, 1)");
   if (reinit_after < 1) throw core::InvalidInput("filter.reinit_after must be >= 1");
+  core::requirePositive(init_omega_sigma, "filter.init_omega_sigma");
+  if (!(ct_q_accel >= 0.0) || !std::isfinite(ct_q_accel)) throw core::InvalidInput("filter.ct_q_accel must be >= 0");
+  if (!(ct_q_omega >= 0.0) || !std::isfinite(ct_q_omega)) throw core::InvalidInput("filter.ct_q_omega must be >= 0");
+  if (!(maneuver_q >= 0.0) || !std::isfinite(maneuver_q)) throw core::InvalidInput("filter.maneuver_q must be >= 0");
+  for (int i = 0; i < 3; ++i) core::requirePositive(imm_sojourn(i), "filter.imm_sojourn");
+}
+
+namespace {
+// CV on (p, v) with the turn rate carried along as a random walk (state (p, v, ω)).
+estimation::NonlinearTransition cvWithOmega(double q, double q_omega, double dt) {
+  Eigen::MatrixXd Phi = Eigen::MatrixXd::Identity(5, 5);
+  Phi(0, 2) = Phi(1, 3) = dt;
+  estimation::models::CoordinatedTurnParams p;
+  p.q_accel = q;
+  p.q_omega = q_omega;
+  estimation::NonlinearTransition tr;
+  tr.f = [Phi](const Eigen::VectorXd& x) { return Eigen::VectorXd(Phi * x); };
+  tr.F = [Phi](const Eigen::VectorXd&) { return Phi; };
+  tr.Q = estimation::models::coordinatedTurnNoise(p, dt);  // same blocks: CV on (p, v), q_ω dt on ω
+  tr.dt = dt;
+  return tr;
+}
+}  // namespace
+
+int PlanarTargetFilter::stateDim() const {
+  switch (config_.model) {
+    case TargetModel::ConstantVelocity: return 4;
+    case TargetModel::CoordinatedTurn:
+    case TargetModel::Imm: return 5;
+    default: return 6;
+  }
+}
+
+Eigen::VectorXd PlanarTargetFilter::modeProbabilities() const {
+  if (imm_ && imm_->initialized()) return imm_->probabilities();
+  return {};
 }
 
 PlanarTargetFilter::PlanarTargetFilter(const TargetFilterConfig& config) : config_(config) {
@@ -101,7 +142,7 @@ PlanarTargetFilter::PlanarTargetFilter(const TargetFilterConfig& config) : confi
   if (n == 4) {
     model_.G.block(2, 0, 2, 2) = I;
     model_.Qc = config_.q * I;
-  } else {
+  } else if (n == 6) {
     model_.A.block(2, 4, 2, 2) = I;
     model_.G.block(4, 0, 2, 2) = I;
     if (config_.model == TargetModel::Singer) {
@@ -112,18 +153,38 @@ PlanarTargetFilter::PlanarTargetFilter(const TargetFilterConfig& config) : confi
     }
   }
   gate_ = core::chiSquareQuantile(2.0, config_.gate_probability);
+  if (usesImm()) {
+    estimation::models::CoordinatedTurnParams ct;
+    ct.q_accel = config_.ct_q_accel;
+    ct.q_omega = config_.ct_q_omega;
+    std::vector<estimation::ImmMode> modes;
+    if (config_.model == TargetModel::Imm) {
+      const TargetFilterConfig c = config_;
+      modes.push_back({"cv", [c](double dt) { return cvWithOmega(c.q, c.ct_q_omega, dt); }, c.imm_sojourn(0)});
+      modes.push_back({"ct", [ct](double dt) { return estimation::models::coordinatedTurnTransition(ct, dt); },
+                       c.imm_sojourn(1)});
+      modes.push_back({"maneuver", [c](double dt) { return cvWithOmega(c.maneuver_q, c.ct_q_omega, dt); },
+                       c.imm_sojourn(2)});
+    } else {
+      modes.push_back({"ct", [ct](double dt) { return estimation::models::coordinatedTurnTransition(ct, dt); }, 1.0});
+    }
+    imm_.emplace(std::move(modes));
+  }
 }
 
 void PlanarTargetFilter::reset(core::Timestamp t, const Eigen::Vector2d& z, const Eigen::Matrix2d& R) {
   core::requireFinite(z, "PlanarTargetFilter: z");
-  const int n = stateDim();
+  const int n = std::max(stateDim(), 4);  // (the max tells gcc n > 2: no false null-dereference warning)
   Eigen::VectorXd x = Eigen::VectorXd::Zero(n);
-  x.head<2>() = z;
+  x(0) = z(0);
+  x(1) = z(1);
   Eigen::MatrixXd P = Eigen::MatrixXd::Zero(n, n);
   P.block(0, 0, 2, 2) = R;
   P.block(2, 2, 2, 2) = std::pow(config_.init_velocity_sigma, 2) * Eigen::Matrix2d::Identity();
   if (n == 6) P.block(4, 4, 2, 2) = std::pow(config_.init_acceleration_sigma, 2) * Eigen::Matrix2d::Identity();
+  if (n == 5) P(4, 4) = std::pow(config_.init_omega_sigma, 2);
   state_ = estimation::StateEstimate(x, P, t);
+  if (imm_) imm_->reset(x, P, t);
   initialized_ = true;
   rejected_in_a_row_ = 0;
 }
@@ -137,12 +198,29 @@ PlanarTargetFilter::Update PlanarTargetFilter::update(core::Timestamp t, const E
     return out;
   }
   const double dt = t - state_.t();
-  if (dt > 1e-9) estimation::predict(state_, estimation::discretize(model_, dt));
   estimation::LinearMeasurement m;
   m.C = Eigen::MatrixXd::Zero(2, stateDim());
   m.C.block(0, 0, 2, 2) = Eigen::Matrix2d::Identity();
   m.y = z;
   m.R = R;
+  if (imm_) {
+    if (dt > 1e-9) imm_->predict(t);
+    state_ = imm_->combined();
+    out.nis = imm_->combinedNis(m);
+    if (out.nis > gate_) {
+      if (++rejected_in_a_row_ >= config_.reinit_after) {
+        reset(t, z, R);
+        out.accepted = out.reinitialized = true;
+      }
+      return out;
+    }
+    rejected_in_a_row_ = 0;
+    imm_->update(m);
+    state_ = imm_->combined();
+    out.accepted = true;
+    return out;
+  }
+  if (dt > 1e-9) estimation::predict(state_, estimation::discretize(model_, dt));
   const Eigen::MatrixXd S = estimation::innovationCovariance(state_, m.C, m.R);
   const Eigen::Vector2d d = z - state_.x().head<2>();
   out.nis = d.dot(S.ldlt().solve(d));
@@ -165,6 +243,16 @@ PlanarTargetFilter::Kinematics PlanarTargetFilter::at(core::Timestamp t) const {
   const double dt = t - state_.t();
   Eigen::VectorXd x = state_.x();
   Eigen::MatrixXd P = state_.P();
+  if (imm_) {
+    estimation::Imm ahead = *imm_;
+    if (dt > 1e-9) ahead.predict(t);
+    const estimation::StateEstimate s = ahead.combined();
+    k.p = s.x().head<2>();
+    k.v = s.x().segment<2>(2);
+    k.a = s.x()(4) * Eigen::Vector2d(-k.v.y(), k.v.x());  // ω J v
+    k.P_pos = s.P().block(0, 0, 2, 2);
+    return k;
+  }
   if (dt > 1e-9) {
     const estimation::LinearTransition tr = estimation::discretize(model_, dt);
     x = tr.Phi * x;

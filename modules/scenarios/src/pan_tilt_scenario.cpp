@@ -123,7 +123,8 @@ PanTiltScenarioConfig loadPanTiltScenarioConfig(const io::ConfigNode& root) {
   {
     const auto f = root.child("filter");
     c.control.filter.model = control::targetModelFromString(
-        f.getChoice("model", {"constant_velocity", "constant_acceleration", "singer"}));
+        f.getChoice("model", {"constant_velocity", "cv", "constant_acceleration", "ca", "singer", "coordinated_turn",
+                              "ct", "imm"}));
     c.control.filter.q = f.getOr<double>("q", c.control.filter.q);
     c.control.filter.singer_tau = f.getOr<double>("singer_tau", c.control.filter.singer_tau);
     c.control.filter.singer_sigma = f.getOr<double>("singer_sigma", c.control.filter.singer_sigma);
@@ -132,6 +133,11 @@ PanTiltScenarioConfig loadPanTiltScenarioConfig(const io::ConfigNode& root) {
         f.getOr<double>("init_acceleration_sigma", c.control.filter.init_acceleration_sigma);
     c.control.filter.gate_probability = f.getOr<double>("gate_probability", c.control.filter.gate_probability);
     c.control.filter.reinit_after = f.getOr<int>("reinit_after", c.control.filter.reinit_after);
+    c.control.filter.init_omega_sigma = f.getOr<double>("init_omega_sigma", c.control.filter.init_omega_sigma);
+    c.control.filter.ct_q_accel = f.getOr<double>("ct_q_accel", c.control.filter.ct_q_accel);
+    c.control.filter.ct_q_omega = f.getOr<double>("ct_q_omega", c.control.filter.ct_q_omega);
+    c.control.filter.maneuver_q = f.getOr<double>("maneuver_q", c.control.filter.maneuver_q);
+    c.control.filter.imm_sojourn = f.getOr<Eigen::Vector3d>("imm_sojourn", c.control.filter.imm_sojourn);
   }
   {
     const auto r = root.child("run");

@@ -47,6 +47,7 @@
 
 #include <Eigen/Geometry>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 #include <visp3/core/vpMatrix.h>
@@ -54,6 +55,7 @@
 
 #include "viewline/core/time.h"
 #include "viewline/estimation/discretization.h"
+#include "viewline/estimation/imm.h"
 #include "viewline/estimation/state.h"
 #include "viewline/robots/pan_tilt_kinematics.h"
 #include "viewline/robots/pan_tilt_unit.h"
@@ -91,8 +93,9 @@ private:
 // ---------------------------------------------------------------------------------------------
 // The planar target filter.
 
-enum class TargetModel { ConstantVelocity, ConstantAcceleration, Singer };
-TargetModel targetModelFromString(const std::string& name);  ///< "constant_velocity", "constant_acceleration", "singer"
+enum class TargetModel { ConstantVelocity, ConstantAcceleration, Singer, CoordinatedTurn, Imm };
+/// "constant_velocity" | "cv", "constant_acceleration" | "ca", "singer", "coordinated_turn" | "ct", "imm"
+TargetModel targetModelFromString(const std::string& name);
 const char* toString(TargetModel model);
 
 struct TargetFilterConfig {
@@ -102,6 +105,11 @@ struct TargetFilterConfig {
   double singer_sigma = 0.2;       ///< Singer acceleration std (m/s²)
   double init_velocity_sigma = 0.5;      ///< prior std of the velocity at (re)initialisation (m/s)
   double init_acceleration_sigma = 0.5;  ///< prior std of the acceleration (m/s²), CA/Singer
+  double init_omega_sigma = 1.0;         ///< prior std of the turn rate (rad/s), CT/IMM
+  double ct_q_accel = 1e-4;              ///< CT (and the IMM's CT mode): acceleration density (m²/s³)
+  double ct_q_omega = 1e-3;              ///< CT/IMM: turn-rate random-walk density (rad²/s³)
+  double maneuver_q = 0.5;               ///< IMM manoeuvre mode: CV acceleration density (m²/s³)
+  Eigen::Vector3d imm_sojourn{5.0, 5.0, 0.2};  ///< IMM mean sojourn times (s) of the cv, ct, manoeuvre modes
   double gate_probability = 0.9999;      ///< chi-square (2 dof) gate on the NIS
   int reinit_after = 3;                  ///< consecutive gated-out measurements that re-initialise
   void validate() const;
@@ -113,6 +121,11 @@ struct TargetFilterConfig {
 ///   CV:     ṗ = v, v̇ = w,                 w ~ q I₂
 ///   CA:     ṗ = v, v̇ = a, ȧ = w,          w ~ q I₂
 ///   Singer: ṗ = v, v̇ = a, ȧ = −a/τ + w,   w ~ (2 σm² / τ) I₂
+///   CT:     state (p, v, ω), coordinated turn (estimation/models/coordinated_turn.h), EKF
+///   IMM:    state (p, v, ω), three modes (estimation/imm.h): "cv" = CV with density q (ω kept,
+///           random walk ct_q_omega), "ct" = CT (ct_q_accel, ct_q_omega), "maneuver" = CV with
+///           density maneuver_q; mean sojourn times imm_sojourn, jumps uniform to the other modes.
+///           (CT alone is the one-mode IMM, i.e. a plain EKF.)
 /// Measurement: the position, y = [I 0] x + e, cov e = R.
 class PlanarTargetFilter {
 public:
@@ -137,10 +150,14 @@ public:
   Kinematics at(core::Timestamp t) const;
   const estimation::StateEstimate& state() const { return state_; }
   const TargetFilterConfig& config() const { return config_; }
-  int stateDim() const { return config_.model == TargetModel::ConstantVelocity ? 4 : 6; }
+  int stateDim() const;
+  /// IMM mode probabilities (cv, ct, maneuver); empty for the other models.
+  Eigen::VectorXd modeProbabilities() const;
 
 private:
+  bool usesImm() const { return config_.model == TargetModel::CoordinatedTurn || config_.model == TargetModel::Imm; }
   TargetFilterConfig config_;
+  std::optional<estimation::Imm> imm_;
   estimation::ContinuousLinearModel model_;
   estimation::StateEstimate state_;
   bool initialized_ = false;
