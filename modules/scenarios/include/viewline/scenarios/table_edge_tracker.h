@@ -1,0 +1,54 @@
+#pragma once
+// Frame-to-frame tracking of the table's four sides and of the ball between full detections
+// (the observer's fast path; [M]'s full pipeline, vision::TableDetector, acquires the table and
+// takes over whenever tracking fails).
+//
+// Sides: from the previous frame's corners P0..P3 (pixels), `samples_per_side` points are
+// spread over the middle 70 % of each side; at each, the red feature f = R − max(G, B) of the
+// raw image is sampled bilinearly along the outward normal over ±search_px (0.25 px steps) and
+// the edge is the crossing of the level half-way between the inside and outside plateaus
+// (needs contrast >= min_contrast). A total-least-squares line is fitted to each side's edge
+// points, refitted without the points farther than 1 px (the ball, clutter); adjacent lines
+// intersect in the new corners. Fails (nullopt) when a side keeps fewer than min_points points
+// or a corner moved more than search_px.
+// Ball: [M]'s ball steps (blur, HLS, green threshold, opening, largest contour) in a window
+// around the previous circle; the circle is the least-squares ellipse's centre and semi-major
+// axis (cv::fitEllipse) when the contour has enough points, else cv::minEnclosingCircle.
+
+#include <Eigen/Core>
+#include <array>
+#include <opencv2/core.hpp>
+#include <optional>
+#include <vector>
+
+#include "viewline/vision/table_detector.h"
+
+namespace viewline::scenarios {
+
+struct TableEdgeTrackerConfig {
+  int samples_per_side = 14;
+  double search_px = 5.0;
+  double min_contrast = 40.0;  ///< grey levels of R − max(G, B)
+  int min_points = 7;
+  double ball_window_factor = 2.2;  ///< window half size = factor · radius + motion margin
+  double ball_margin_px = 6.0;
+};
+
+class TableEdgeTracker {
+public:
+  TableEdgeTracker(const vision::TableDetectorConfig& detector, const TableEdgeTrackerConfig& config = {});
+
+  /// New corners (order P0..P3 kept) from the previous ones, or nullopt.
+  std::optional<std::array<Eigen::Vector2d, 4>> trackCorners(const cv::Mat& bgr,
+                                                             const std::array<Eigen::Vector2d, 4>& previous) const;
+  /// The ball circle in a window around the previous one, or nullopt.
+  std::optional<vision::Circle> trackBall(const cv::Mat& bgr, const vision::Circle& previous);
+
+private:
+  vision::TableDetectorConfig detector_;
+  TableEdgeTrackerConfig config_;
+  cv::Mat kernel_, blurred_, hls_, mask_;
+  std::vector<std::vector<cv::Point>> contours_;
+};
+
+}  // namespace viewline::scenarios

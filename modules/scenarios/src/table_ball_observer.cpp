@@ -1,0 +1,241 @@
+#include "viewline/scenarios/table_ball_observer.h"
+
+#include <chrono>
+#include <cmath>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core/eigen.hpp>
+
+#include "viewline/core/checks.h"
+#include "viewline/core/error.h"
+#include "viewline/core/frames.h"
+#include "viewline/estimation/kalman_filter.h"
+
+namespace viewline::scenarios {
+
+Eigen::Vector2d tiltFromTableRotation(const Eigen::Matrix3d& w_R_t) {
+  // Rx(a) Ry(b) = [[cb, 0, sb], [sa sb, ca, -sa cb], [-ca sb, sa, ca cb]].
+  return {std::atan2(w_R_t(2, 1), w_R_t(1, 1)), std::atan2(w_R_t(0, 2), w_R_t(0, 0))};
+}
+
+Eigen::Isometry3d borderAwareTablePose(const core::Camera& camera, const std::array<Eigen::Vector2d, 4>& corners,
+                                       const Eigen::Isometry3d& c_M_t, double side, double border_height,
+                                       int iterations) {
+  if (!(border_height > 0.0)) return c_M_t;
+  std::vector<cv::Point2d> image;
+  for (const auto& c : corners) {
+    const Eigen::Vector2d n = camera.pixelToNormalized(c);
+    image.emplace_back(n.x(), n.y());
+  }
+  const cv::Matx33d K = cv::Matx33d::eye();
+  Eigen::Isometry3d pose = c_M_t;
+  const double h = 0.5 * side;
+  for (int it = 0; it < iterations; ++it) {
+    const Eigen::Vector3d cam_t = -(pose.linear().transpose() * pose.translation());  // t' = -Rᵀ t
+    if (!(cam_t.z() > 2.0 * border_height)) break;                                     // too flat a view
+    auto shift = [&](double coord) { return border_height * std::max(0.0, coord - h) / (cam_t.z() - border_height); };
+    const double dxp = shift(cam_t.x()), dxm = shift(-cam_t.x()), dyp = shift(cam_t.y()), dym = shift(-cam_t.y());
+    // P0 = (-,-), P1 = (+,-), P2 = (+,+), P3 = (-,+).
+    const std::vector<cv::Point3d> object = {{-h + dxm, -h + dym, 0.0}, {h - dxp, -h + dym, 0.0},
+                                             {h - dxp, h - dyp, 0.0}, {-h + dxm, h - dyp, 0.0}};
+    cv::Mat R, rvec, tvec;
+    Eigen::Matrix3d Re = pose.linear();
+    cv::eigen2cv(Re, R);
+    cv::Rodrigues(R, rvec);
+    tvec = (cv::Mat_<double>(3, 1) << pose.translation().x(), pose.translation().y(), pose.translation().z());
+    if (!cv::solvePnP(object, image, K, cv::noArray(), rvec, tvec, true, cv::SOLVEPNP_ITERATIVE)) break;
+    cv::Rodrigues(rvec, R);
+    cv::cv2eigen(R, Re);
+    Eigen::Isometry3d next = Eigen::Isometry3d::Identity();
+    next.linear() = Re;
+    next.translation() = Eigen::Vector3d(tvec.at<double>(0), tvec.at<double>(1), tvec.at<double>(2));
+    if (!next.matrix().allFinite() || next.translation().z() <= 0.0) break;
+    pose = next;
+  }
+  return pose;
+}
+
+// -------------------------------------------------------------------------------------------
+
+RollingBallTracker::RollingBallTracker(const RollingBallTrackerConfig& config) : config_(config) {
+  config_.model.validate();
+  core::requirePositive(config_.nominal_period, "RollingBallTrackerConfig.nominal_period");
+  core::requirePositive(config_.initial_velocity_std, "RollingBallTrackerConfig.initial_velocity_std");
+  if (config_.stationary_gain) stationary_ = config_.model.stationaryFilter(config_.nominal_period);
+}
+
+Eigen::MatrixXd RollingBallTracker::P() const {
+  if (stationary_) return stationary_->Pf;
+  return initialized_ ? state_.P() : Eigen::MatrixXd::Zero(6, 6);
+}
+
+void RollingBallTracker::step(double t, const Eigen::Vector2d& a_xy, const std::optional<Eigen::Vector2d>& y) {
+  core::requireFinite(t, "RollingBallTracker::step: t");
+  core::requireFinite(a_xy, "RollingBallTracker::step: a_xy");
+  const auto& model = config_.model;
+  if (!initialized_) {
+    if (!y) return;
+    core::requireFinite(*y, "RollingBallTracker::step: measurement");
+    x_ = Eigen::VectorXd::Zero(6);
+    x_[0] = (*y)[0];
+    x_[2] = (*y)[1];
+    model.clamp(x_);
+    const double sv = model.sigma_v, sp = config_.initial_velocity_std;
+    const double sw = std::max(model.sigma_w, 1e-3);
+    Eigen::VectorXd d(6);
+    d << sv * sv, sp * sp, sv * sv, sp * sp, sw * sw, sw * sw;
+    state_ = estimation::StateEstimate(x_, d.asDiagonal(), t);
+    t_ = t;
+    initialized_ = true;
+    missed_ = 0;
+    predictions_ = model.predictPositions(x_, last_dt_, a_xy);
+    return;
+  }
+  if (!(t > t_)) throw core::InvalidInput("RollingBallTracker::step: time must increase");
+  const double dt = t - t_;
+  const estimation::LinearTransition tr = model.transition(dt, a_xy);  // rediscretised every frame
+  if (stationary_) {
+    if (y) {
+      x_ = model.stationaryStep(*stationary_, tr, x_, *y);
+    } else {
+      x_ = tr.Phi * x_ + tr.Gamma * tr.u;
+      model.clamp(x_);
+    }
+  } else {
+    estimation::predict(state_, tr);
+    model.clampEstimate(state_);
+    if (y) {
+      const estimation::UpdateReport rep = estimation::update(state_, model.measurement(*y));
+      nis_ = rep.nis;
+      model.clampEstimate(state_);
+    }
+    x_ = state_.x();
+  }
+  missed_ = y ? 0 : missed_ + 1;
+  t_ = t;
+  last_dt_ = dt;
+  predictions_ = model.predictPositions(x_, dt, a_xy);
+}
+
+// -------------------------------------------------------------------------------------------
+
+TableBallObserver::TableBallObserver(const core::Camera& camera, const TableBallObserverConfig& config)
+    : camera_(camera), config_(config), detector_(camera, config.detector), tracker_(config.tracker),
+      edges_(config.detector, config.edge_tracker) {
+  core::requireFinite(config.gravity_w, "TableBallObserverConfig.gravity_w");
+  if (config_.table_pose == TablePoseSource::AprilTag) {
+    if (config_.tag_layout.empty()) throw core::InvalidInput("TableBallObserverConfig.tag_layout: empty for AprilTag table pose");
+    tags_ = std::make_unique<vision::AprilTagTableDetector>(camera, config_.tag_layout, config_.tag_detector);
+  }
+}
+
+TableBallObserver::~TableBallObserver() = default;
+
+void TableBallObserver::filterStep(double t, const std::optional<Eigen::Vector2d>& y) {
+  tracker_.step(t, frame_.a_xy, y);
+  frame_.estimate_valid = tracker_.initialized();
+  if (frame_.estimate_valid) {
+    frame_.x = tracker_.x();
+    frame_.predictions = tracker_.predictions();
+  }
+}
+
+const ObserverFrame& TableBallObserver::process(const cv::Mat& bgr, double t, const Eigen::Matrix3d& c_R_w,
+                                                const Eigen::Isometry3d& c_M_t_nominal) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const auto& model = config_.tracker.model;
+  frame_.t = t;
+  frame_.image = true;
+  frame_.failure.clear();
+  frame_.ball_circle.reset();
+  frame_.measured.setConstant(std::numeric_limits<double>::quiet_NaN());
+
+  std::optional<Eigen::Isometry3d> pose;
+  std::optional<vision::Circle> circle;
+  frame_.tracked = false;
+  if (config_.edge_tracking && config_.table_pose == TablePoseSource::Corners && frame_.table_found &&
+      frame_.ball_circle_prev) {
+    const auto corners = edges_.trackCorners(bgr, frame_.corners);
+    const auto ball = corners ? edges_.trackBall(bgr, *frame_.ball_circle_prev) : std::nullopt;
+    if (corners && ball) {
+      const Eigen::Isometry3d p = borderAwareTablePose(camera_, *corners, c_M_t_, model.table_side,
+                                                       std::max(config_.border_height, 1e-9), 1);
+      if (core::rotationAngle(p.linear(), c_M_t_.linear()) < 0.2) {
+        pose = p;
+        circle = ball;
+        frame_.corners = *corners;
+        frame_.tracked = true;
+      }
+    }
+  }
+  if (!frame_.tracked) {
+    detector_.setPrior(c_M_t_nominal);  // quarter turns from the arm's kinematics
+    const vision::TableScene scene = detector_.detect(bgr, t);
+    circle = scene.ball_circle;
+    if (config_.table_pose == TablePoseSource::Corners) {
+      if (scene.table) {
+        frame_.corners = scene.table->corners;
+        pose = borderAwareTablePose(camera_, frame_.corners, scene.table->c_M_t, model.table_side, config_.border_height);
+      } else {
+        frame_.failure = std::string("table: ") + vision::toString(scene.table.failure().reason) + " " +
+                         scene.table.failure().message;
+      }
+    } else {
+      const auto tag_table = tags_->detect(bgr, t);
+      if (tag_table) {
+        pose = tag_table->c_M_t;
+        frame_.corners = tag_table->corners;
+      } else {
+        frame_.failure = std::string("tags: ") + vision::toString(tag_table.failure().reason) + " " +
+                         tag_table.failure().message;
+      }
+    }
+  }
+  frame_.table_found = pose.has_value();
+  if (pose) {
+    c_M_t_ = *pose;
+    have_table_ = true;
+  }
+  frame_.c_M_t = c_M_t_;
+  if (have_table_) {
+    const Eigen::Matrix3d t_R_w = estimation::tableRotationInWorld(c_M_t_.linear(), c_R_w);
+    frame_.a_xy = estimation::rollingBallAcceleration(t_R_w, config_.gravity_w);
+    frame_.measured_tilt = tiltFromTableRotation(t_R_w.transpose());
+  }
+
+  std::optional<Eigen::Vector2d> y;
+  frame_.ball_circle = circle;
+  if (have_table_ && circle) {
+    if (config_.ball_geometry == BallGeometry::KnownRadius) {
+      y = vision::ballOnTableKnownRadius(camera_, *circle, c_M_t_, model.ball_radius).p_t.head<2>();
+    } else if (const auto g = vision::ballOnTableUnknownRadius(camera_, *circle, c_M_t_)) {
+      y = g->p_t.head<2>();
+    }
+    // A ball "found" far outside the table is a detection error, not a measurement.
+    if (y && (!y->allFinite() || y->cwiseAbs().maxCoeff() > 0.5 * model.table_side + model.ball_radius)) y.reset();
+  } else if (!circle && frame_.failure.empty()) {
+    frame_.failure = "ball: not found";
+  }
+  frame_.ball_found = y.has_value();
+  frame_.ball_circle_prev = y ? circle : std::nullopt;
+  if (y) frame_.measured = *y;
+  filterStep(t, y);
+  frame_.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return frame_;
+}
+
+const ObserverFrame& TableBallObserver::predictOnly(double t) {
+  const auto t0 = std::chrono::steady_clock::now();
+  frame_.t = t;
+  frame_.image = false;
+  frame_.table_found = false;
+  frame_.ball_found = false;
+  frame_.failure = "no image";
+  frame_.ball_circle.reset();
+  frame_.ball_circle_prev.reset();
+  frame_.measured.setConstant(std::numeric_limits<double>::quiet_NaN());
+  if (tracker_.initialized()) filterStep(t, std::nullopt);
+  frame_.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return frame_;
+}
+
+}  // namespace viewline::scenarios

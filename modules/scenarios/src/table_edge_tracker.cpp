@@ -1,0 +1,204 @@
+#include "viewline/scenarios/table_edge_tracker.h"
+
+#include <algorithm>
+#include <cmath>
+#include <opencv2/imgproc.hpp>
+
+#include "viewline/vision/color.h"
+
+namespace viewline::scenarios {
+
+namespace {
+
+/// R − max(G, B) of the BGR image at (u, v), bilinear; NaN outside.
+double redFeature(const cv::Mat& bgr, double u, double v) {
+  if (!(u >= 0.0 && v >= 0.0 && u < bgr.cols - 1.0 && v < bgr.rows - 1.0)) return std::nan("");
+  const int x = static_cast<int>(u), y = static_cast<int>(v);
+  const double fx = u - x, fy = v - y;
+  const cv::Vec3b* r0 = bgr.ptr<cv::Vec3b>(y) + x;
+  const cv::Vec3b* r1 = bgr.ptr<cv::Vec3b>(y + 1) + x;
+  double f[3];
+  for (int k = 0; k < 3; ++k) {
+    f[k] = (1 - fy) * ((1 - fx) * r0[0][k] + fx * r0[1][k]) + fy * ((1 - fx) * r1[0][k] + fx * r1[1][k]);
+  }
+  return f[2] - std::max(f[0], f[1]);
+}
+
+bool fitLine(std::vector<Eigen::Vector2d>& pts, Eigen::Vector2d& c, Eigen::Vector2d& d, int min_points) {
+  for (int pass = 0; pass < 2; ++pass) {
+    if (static_cast<int>(pts.size()) < min_points) return false;
+    c.setZero();
+    for (const auto& p : pts) c += p;
+    c /= static_cast<double>(pts.size());
+    Eigen::Matrix2d S = Eigen::Matrix2d::Zero();
+    for (const auto& p : pts) S += (p - c) * (p - c).transpose();
+    // Principal direction of the 2x2 scatter (closed form).
+    const double a = S(0, 0), b = S(0, 1), e = S(1, 1);
+    const double ang = 0.5 * std::atan2(2.0 * b, a - e);
+    d = Eigen::Vector2d(std::cos(ang), std::sin(ang));
+    if (pass == 0) {
+      const Eigen::Vector2d n(-d.y(), d.x());
+      pts.erase(std::remove_if(pts.begin(), pts.end(), [&](const Eigen::Vector2d& p) { return std::abs(n.dot(p - c)) > 1.0; }),
+                pts.end());
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
+TableEdgeTracker::TableEdgeTracker(const vision::TableDetectorConfig& detector, const TableEdgeTrackerConfig& config)
+    : detector_(detector), config_(config) {
+  if (detector_.ball_open_kernel_px > 1) {
+    kernel_ = cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(detector_.ball_open_kernel_px, detector_.ball_open_kernel_px));
+  }
+}
+
+std::optional<std::array<Eigen::Vector2d, 4>> TableEdgeTracker::trackCorners(
+    const cv::Mat& bgr, const std::array<Eigen::Vector2d, 4>& previous) const {
+  Eigen::Vector2d centre = Eigen::Vector2d::Zero();
+  for (const auto& p : previous) centre += 0.25 * p;
+  std::array<Eigen::Vector2d, 4> line_c, line_d;
+  constexpr double kStep = 0.25;
+  const int count = static_cast<int>(2.0 * config_.search_px / kStep) + 1;
+  std::vector<double> prof(static_cast<std::size_t>(count));
+  std::vector<Eigen::Vector2d> pts;
+  for (std::size_t i = 0; i < 4; ++i) {
+    const Eigen::Vector2d a = previous[i], b = previous[(i + 1) % 4];
+    Eigen::Vector2d n(-(b - a).y(), (b - a).x());
+    n.normalize();
+    if (n.dot(0.5 * (a + b) - centre) < 0.0) n = -n;  // outward
+    pts.clear();
+    for (int k = 0; k < config_.samples_per_side; ++k) {
+      const double s = 0.15 + 0.7 * (k + 0.5) / config_.samples_per_side;
+      const Eigen::Vector2d p0 = a + s * (b - a);
+      bool ok = true;
+      for (int j = 0; j < count && ok; ++j) {
+        const Eigen::Vector2d p = p0 + (-config_.search_px + j * kStep) * n;
+        prof[static_cast<std::size_t>(j)] = redFeature(bgr, p.x(), p.y());
+        ok = !std::isnan(prof[static_cast<std::size_t>(j)]);
+      }
+      if (!ok) continue;
+      const double in = 0.5 * (prof[0] + prof[1]), out = 0.5 * (prof[static_cast<std::size_t>(count - 1)] + prof[static_cast<std::size_t>(count - 2)]);
+      if (in - out < config_.min_contrast) continue;
+      const double level = 0.5 * (in + out);
+      for (int j = 0; j + 1 < count; ++j) {
+        const double f0 = prof[static_cast<std::size_t>(j)], f1 = prof[static_cast<std::size_t>(j + 1)];
+        if (f0 >= level && f1 < level) {
+          const double sj = -config_.search_px + kStep * (j + (f0 - level) / (f0 - f1));
+          pts.push_back(p0 + sj * n);
+          break;
+        }
+      }
+    }
+    if (!fitLine(pts, line_c[i], line_d[i], config_.min_points)) return std::nullopt;
+  }
+  std::array<Eigen::Vector2d, 4> out;
+  for (std::size_t i = 0; i < 4; ++i) {
+    // Corner i is the meeting point of side i-1 (P_{i-1} P_i) and side i (P_i P_{i+1}).
+    const std::size_t j = (i + 3) % 4;
+    Eigen::Matrix2d A;
+    A.col(0) = line_d[j];
+    A.col(1) = -line_d[i];
+    if (std::abs(A.determinant()) < 1e-6) return std::nullopt;
+    const Eigen::Vector2d t = A.partialPivLu().solve(line_c[i] - line_c[j]);
+    out[i] = line_c[j] + t(0) * line_d[j];
+    if ((out[i] - previous[i]).norm() > config_.search_px) return std::nullopt;
+  }
+  return out;
+}
+
+std::optional<vision::Circle> TableEdgeTracker::trackBall(const cv::Mat& bgr, const vision::Circle& previous) {
+  const double half = config_.ball_window_factor * previous.radius + config_.ball_margin_px;
+  const cv::Rect roi = vision::squareRoi(previous.center.x(), previous.center.y(), half, bgr.size());
+  if (roi.width < 8 || roi.height < 8) return std::nullopt;
+  const int k = detector_.blur_ksize;
+  if (k > 1) {
+    cv::GaussianBlur(bgr(roi), blurred_, cv::Size(k, k), 0.0);
+  } else {
+    bgr(roi).copyTo(blurred_);
+  }
+  cv::cvtColor(blurred_, hls_, cv::COLOR_BGR2HLS);
+  vision::thresholdColor(hls_, detector_.green_hls, mask_);
+  if (!kernel_.empty()) cv::morphologyEx(mask_, mask_, cv::MORPH_OPEN, kernel_);
+  cv::findContours(mask_, contours_, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_NONE, roi.tl());
+  double best = 0.0;
+  const std::vector<cv::Point>* ball = nullptr;
+  for (const auto& c : contours_) {
+    const double a = cv::contourArea(c);
+    if (a > best) {
+      best = a;
+      ball = &c;
+    }
+  }
+  if (ball == nullptr || best < detector_.min_ball_area_px) return std::nullopt;
+  const cv::Rect box = cv::boundingRect(*ball);
+  if (vision::touchesBorder(box, roi)) return std::nullopt;  // cut by the window: let the full detector look
+  // Coarse circle, then the outline at sub-pixel precision: along 32 rays from the centre, the
+  // crossing of the green feature G − max(R, B) half-way between inside and outside; the circle
+  // is the least-squares ellipse's centre and semi-major axis of those points.
+  cv::Point2f centre;
+  float r = 0.0F;
+  cv::minEnclosingCircle(*ball, centre, r);
+  vision::Circle c{Eigen::Vector2d(static_cast<double>(centre.x), static_cast<double>(centre.y)), static_cast<double>(r)};
+  std::vector<cv::Point2f> edge;
+  constexpr double kStep = 0.25;
+  const double reach = 3.0;
+  const int count = static_cast<int>(2.0 * reach / kStep) + 1;
+  std::vector<double> prof(static_cast<std::size_t>(count));
+  for (int ray = 0; ray < 32; ++ray) {
+    const double ang = 2.0 * 3.14159265358979323846 * ray / 32.0;
+    const Eigen::Vector2d dir(std::cos(ang), std::sin(ang));
+    bool ok = true;
+    for (int j = 0; j < count && ok; ++j) {
+      const Eigen::Vector2d p = c.center + (c.radius - reach + j * kStep) * dir;
+      const double u = p.x(), v = p.y();
+      if (!(u >= 0.0 && v >= 0.0 && u < bgr.cols - 1.0 && v < bgr.rows - 1.0)) {
+        ok = false;
+        break;
+      }
+      const int x = static_cast<int>(u), y = static_cast<int>(v);
+      const double fx = u - x, fy = v - y;
+      const cv::Vec3b* r0 = bgr.ptr<cv::Vec3b>(y) + x;
+      const cv::Vec3b* r1 = bgr.ptr<cv::Vec3b>(y + 1) + x;
+      double f[3];
+      for (int q = 0; q < 3; ++q) f[q] = (1 - fy) * ((1 - fx) * r0[0][q] + fx * r0[1][q]) + fy * ((1 - fx) * r1[0][q] + fx * r1[1][q]);
+      prof[static_cast<std::size_t>(j)] = f[1] - std::max(f[0], f[2]);
+    }
+    if (!ok) continue;
+    const double in = 0.5 * (prof[0] + prof[1]);
+    const double out = 0.5 * (prof[static_cast<std::size_t>(count - 1)] + prof[static_cast<std::size_t>(count - 2)]);
+    if (in - out < 0.5 * config_.min_contrast) continue;
+    // Crossing of the mid level; then once more with the levels 1.25 px either side of it (the
+    // shaded sphere darkens towards its limb, so the far inside plateau would bias the edge).
+    auto crossing = [&](double level, int from, int to, double& s_out) {
+      for (int j = std::max(from, 0); j + 1 < count && j < to; ++j) {
+        const double f0 = prof[static_cast<std::size_t>(j)], f1 = prof[static_cast<std::size_t>(j + 1)];
+        if (f0 >= level && f1 < level) {
+          s_out = kStep * (j + (f0 - level) / (f0 - f1));
+          return true;
+        }
+      }
+      return false;
+    };
+    double s_edge = 0.0;
+    if (!crossing(0.5 * (in + out), 0, count, s_edge)) continue;
+    const int ie = static_cast<int>(std::lround(s_edge / kStep));
+    constexpr int kGap = 5;
+    if (ie - kGap >= 0 && ie + kGap < count) {
+      const double in2 = prof[static_cast<std::size_t>(ie - kGap)], out2 = prof[static_cast<std::size_t>(ie + kGap)];
+      double s2 = 0.0;
+      if (in2 - out2 >= 0.5 * config_.min_contrast && crossing(0.5 * (in2 + out2), ie - kGap, ie + kGap, s2)) s_edge = s2;
+    }
+    const Eigen::Vector2d p = c.center + (c.radius - reach + s_edge) * dir;
+    edge.emplace_back(static_cast<float>(p.x()), static_cast<float>(p.y()));
+  }
+  if (edge.size() >= 12) {
+    const cv::RotatedRect e = cv::fitEllipse(edge);
+    c.center = Eigen::Vector2d(static_cast<double>(e.center.x), static_cast<double>(e.center.y));
+    c.radius = 0.5 * static_cast<double>(std::max(e.size.width, e.size.height));
+  }
+  return c;
+}
+
+}  // namespace viewline::scenarios
