@@ -619,7 +619,7 @@ TableBallResult runTableBall(const TableBallConfig& cfg_in, std::uint64_t seed, 
     m.size_m = delta.norm();
     double last_out = sp.t, last_out_2d = sp.t, over = 0.0, ss_sum = 0.0;
     int ss_n = 0;
-    for (std::size_t k = idx(sp.t); k < tick_t.size() && tick_t[k] <= t_end; ++k) {
+    for (std::size_t k = idx(sp.t); k < tick_t.size() && tick_t[k] < t_end - 1e-9; ++k) {
       const Eigen::Vector2d e = tick_p[k] - sp.xy;
       over = std::max(over, e.dot(u));
       if (std::abs(e.dot(u)) > band) last_out = tick_t[k];
@@ -642,7 +642,7 @@ TableBallResult runTableBall(const TableBallConfig& cfg_in, std::uint64_t seed, 
     m.t = p.t;
     m.speed = p.dv.norm();
     double last_out = p.t;
-    for (std::size_t k = idx(p.t); k < tick_t.size() && tick_t[k] <= t_end; ++k) {
+    for (std::size_t k = idx(p.t); k < tick_t.size() && tick_t[k] < t_end - 1e-9; ++k) {
       const double e = (tick_p[k] - setpointAt(tick_t[k])).norm();
       m.peak_excursion_mm = std::max(m.peak_excursion_mm, 1000.0 * e);
       if (e > cfg.push_band) last_out = tick_t[k];
