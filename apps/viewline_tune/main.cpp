@@ -21,7 +21,11 @@ namespace {
 
 std::atomic<bool> g_stop{false};  // set by SIGINT: no new runs are started (signal handlers need a global)
 
-extern "C" void onSigint(int) { g_stop.store(true); }
+// First Ctrl-C: stop launching runs and write what is done; a second one ends the program.
+extern "C" void onSigint(int) {
+  g_stop.store(true);
+  std::signal(SIGINT, SIG_DFL);
+}
 
 tuning::AdapterOptions parseOptions(const std::vector<std::string>& kv) {
   tuning::AdapterOptions o;

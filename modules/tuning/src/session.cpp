@@ -330,7 +330,7 @@ nlohmann::json runSweepSession(const AdapterRegistry& registry, const std::strin
   so.workers = opt.workers;
   so.stop = opt.stop;
   so.results_jsonl = jsonl;
-  so.series_for_first_seed = false;
+  so.series_for_first_seed = true;  // the report's run plots come from the best setting's first run
   if (!opt.quiet) so.progress = [](const SweepProgress& p) { std::fprintf(stderr, "%s\n", formatProgress(p).c_str()); };
   const std::string load_before = loadAverage();
   SweepOutcome out = runSweep(spec, settings, instances, so);
@@ -503,10 +503,9 @@ nlohmann::json runSweepSession(const AdapterRegistry& registry, const std::strin
   sweepPlots(rep, spec, out);
   if (out.best) {
     rep.heading("Best setting, first seed: error, NIS, trajectories");
-    RunOptions ro;
-    ro.series = true;
-    const RunResult r = instances[*out.best]->run(core::deriveSeed(spec.base_seed, 0), ro);
-    if (r.series) addRunPlots(rep, *r.series, "best_run", "best setting, seed 0", spec.confidence);
+    const SettingResult& b = out.settings[*out.best];
+    if (!b.runs.empty() && b.runs.front().series)
+      addRunPlots(rep, *b.runs.front().series, "best_run", "best setting, seed 0", spec.confidence);
   }
   if (at) {
     rep.heading("Noise auto-tuning");
