@@ -51,6 +51,7 @@ void CatchPlanner::reset(double t, const Eigen::Vector3d& p, const Eigen::Vector
   first_update_.reset();
   commit_time_.reset();
   give_up_time_.reset();
+  first_move_.reset();
   updates_ = 0;
   replans_ = 0;
 }
@@ -91,6 +92,7 @@ PlannerUpdate CatchPlanner::update(double now, const estimation::StateEstimate& 
   if (sigma > cfg_.start_sigma || !in_workspace) return out;
   if (phase_ == CatchPhase::Idle) phase_ = CatchPhase::Tracking;
   target_ = c;
+  if (!first_move_) first_move_ = now;
   planTo(now, c.p);
   out.replanned = true;
   return out;

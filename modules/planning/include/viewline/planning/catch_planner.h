@@ -77,6 +77,8 @@ public:
   std::optional<double> firstUpdateTime() const { return first_update_; }
   std::optional<double> commitTime() const { return commit_time_; }
   std::optional<double> giveUpTime() const { return give_up_time_; }
+  /// First update that moved the box towards a predicted crossing.
+  std::optional<double> firstMoveTime() const { return first_move_; }
   /// The crossing the current plan aims at (last accepted prediction).
   const std::optional<Crossing>& target() const { return target_; }
   const SyncProfile& profile() const { return profile_; }
@@ -93,7 +95,7 @@ private:
   SyncProfile profile_;
   double last_t_ = 0.0;
   std::optional<Crossing> target_;
-  std::optional<double> first_update_, commit_time_, give_up_time_;
+  std::optional<double> first_update_, commit_time_, give_up_time_, first_move_;
   int updates_ = 0, replans_ = 0;
 };
 
