@@ -32,6 +32,7 @@
 #include "viewline/control/pan_tilt_servo.h"
 #include "viewline/core/error.h"
 #include "viewline/core/random.h"
+#include "viewline/scenarios/pan_tilt_display.h"
 #include "viewline/scenarios/pan_tilt_scenario.h"
 #include "viewline/tuning/scenario.h"
 #include "viewline/tuning/yaml_edit.h"
@@ -161,8 +162,24 @@ public:
     Recorded rec;
     try {
       io::LogDirectory log(dir.string());
+      // --display: the scenario's camera view (vpDisplayX) and the live error curve during the run.
+      std::unique_ptr<scenarios::PanTiltDisplay> view;
+      if (ro.display) {
+        try {
+          view = std::make_unique<scenarios::PanTiltDisplay>();
+        } catch (const core::InvalidInput&) {
+          view.reset();  // no X display: headless
+        }
+      }
+      scenarios::PanTiltFrameSink sink;
+      if (view || ro.live) {
+        sink = [&view, &ro](const scenarios::PanTiltFrameView& v) {
+          if (view) view->show(v);
+          if (ro.live) ro.live({v.t, v.error_px, -1.0});
+        };
+      }
       const scenarios::PanTiltRunMetrics m =
-          scenarios::runPanTilt(cfg_, seed, scenarios::PanTiltControllerKind::Predictive, nullptr, &log, ro.progress);
+          scenarios::runPanTilt(cfg_, seed, scenarios::PanTiltControllerKind::Predictive, sink, &log, ro.progress);
       log.flush();
       if (metrics != nullptr) *metrics = m;
       rec.frames = readFrames((dir / "predictive_frames.csv").string());
@@ -191,7 +208,9 @@ public:
     io::CsvWriter* inn = nullptr;
     if (ro.log != nullptr && ro.log->enabled())
       inn = &ro.log->stream("innovations", {"t", "d0", "d1", "S00", "S01", "S11", "nis", "accepted", "in_statistics"});
-    replayRun(rec, cfg_.control.filter.q, 1.0, 0.0, a, series.get(), inn, ro);
+    RunOptions replay_options = ro;  // the live curve was fed during the run; the NIS follows below
+    replay_options.live = nullptr;
+    replayRun(rec, cfg_.control.filter.q, 1.0, 0.0, a, series.get(), inn, replay_options);
     r.nis = a.nis;
     r.nees = a.nees;
     r.metrics["image_error_rms_px"] = m.image_error_rms_px;
@@ -209,6 +228,14 @@ public:
   }
 
   std::vector<NoiseParameter> noiseParameters() const override {
+    // The IMM / CT filters have several process-noise densities (per mode); filter.q alone barely
+    // changes their likelihood (measured: the search drifts to q -> 0), so they are not auto-tuned.
+    if (cfg_.control.filter.model == control::TargetModel::Imm ||
+        cfg_.control.filter.model == control::TargetModel::CoordinatedTurn)
+      throw core::InvalidInput(std::string("pan-tilt auto-tuning: filter.model ") + control::toString(cfg_.control.filter.model) +
+                               " has one process noise per mode; auto-tuning supports constant_velocity, "
+                               "constant_acceleration and singer (e.g. config/sweeps/scenarios/pan_tilt_circle_ca.yaml); "
+                               "sweeps work with every model");
     return {{"process", "q", cfg_.control.filter.model == control::TargetModel::ConstantVelocity ? "m^2/s^3" : "m^2/s^5",
              "filter.q", "process noise density of the target filter", cfg_.control.filter.q},
             {"measurement", "R_scale", "x", "",

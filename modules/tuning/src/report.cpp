@@ -92,7 +92,7 @@ bool HtmlReport::plot(const std::string& name, const std::string& script, const 
   const std::string png = name + ".png";
   std::ostringstream gp;
   gp << "# " << caption << "\n# re-plot: cd " << plots.string() << " && gnuplot " << name << ".gp\n"
-     << "set terminal pngcairo size 960,480 font ',10'\nset output '" << png << "'\nset grid\nset key outside right\n"
+     << "set terminal pngcairo size 960,480 font ',10' noenhanced\nset output '" << png << "'\nset grid\nset key outside right\n"
      << script << "\n";
   dataFile(name + ".gp", gp.str());
   fs::remove(plots / png);
