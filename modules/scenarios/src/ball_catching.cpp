@@ -86,8 +86,14 @@ public:
       : room_(room), flight_(flight), cfg_(cfg), robot_(robot), R_(boxRotation(cfg.box_normal)) {}
   const sim::Scene& staticScene() const override { return room_; }
   void dynamicObjects(double t, std::vector<sim::Primitive>& out) const override {
-    if (t >= flight_.startTime() && t <= flight_.endTime())
-      out.push_back(sim::makeSphere("ball", flight_.state(t).p, cfg_.throws.body.reference_radius, cfg_.ball_albedo_bgr));
+    if (t >= flight_.startTime() && t <= flight_.endTime()) {
+      const sim::FlightState s = flight_.state(t);
+      if (cfg_.object == "dart") {
+        for (auto& prim : sim::makeDart("dart", sim::dartPose(s.p, s.v), cfg_.ball_albedo_bgr)) out.push_back(prim);
+      } else {
+        out.push_back(sim::makeSphere("ball", s.p, cfg_.throws.body.reference_radius, cfg_.ball_albedo_bgr));
+      }
+    }
     if (cfg_.render_box) {
       const Eigen::Vector3d hole = robot_.read(t).p;
       const Eigen::Vector3d& n = cfg_.box_normal;
@@ -166,6 +172,7 @@ void BallCatchingConfig::validate() const {
   if (!(throws.aim_radius >= 0.0)) throw InvalidInput("throws.aim_radius: expected >= 0");
   for (int i = 0; i < 3; ++i)
     if (!(throws.release_min(i) <= throws.release_max(i))) throw InvalidInput("throws.release_min: expected <= release_max");
+  if (object != "ball" && object != "dart") throw InvalidInput("throws.object: expected ball or dart");
   if (!(hole_radius > throws.body.reference_radius))
     throw InvalidInput("box.hole_radius: expected larger than the ball radius");
   if (!(control_period > 0.0)) throw InvalidInput("robot.control_period_s: expected > 0");
@@ -228,6 +235,7 @@ BallCatchingConfig loadBallCatchingConfig(const io::ConfigNode& root) {
     c.throws.body.drag_coefficient = t.getOr<double>("drag_coefficient", c.throws.body.drag_coefficient);
     c.throws.body.air_density = t.getOr<double>("air_density", c.throws.body.air_density);
     c.ball_albedo_bgr = t.getOr<Eigen::Vector3d>("ball_albedo_bgr", c.ball_albedo_bgr);
+    c.object = t.getChoiceOr("object", {"ball", "dart"}, c.object);
   }
   if (root.has("box")) {
     const auto b = root.child("box");
@@ -443,9 +451,9 @@ ThrowResult runThrow(const BallCatchingConfig& cfg, const sim::Scene& room, int 
     if (!frame) continue;
     ++res.frames;
     const std::size_t ci = frame->camera_index;
-    if (const sim::ObjectTruth* b = frame->find("ball"); b && b->in_front && b->in_image && res.t_first_visible < 0.0)
+    if (const sim::ObjectTruth* b = frame->find(cfg.object); b && b->in_front && b->in_image && res.t_first_visible < 0.0)
       res.t_first_visible = frame->capture_time;
-    if (log && frame->find("ball")) {
+    if (log && frame->find(cfg.object)) {
       const Eigen::Vector3d p = flight.state(frame->capture_time).p;
       log->stream("truth", {"throw", "t", "camera", "x", "y", "z"})
           .row({double(index), frame->capture_time, double(ci), p.x(), p.y(), p.z()});
@@ -641,6 +649,7 @@ nlohmann::json summaryJson(const CatchSummary& s, const BallCatchingConfig& cfg)
   auto num = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
   nlohmann::json j;
   j["scenario"] = cfg.name;
+  j["object"] = cfg.object;
   j["seed"] = s.seed;
   j["throws"] = s.throws;
   j["reachable_throws"] = s.reachable_throws;

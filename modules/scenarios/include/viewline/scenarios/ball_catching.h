@@ -99,7 +99,11 @@ struct BallCatchingConfig {
   std::size_t camera_count = 0;      ///< use the first N cameras (0: all)
   double rate_override_hz = 0.0;     ///< > 0: every camera at this rate
   ThrowDistribution throws;
-  Eigen::Vector3d ball_albedo_bgr = Eigen::Vector3d(0.08, 0.45, 0.95);  ///< orange
+  Eigen::Vector3d ball_albedo_bgr = Eigen::Vector3d(0.08, 0.45, 0.95);  ///< orange (dart: flight colour)
+  /// "ball" (a sphere of the body's radius) or "dart" (sim::makeDart oriented along its velocity;
+  /// the detector then finds the coloured flights, 5 cm behind the centre of mass, and the
+  /// tracked point is theirs: its crossing point lies on the same flight line).
+  std::string object = "ball";
   double hole_radius = 0.03;         ///< m (6 cm hole)
   Eigen::Vector3d box_normal = -Eigen::Vector3d::UnitX();  ///< box-front normal, towards the thrower
   double box_size = 0.3;             ///< m, cube side (rendered)
