@@ -135,6 +135,22 @@ void BM_Table_Ours_Refined(benchmark::State& state) {
 }
 BENCHMARK(BM_Table_Ours_Refined)->Unit(benchmark::kMicrosecond);
 
+/// The production detector with the earlier ball outline (greenness ellipse, no sphere cone).
+void BM_Table_Ours_Refined_GreennessEllipse(benchmark::State& state) {
+  const auto& frames = tableFrames();
+  vision::TableDetectorConfig cfg;
+  cfg.ball_outline = vision::TableDetectorConfig::BallOutline::GreennessEllipse;
+  vision::TableDetector det(tableCamera(), cfg);
+  std::size_t i = 0, ok = 0;
+  for (auto _ : state) {
+    const auto scene = det.detect(frames[i++ % frames.size()], 0.0);
+    ok += scene.table.ok() && scene.ball.ok();
+    benchmark::DoNotOptimize(scene);
+  }
+  state.counters["detected"] = benchmark::Counter(static_cast<double>(ok) / static_cast<double>(i));
+}
+BENCHMARK(BM_Table_Ours_Refined_GreennessEllipse)->Unit(benchmark::kMicrosecond);
+
 // ---- ball, 656x480 --------------------------------------------------------------------
 
 /// [M]'s ball steps written plainly on the full frame: blur, HLS, threshold, open, largest

@@ -26,9 +26,17 @@ int main(int argc, char** argv) {
   std::printf("detected %d/%d, wrong %d, centre RMS %.3f px (target <= 0.3)\n\n", ball.detected, ball.frames, ball.wrong,
               ball.rms());
 
-  for (const bool refine : {true, false}) {
-    const auto t = detection_scoring::scoreTable(n, seed + 1, refine);
-    std::printf("## [M]'s table scene, 320x240, %s (%d frames)\n", refine ? "production (sub-pixel, borders)" : "[M]'s steps exactly", t.rotation.frames);
+  using Outline = vision::TableDetectorConfig::BallOutline;
+  const struct {
+    bool refine;
+    Outline outline;
+    const char* name;
+  } variants[] = {{true, Outline::SphereCone, "production (sub-pixel, borders; ball: sphere cone on unmixed outline)"},
+                  {true, Outline::GreennessEllipse, "production with the earlier ball outline (greenness ellipse)"},
+                  {false, Outline::SphereCone, "[M]'s steps exactly"}};
+  for (const auto& v : variants) {
+    const auto t = detection_scoring::scoreTable(n, seed + 1, v.refine, v.outline);
+    std::printf("## [M]'s table scene, 320x240, %s (%d frames)\n", v.name, t.rotation.frames);
     std::printf("| quantity | RMS | detected |\n|---|---|---|\n");
     std::printf("| table rotation | %.3f deg | %d/%d |\n", core::rad2deg(t.rotation.rms()), t.rotation.detected, t.rotation.frames);
     std::printf("| table translation | %.2f mm | |\n", 1e3 * t.translation.rms());

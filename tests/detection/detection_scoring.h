@@ -130,7 +130,10 @@ struct TableScores {
 };
 
 /// The table tilts along a Lissajous command (±2.3°, ±2°) while the ball rolls; `n` frames at 50 Hz.
-inline TableScores scoreTable(int n, std::uint64_t seed, bool refine = true) {
+/// `refine` = false: [M]'s steps exactly; `outline`: the ball outline of the refined detector.
+inline TableScores scoreTable(int n, std::uint64_t seed, bool refine = true,
+                              vision::TableDetectorConfig::BallOutline outline =
+                                  vision::TableDetectorConfig::BallOutline::SphereCone) {
   core::Rng rng = core::makeRng(seed);
   sim::TiltTableParams params;
   params.w_M_base.translation() = Eigen::Vector3d(0.0, 0.0, 0.75);  // on a stand, above the floor
@@ -142,6 +145,7 @@ inline TableScores scoreTable(int n, std::uint64_t seed, bool refine = true) {
   const core::Camera cam = tableCamera();
   vision::TableDetectorConfig cfg;
   cfg.refine = refine;
+  cfg.ball_outline = outline;
   cfg.border_height_m = look.border_height;  // the sim's raised black borders
   vision::TableDetector det(cam, cfg);
   std::vector<vision::TagOnTable> layout;

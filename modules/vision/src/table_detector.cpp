@@ -79,23 +79,30 @@ bool edgeAlong(const cv::Mat& bgr, const Eigen::Vector2d& p0, const Eigen::Vecto
   const int count = static_cast<int>(2.0 * reach / kStep) + 1;
   double prof[64];
   if (count > 64 || count < 9) return false;
-  for (int i = 0; i < count; ++i) {
-    const Eigen::Vector2d p = p0 + (-reach + i * kStep) * n;
-    prof[i] = featureAt<kChannel>(bgr, p.x(), p.y());
-    if (std::isnan(prof[i])) return false;
-  }
+  // The segment is inside the image when both ends are (the image is convex); the samples are
+  // then taken lazily: the plateaus at both ends, the rest only as far as the search needs.
+  bool have[64] = {};
+  const auto at = [&](int i) {
+    if (!have[i]) {
+      const Eigen::Vector2d p = p0 + (-reach + i * kStep) * n;
+      prof[i] = featureAt<kChannel>(bgr, p.x(), p.y());
+      have[i] = true;
+    }
+    return prof[i];
+  };
+  if (std::isnan(at(0)) || std::isnan(at(count - 1))) return false;
   const int plateau = 4;  // 1 px
   double in = 0.0, out = 0.0;
   for (int i = 0; i < plateau; ++i) {
-    in += prof[i];
-    out += prof[count - 1 - i];
+    in += at(i);
+    out += at(count - 1 - i);
   }
   in /= plateau;
   out /= plateau;
   if (in - out < min_contrast) return false;
   const auto crossing = [&](double level, int from, int to, double& s) {
     for (int i = std::max(from, 0); i + 1 < count && i < to; ++i) {
-      if (prof[i] >= level && prof[i + 1] < level) {
+      if (at(i) >= level && at(i + 1) < level) {
         s = -reach + kStep * (i + (prof[i] - level) / (prof[i] - prof[i + 1]));
         return true;
       }
@@ -108,7 +115,7 @@ bool edgeAlong(const cv::Mat& bgr, const Eigen::Vector2d& p0, const Eigen::Vecto
   const int ie = static_cast<int>(std::lround((s_edge + reach) / kStep));
   const int gap = 5;  // 1.25 px: the anti-aliased, bilinearly sampled step spans ±1 px
   if (ie - gap >= 0 && ie + gap < count) {
-    const double in2 = prof[ie - gap], out2 = prof[ie + gap];
+    const double in2 = at(ie - gap), out2 = at(ie + gap);
     double s2 = 0.0;
     if (in2 - out2 >= min_contrast && crossing(0.5 * (in2 + out2), ie - gap, ie + gap, s2)) s_edge = s2;
   }
@@ -309,7 +316,14 @@ TableScene finishScene(const cv::Mat& bgr, const std::vector<cv::Point>* table_c
   if (ball_contour && ball_area + 0.5 * cv::arcLength(*ball_contour, true) >= cfg.min_ball_area_px) {
     ball_clipped = touchesBorder(cv::boundingRect(*ball_contour), frame);
     scene.ball_circle = ballCircle(*ball_contour);
-    if (refine && !ball_clipped && scene.ball_circle) scene.ball_circle = refineBallCircle(bgr, *scene.ball_circle);
+    if (refine && !ball_clipped && scene.ball_circle) {
+      // Sphere cone from [M]'s circle (off by up to about 1 px); the greenness ellipse when the
+      // cone is refused (partial outline: ball against the black border or occluded).
+      std::optional<Circle> cone;
+      if (cfg.ball_outline == TableDetectorConfig::BallOutline::SphereCone)
+        cone = refineBallBySphereCone(bgr, camera, *scene.ball_circle, cfg.ball_outline_params, 1.0);
+      scene.ball_circle = cone ? *cone : refineBallCircle(bgr, *scene.ball_circle);
+    }
   }
   // Table.
   if (!table_contour) {
@@ -414,6 +428,7 @@ void TableDetectorConfig::validate() const {
   if (!(border_height_m >= 0.0 && border_height_m < side_m))
     throw core::InvalidInput("TableDetectorConfig.border_height_m must be in [0, side_m)");
   core::requirePositive(ball_edge_noise_px, "TableDetectorConfig.ball_edge_noise_px");
+  ball_outline_params.validate();
 }
 
 TableDetector::TableDetector(core::Camera camera, TableDetectorConfig config)

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
@@ -15,6 +16,60 @@ namespace viewline::vision {
 namespace {
 
 Eigen::Vector2d toEigen(const cv::Point& p) { return {p.x, p.y}; }
+
+/// Gauss-Newton on the pixel reprojection error of the four corners (what
+/// cv::solvePnPRefineLM minimises, without its per-iteration projectPoints/Jacobian matrices):
+/// pose perturbed as R ← exp([δω]×) R, t ← t + δt; for X = R P + t,
+///   ∂u/∂X = [px/Z, 0, -px X/Z²; 0, py/Z, -py Y/Z²],  ∂X/∂δω = -[R P]×,  ∂X/∂δt = I.
+/// A step that does not lower the cost ends the iteration (the start is AP3P's exact fit of
+/// three corners, close to the minimum).
+Eigen::Isometry3d refinePoseOnPoints(const Eigen::Isometry3d& c_M_t, const std::array<Eigen::Vector3d, 4>& P,
+                                     const std::array<Eigen::Vector2d, 4>& uv, double px, double py, double u0,
+                                     double v0) {
+  const auto cost = [&](const Eigen::Isometry3d& M) {
+    double sq = 0.0;
+    for (std::size_t k = 0; k < 4; ++k) {
+      const Eigen::Vector3d X = M * P[k];
+      if (!(X.z() > 1e-9)) return std::numeric_limits<double>::infinity();
+      sq += Eigen::Vector2d(u0 + px * X.x() / X.z() - uv[k].x(), v0 + py * X.y() / X.z() - uv[k].y()).squaredNorm();
+    }
+    return sq;
+  };
+  Eigen::Isometry3d M = c_M_t;
+  double c0 = cost(M);
+  if (!std::isfinite(c0)) return c_M_t;
+  for (int it = 0; it < 20; ++it) {
+    Eigen::Matrix<double, 6, 6> JtJ = Eigen::Matrix<double, 6, 6>::Zero();
+    Eigen::Matrix<double, 6, 1> Jtr = Eigen::Matrix<double, 6, 1>::Zero();
+    for (std::size_t k = 0; k < 4; ++k) {
+      const Eigen::Vector3d RP = M.linear() * P[k];
+      const Eigen::Vector3d X = RP + M.translation();
+      const double iz = 1.0 / X.z();
+      Eigen::Matrix<double, 2, 3> dudX;
+      dudX << px * iz, 0.0, -px * X.x() * iz * iz, 0.0, py * iz, -py * X.y() * iz * iz;
+      Eigen::Matrix3d skew;
+      skew << 0.0, -RP.z(), RP.y(), RP.z(), 0.0, -RP.x(), -RP.y(), RP.x(), 0.0;
+      Eigen::Matrix<double, 2, 6> J;
+      J.leftCols<3>() = -dudX * skew;
+      J.rightCols<3>() = dudX;
+      const Eigen::Vector2d r(u0 + px * X.x() * iz - uv[k].x(), v0 + py * X.y() * iz - uv[k].y());
+      JtJ += J.transpose() * J;
+      Jtr += J.transpose() * r;
+    }
+    const Eigen::Matrix<double, 6, 1> step = JtJ.ldlt().solve(-Jtr);
+    if (!step.allFinite()) break;
+    Eigen::Isometry3d next = M;
+    const double a = step.head<3>().norm();
+    if (a > 0.0) next.linear() = Eigen::AngleAxisd(a, step.head<3>() / a).toRotationMatrix() * M.linear();
+    next.translation() += step.tail<3>();
+    const double c1 = cost(next);
+    if (!(c1 <= c0)) break;
+    M = next;
+    c0 = c1;
+    if (step.norm() < 1e-12) break;
+  }
+  return M;
+}
 
 }  // namespace
 
@@ -136,7 +191,6 @@ Result<TablePose> solveTablePose(const std::array<Eigen::Vector2d, 4>& ordered_c
   bool ok = false;
   try {
     ok = cv::solvePnP(object, image, K, cv::noArray(), rvec, tvec, false, cv::SOLVEPNP_AP3P);
-    if (ok && refine) cv::solvePnPRefineLM(object, image, K, cv::noArray(), rvec, tvec);
   } catch (const cv::Exception& e) {
     return Result<TablePose>::fail(FailureReason::PoseFailed, std::string("solvePnP: ") + e.what());
   }
@@ -149,20 +203,26 @@ Result<TablePose> solveTablePose(const std::array<Eigen::Vector2d, 4>& ordered_c
     for (int c = 0; c < 3; ++c) R(r, c) = Rcv(r, c);
   out.c_M_t.linear() = R;
   out.c_M_t.translation() = Eigen::Vector3d(tvec.at<double>(0), tvec.at<double>(1), tvec.at<double>(2));
+  std::array<Eigen::Vector3d, 4> P;
+  std::array<Eigen::Vector2d, 4> uv;
+  for (std::size_t k = 0; k < 4; ++k) {
+    P[k] = Eigen::Vector3d(object[k].x, object[k].y, 0.0);
+    uv[k] = Eigen::Vector2d(image[k].x, image[k].y);
+  }
+  if (refine) out.c_M_t = refinePoseOnPoints(out.c_M_t, P, uv, px, py, u0, v0);
   if (!out.c_M_t.matrix().allFinite())
     return Result<TablePose>::fail(FailureReason::PoseFailed, "non-finite pose");
   if (out.c_M_t.translation().z() <= 0.0)
     return Result<TablePose>::fail(FailureReason::PoseFailed, "table behind the camera");
-  const Eigen::Vector3d cam_in_table = -R.transpose() * out.c_M_t.translation();
+  const Eigen::Vector3d cam_in_table = -out.c_M_t.linear().transpose() * out.c_M_t.translation();
   if (cam_in_table.z() <= 0.0)
     return Result<TablePose>::fail(FailureReason::PoseFailed,
                                    "pose shows the table from below (corner order mismatch)");
   double sq = 0.0;
-  std::vector<cv::Point2d> reproj;
-  cv::projectPoints(object, rvec, tvec, K, cv::noArray(), reproj);
   for (std::size_t k = 0; k < 4; ++k) {
-    const double du = reproj[k].x - image[k].x, dv = reproj[k].y - image[k].y;
-    sq += du * du + dv * dv;
+    const Eigen::Vector3d X = out.c_M_t * P[k];
+    const Eigen::Vector2d reproj(u0 + px * X.x() / X.z(), v0 + py * X.y() / X.z());
+    sq += (reproj - uv[k]).squaredNorm();
   }
   out.reprojection_rms_px = std::sqrt(sq / 4.0);
   out.corners = ordered_corners;

@@ -32,6 +32,12 @@
 // semi-major axis, i.e. the minimum enclosing circle of the true outline).
 // With raised borders (border_height_m > 0) the pose is then refined on the
 // edge points against the visible 3D boundary (see refinePoseWithBorders).
+// The greenness mid level is biased on a shaded ball (its dark limb has a lower
+// level), which is too much for the distance d = r / sin α (0.04 px of radius
+// is 2.5 mm at 0.5 m); so with ball_outline = SphereCone (default) the ball's
+// circle is finally replaced by the fit of the sphere's viewing cone to outline
+// points found by colour unmixing, which do not depend on the shading
+// (ball_outline.h). ball_outline = GreennessEllipse keeps the ellipse above.
 //
 // referenceTableScene() is the plain speed baseline written the straightforward
 // way (as [M]'s Python): full frame at every step, fresh buffers, two inRange
@@ -44,6 +50,7 @@
 #include <vector>
 
 #include "viewline/core/camera.h"
+#include "viewline/vision/ball_outline.h"
 #include "viewline/vision/color.h"
 #include "viewline/vision/detection.h"
 #include "viewline/vision/table_geometry.h"
@@ -68,6 +75,10 @@ struct TableDetectorConfig {
   double roi_margin_fraction = 0.1;  ///< window = last table box grown by this fraction ...
   int roi_margin_px = 10;            ///< ... plus this many pixels on each side
   bool refine = true;                ///< production refinements (see above); false = [M] exactly
+  /// Ball outline with `refine`: SphereCone (production) or GreennessEllipse (the earlier one).
+  enum class BallOutline { GreennessEllipse, SphereCone };
+  BallOutline ball_outline = BallOutline::SphereCone;
+  BallOutlineParams ball_outline_params;  ///< rays, reach, background separation (ball_outline.h)
   double max_reprojection_px = 2.0;  ///< corner reprojection RMS above which the pose is refused
   double corner_sigma_px = 0.5;      ///< corner noise used for the table "pixel" covariance
   double ball_edge_noise_px = 0.5;   ///< σe of the ball circle centre: var = σe² / (π ρ)
