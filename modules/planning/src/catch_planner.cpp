@@ -32,6 +32,7 @@ void CatchPlannerConfig::validate() const {
   nonneg(give_up_late, "planner.give_up_late_s");
   nonneg(home_delay, "planner.home_delay_s");
   nonneg(min_lead, "planner.min_lead_s");
+  nonneg(target_prior_std, "planner.target_prior_std_m");
   if (!(std::isfinite(start_sigma) && start_sigma > 0.0)) throw InvalidInput("planner.start_sigma_m: expected > 0");
   if (!(std::isfinite(commit_sigma) && commit_sigma > 0.0)) throw InvalidInput("planner.commit_sigma_m: expected > 0");
   if (commit_min_updates < 1) throw InvalidInput("planner.commit_min_updates: expected >= 1");
@@ -92,8 +93,16 @@ PlannerUpdate CatchPlanner::update(double now, const estimation::StateEstimate& 
   if (sigma > cfg_.start_sigma || !in_workspace) return out;
   if (phase_ == CatchPhase::Idle) phase_ = CatchPhase::Tracking;
   target_ = c;
+  Eigen::Vector3d goal = c.p;
+  if (cfg_.target_prior_std > 0.0) {
+    const double s0 = cfg_.target_prior_std * cfg_.target_prior_std;
+    const Eigen::Matrix3d S = s0 * Eigen::Matrix3d::Identity() + c.cov_p;
+    goal = cfg_.home + s0 * S.ldlt().solve(c.p - cfg_.home);
+    goal -= cfg_.normal * cfg_.normal.dot(goal - cfg_.home);  // stay in the plane
+    if (workspace_ && !workspace_(goal)) goal = c.p;
+  }
   if (!first_move_) first_move_ = now;
-  planTo(now, c.p);
+  planTo(now, goal);
   out.replanned = true;
   return out;
 }

@@ -138,3 +138,25 @@ TEST(CatchPlanner, RejectsBadConfig) {
   c.commit_sigma = 0;
   EXPECT_THROW(CatchPlanner{c}, core::InvalidInput);
 }
+
+TEST(CatchPlanner, TargetPriorShrinksUncertainPredictionsTowardsHome) {
+  CatchPlannerConfig c = config();
+  c.target_prior_std = 0.15;
+  c.start_sigma = 10.0;
+  c.latency = 0.0;
+  const double tc = 0.6;
+  for (double sigma : {1.0, 1e-4}) {
+    CatchPlanner pl(c);
+    pl.update(0.0, estimate(0.0, flightState(0.0, tc, 0.2, 1.2), sigma, sigma));
+    ASSERT_TRUE(pl.target());
+    const Eigen::Vector3d goal = pl.profile().goal();
+    const double expected_y = 0.2 * 0.0225 / (0.0225 + pl.target()->cov_p(1, 1));  // posterior mean (cov is diagonal here)
+    EXPECT_NEAR(goal.y(), expected_y, 1e-3) << sigma;
+    EXPECT_NEAR(goal.x(), 0.0, 1e-12);  // stays in the plane
+    if (sigma < 1e-3) {
+      EXPECT_NEAR(goal.y(), 0.2, 1e-4);
+    } else {
+      EXPECT_LT(goal.y(), 0.05);
+    }
+  }
+}

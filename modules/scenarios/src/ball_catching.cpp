@@ -310,6 +310,7 @@ BallCatchingConfig loadBallCatchingConfig(const io::ConfigNode& root) {
     c.planner.give_up_late = p.getOr<double>("give_up_late_s", c.planner.give_up_late);
     c.planner.home_delay = p.getOr<double>("home_delay_s", c.planner.home_delay);
     c.planner.min_lead = p.getOr<double>("min_lead_s", c.planner.min_lead);
+    c.planner.target_prior_std = p.getOr<double>("target_prior_std_m", c.planner.target_prior_std);
   }
   if (root.has("render")) {
     const auto r = root.child("render");

@@ -11,7 +11,8 @@
 //  1. predict the crossing (crossing.h) with the configured flight model (drag or ballistic) and
 //     its covariance; ignore it when there is none ahead;
 //  2. while the crossing point is too uncertain (largest std > start_sigma) do nothing; below it,
-//     re-plan a time-optimal synchronised profile (motion_profile.h) to the predicted point,
+//     re-plan a time-optimal synchronised profile (motion_profile.h) to the predicted point (or,
+//     with target_prior_std > 0, to its posterior mean under the prior of the throws),
 //     starting from the CURRENT commanded position and velocity (no jump, no velocity step);
 //  3. the first time the largest std falls below commit_sigma (after at least commit_min_updates
 //     updates) the target is "committed" (decision time = commit − first update). At and after
@@ -46,6 +47,11 @@ struct CatchPlannerConfig {
   bool give_up = true;            ///< false: keep chasing unreachable targets (for comparisons)
   double home_delay = 0.1;        ///< s after the predicted crossing before going home
   double min_lead = 0.0;          ///< s, ignore crossings sooner than now + latency + this
+  /// Prior of where throws cross the plane: N(home, σ0² I) per in-plane axis (0 = no prior).
+  /// The box then goes to the posterior mean  home + σ0² (σ0² I + C)⁻¹ (ĉ − home)  of the
+  /// predicted crossing ĉ with covariance C: early, uncertain predictions (one camera) move the
+  /// box only a little towards where they point, precise ones move it all the way.
+  double target_prior_std = 0.0;
   /// Throws core::InvalidInput naming the field.
   void validate() const;
 };
