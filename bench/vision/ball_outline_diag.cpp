@@ -1,11 +1,14 @@
 // Diagnostic (not a figure): ball circle errors of each outline method against the exact
 // projected sphere, on [M]'s scene as scored by detection_scoring::scoreTable.
-//   ball_outline_diag [frames=100] [seed=2]
+//   ball_outline_diag [frames=100] [seed=2] [verbose] [frame to dump]
+// Environment knobs for the sphere-cone parameters (evaluation only): RAYS, REACH, MARGIN,
+// MAX_GAP, MAX_SIG; imaging effects NOISE (sigma) and EXPOSURE (s); TIMING=1 prints CPU times.
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "detection_scoring.h"
 #include "viewline/sim/effects.h"
@@ -33,7 +36,8 @@ int main(int argc, char** argv) {
   methods[1].cfg.ball_outline = vision::TableDetectorConfig::BallOutline::GreennessEllipse;
   methods[2].name = "sphere cone (unmixing)";
   for (auto& m : methods) m.cfg.border_height_m = look.border_height;
-  int fallbacks = 0;
+  int fallbacks = 0, n_el = 0;
+  double sq_el = 0.0, sq_cone = 0.0;
   if (const char* g = std::getenv("MARGIN")) methods[2].cfg.ball_outline_params.clean_margin_px = std::atof(g);
   if (const char* g = std::getenv("MAX_SIG")) methods[2].cfg.ball_outline_params.max_alpha_sigma_px = std::atof(g);
   if (const char* g = std::getenv("MAX_GAP")) methods[2].cfg.ball_outline_params.max_gap_deg = std::atof(g);
@@ -81,6 +85,16 @@ int main(int argc, char** argv) {
         const auto c1 = vision::refineBallBySphereCone(img, cam, *scene.ball_circle, bp);
         if (c1) {
           const auto cone = vision::fitSphereCone(cam, vision::ballOutlinePoints(img, *c1, bp), bp);
+          const auto pts2 = vision::ballOutlinePoints(img, *c1, bp);
+          if (pts2.size() >= 16) {
+            std::vector<cv::Point2f> cvp;
+            for (const auto& q : pts2) cvp.emplace_back(static_cast<float>(q.x()), static_cast<float>(q.y()));
+            const cv::RotatedRect el = cv::fitEllipse(cvp);
+            const double a = 0.5 * static_cast<double>(std::max(el.size.width, el.size.height));
+            if (cone && cone->max_gap_rad < core::deg2rad(180.0) && cone->alpha_sigma_px < 0.015) {
+              ++n_el; sq_el += std::pow(a - tc.radius, 2); sq_cone += std::pow(c1->radius - tc.radius, 2);
+            }
+          }
           if (cone) std::printf(" [gap %3.0f sig %.3f rms %.3f n %2d err %+.3f]", core::rad2deg(cone->max_gap_rad), cone->alpha_sigma_px, cone->rms_px, cone->inliers, c1->radius - tc.radius);
         }
       }
@@ -139,6 +153,7 @@ int main(int argc, char** argv) {
       for (std::size_t j = 0; j < imgs.size(); ++j) if (circles[j].radius > 0) { vision::ballOutlinePoints(imgs[j], circles[j], methods[2].cfg.ball_outline_params); ++calls; }
     std::printf("ballOutlinePoints: %.1f us\n", 1e6 * (cpu() - t0) / calls);
   }
+  if (n_el) std::printf("same unmixed outline points, %d accepted frames: radius RMS %.4f px with cv::fitEllipse (semi-major axis), %.4f px with the sphere cone\n", n_el, std::sqrt(sq_el / n_el), std::sqrt(sq_cone / n_el));
   std::printf("sphere cone fell back to the greenness ellipse in %d frames\n", fallbacks);
   return 0;
 }

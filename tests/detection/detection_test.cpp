@@ -29,7 +29,10 @@ TEST(DetectionOnSim, TablePoseAndBallOnTableInMsScene) {
   EXPECT_EQ(s.rotation.detected, s.rotation.frames);
   EXPECT_LT(core::rad2deg(s.rotation.rms()), 0.5);
   EXPECT_LT(s.ball_unknown.rms(), 0.002);
-  EXPECT_LT(s.ball_known.rms(), 0.003);  // issue target 2 mm: 2.4 mm measured, see results
+  // Issue target 2 mm for both variants. Known radius: 0.50 mm here with the sphere-cone outline
+  // (2.6 mm with the earlier greenness ellipse, whose outline the ball's dark limb biased by
+  // -0.05 px; 1 mm is 0.016 px of apparent radius).
+  EXPECT_LT(s.ball_known.rms(), 0.002);
   EXPECT_GT(s.tag_rotation.detected, s.tag_rotation.frames / 2);
 }
 

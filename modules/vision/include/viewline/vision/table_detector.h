@@ -33,11 +33,14 @@
 // With raised borders (border_height_m > 0) the pose is then refined on the
 // edge points against the visible 3D boundary (see refinePoseWithBorders).
 // The greenness mid level is biased on a shaded ball (its dark limb has a lower
-// level), which is too much for the distance d = r / sin α (0.04 px of radius
-// is 2.5 mm at 0.5 m); so with ball_outline = SphereCone (default) the ball's
-// circle is finally replaced by the fit of the sphere's viewing cone to outline
-// points found by colour unmixing, which do not depend on the shading
-// (ball_outline.h). ball_outline = GreennessEllipse keeps the ellipse above.
+// level: -0.05 px of radius), too much for the distance d = r / sin α (1 mm is
+// 0.016 px at 0.5 m). So with ball_outline = SphereCone (default) the ball's
+// circle comes from the fit of the sphere's viewing cone to outline points
+// found by colour unmixing, which do not depend on the shading (ball_outline.h),
+// started from [M]'s circle; only when that fit is refused (ball against the
+// black border on much of its outline, occluded) does the greenness ellipse
+// above give the circle. ball_outline = GreennessEllipse always uses the
+// ellipse (the earlier production path, kept for comparison).
 //
 // referenceTableScene() is the plain speed baseline written the straightforward
 // way (as [M]'s Python): full frame at every step, fresh buffers, two inRange
