@@ -316,6 +316,7 @@ BallCatchingConfig loadBallCatchingConfig(const io::ConfigNode& root) {
     const auto r = root.child("render");
     c.render.supersampling = r.getOr<int>("supersampling", c.render.supersampling);
     c.post_crossing_s = r.getOr<double>("post_crossing_s", c.post_crossing_s);
+    c.prediction_lead_s = r.getOr<double>("prediction_lead_s", c.prediction_lead_s);
   }
   if (root.has("room")) {
     const auto r = root.child("room");
@@ -418,6 +419,7 @@ ThrowResult runThrow(const BallCatchingConfig& cfg, const sim::Scene& room, int 
     estimation::StateEstimate est;
   };
   std::deque<Pending> pending;
+  std::optional<Eigen::Vector3d> lead_prediction;
   double t_tick = 0.0;
   std::uint64_t next_id = 1;
   io::CsvWriter no_log;
@@ -427,6 +429,7 @@ ThrowResult runThrow(const BallCatchingConfig& cfg, const sim::Scene& room, int 
     while (t_tick <= t_limit) {
       while (!pending.empty() && pending.front().t_avail <= t_tick) {
         const auto u = planner.update(pending.front().t_avail, pending.front().est);
+        if (u.crossing && pending.front().t_avail <= res.t_cross - cfg.prediction_lead_s) lead_prediction = u.crossing->p;
         if (log && u.crossing)
           log->stream("predictions", {"throw", "t", "t_cross", "x", "y", "z", "sigma_max", "sigma_t", "feasible", "phase"})
               .row({double(index), pending.front().t_avail, u.crossing->t, u.crossing->p.x(), u.crossing->p.y(),
@@ -529,6 +532,8 @@ ThrowResult runThrow(const BallCatchingConfig& cfg, const sim::Scene& room, int 
   res.committed = planner.committed();
   res.gave_up = planner.giveUpTime().has_value();
   if (planner.firstMoveTime()) res.t_first_move = *planner.firstMoveTime();
+  if (lead_prediction) res.prediction_error_lead = (*lead_prediction - res.cross_true).norm();
+  if (planner.giveUpTime()) res.give_up_lead = res.t_cross - *planner.giveUpTime();
   if (planner.commitTime() && planner.firstUpdateTime())
     res.decision_time = *planner.commitTime() - *planner.firstUpdateTime();
   if (res.had_target) {
@@ -605,7 +610,7 @@ CatchSummary runBallCatching(const BallCatchingConfig& cfg, int throws, std::uin
   if (hooks.log) hooks.log->flush();
 
   for (const char* r : kMissReasons) s.miss_reasons[r] = 0;
-  std::vector<double> pred_err, decision, miss_reach, speeds, elev, flight;
+  std::vector<double> pred_lead, pred_err, decision, miss_reach, speeds, elev, flight, give_up_lead;
   double frame_time = 0.0;
   for (const ThrowResult& r : s.results) {
     s.reachable_throws += r.reachable;
@@ -613,7 +618,13 @@ CatchSummary runBallCatching(const BallCatchingConfig& cfg, int throws, std::uin
     s.caught_reachable += r.caught && r.reachable;
     if (!r.caught) ++s.miss_reasons[r.miss_reason];
     if (r.prediction_error >= 0.0) pred_err.push_back(1e3 * r.prediction_error);
+    if (r.prediction_error_lead >= 0.0) pred_lead.push_back(1e3 * r.prediction_error_lead);
     if (r.decision_time >= 0.0) decision.push_back(r.decision_time);
+    if (r.gave_up && !r.reachable) {
+      ++s.gave_up_unreachable;
+      give_up_lead.push_back(r.give_up_lead);
+    }
+    if (r.gave_up && r.reachable) ++s.gave_up_reachable;
     if (r.reachable) miss_reach.push_back(1e3 * r.miss_distance);
     s.limit_violations += r.limit_violations;
     s.refused_setpoints += r.refused_setpoints;
@@ -628,10 +639,14 @@ CatchSummary runBallCatching(const BallCatchingConfig& cfg, int throws, std::uin
   s.catch_rate_reachable = s.reachable_throws > 0 ? static_cast<double>(s.caught_reachable) / s.reachable_throws : 0.0;
   s.prediction_error_mm_median = percentile(pred_err, 0.5);
   s.prediction_error_mm_p95 = percentile(pred_err, 0.95);
+  s.prediction_error_lead_mm_median = percentile(pred_lead, 0.5);
+  s.prediction_error_lead_mm_p95 = percentile(pred_lead, 0.95);
+  s.predictions_at_lead = static_cast<int>(pred_lead.size());
   s.decisions = static_cast<int>(decision.size());
   s.decision_time_s_median = percentile(decision, 0.5);
   s.decision_time_s_p95 = percentile(decision, 0.95);
   s.miss_distance_mm_median_reachable = percentile(miss_reach, 0.5);
+  s.give_up_lead_s_median = percentile(give_up_lead, 0.5);
   s.detection_rate = s.frames > 0 ? static_cast<double>(s.detections) / s.frames : 0.0;
   s.launch_speed_min = *std::min_element(speeds.begin(), speeds.end());
   s.launch_speed_max = *std::max_element(speeds.begin(), speeds.end());
@@ -660,9 +675,16 @@ nlohmann::json summaryJson(const CatchSummary& s, const BallCatchingConfig& cfg)
   j["miss_reasons"] = s.miss_reasons;
   j["prediction_error_mm_at_catch"] = {{"median", num(s.prediction_error_mm_median)},
                                        {"p95", num(s.prediction_error_mm_p95)}};
+  j["prediction_error_mm_at_lead"] = {{"lead_s", cfg.prediction_lead_s},
+                                      {"median", num(s.prediction_error_lead_mm_median)},
+                                      {"p95", num(s.prediction_error_lead_mm_p95)},
+                                      {"throws", s.predictions_at_lead}};
   j["decision_time_s"] = {{"median", num(s.decision_time_s_median)}, {"p95", num(s.decision_time_s_p95)},
                           {"throws_with_decision", s.decisions}};
   j["miss_distance_mm_median_reachable"] = num(s.miss_distance_mm_median_reachable);
+  j["early_give_up"] = {{"not_reachable_throws_given_up", s.gave_up_unreachable},
+                        {"reachable_throws_given_up", s.gave_up_reachable},
+                        {"lead_before_crossing_s_median", num(s.give_up_lead_s_median)}};
   j["robot"] = {{"kind", robots::toString(cfg.robot.kind)},
                 {"v_max", cfg.robot.limits.v_max.x()},
                 {"a_max", cfg.robot.limits.a_max.x()},

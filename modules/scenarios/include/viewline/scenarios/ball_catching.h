@@ -112,6 +112,7 @@ struct BallCatchingConfig {
   double control_period = 0.004;     ///< s between set points (250 Hz)
   double processing_latency = 0.008; ///< s from capture to the tracker/planner update
   double post_crossing_s = 0.05;     ///< s simulated after the true crossing
+  double prediction_lead_s = 0.2;    ///< the early-prediction metric uses the last prediction this long before the crossing
   vision::BallDetectorConfig detector;
   double sigma_px_floor = 0.3;       ///< px, floor of the measurement std given to the tracker
   tracking::TrackerConfig tracker;
@@ -145,9 +146,11 @@ struct ThrowResult {
   double t_first_detection = -1.0;
   double t_first_move = -1.0;                           ///< planner's first move towards a target
   bool had_target = false, committed = false, gave_up = false;
+  double give_up_lead = -1.0;                           ///< true crossing − give-up decision, s
   double decision_time = -1.0;                          ///< commit − first update, s
   Eigen::Vector3d target = Eigen::Vector3d::Zero();     ///< planner's final target
   double prediction_error = -1.0;                       ///< |target − true crossing|, m
+  double prediction_error_lead = -1.0;                  ///< same, last prediction >= prediction_lead_s before it
   Eigen::Vector3d hole_at_cross = Eigen::Vector3d::Zero();
   double miss_distance = 0.0;                           ///< in-plane |ball − hole| at the crossing, m
   bool caught = false;
@@ -162,8 +165,13 @@ struct CatchSummary {
   double catch_rate_all = 0.0, catch_rate_reachable = 0.0;
   std::map<std::string, int> miss_reasons;
   double prediction_error_mm_median = 0.0, prediction_error_mm_p95 = 0.0;
+  double prediction_error_lead_mm_median = 0.0, prediction_error_lead_mm_p95 = 0.0;
+  int predictions_at_lead = 0;
   double decision_time_s_median = 0.0, decision_time_s_p95 = 0.0;
   int decisions = 0;
+  int gave_up_unreachable = 0;   ///< not-reachable throws the planner gave up on (early decision)
+  int gave_up_reachable = 0;     ///< reachable throws it gave up on (wrong decisions)
+  double give_up_lead_s_median = 0.0;  ///< how long before the crossing it gave up (unreachable ones)
   double miss_distance_mm_median_reachable = 0.0;
   std::size_t limit_violations = 0, refused_setpoints = 0;
   int frames = 0, detections = 0;
