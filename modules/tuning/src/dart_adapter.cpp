@@ -33,6 +33,7 @@
 #include <map>
 #include <sstream>
 
+#include "adapter_util.h"
 #include "dart_config.h"
 #include "viewline/core/error.h"
 #include "viewline/core/random.h"
@@ -49,8 +50,6 @@ namespace {
 
 using tracking::DartScenarioConfig;
 using tracking::ImageMeasurement;
-
-constexpr double kPi = 3.14159265358979323846;
 
 struct DartOptions {
   int flights = 50;
@@ -164,28 +163,14 @@ public:
 
   std::unique_ptr<ReplayData> loadLog(const std::string& dir) const override {
     const std::string path = (std::filesystem::path(dir) / "detections.csv").string();
-    std::ifstream in(path);
-    if (!in) throw core::InvalidInput(path + ": cannot read (expected the detections.csv of dart_tracking --log)");
-    std::string line;
-    std::getline(in, line);
-    std::vector<std::string> header = split(line);
-    auto col = [&](const std::string& name) {
-      const auto it = std::find(header.begin(), header.end(), name);
-      if (it == header.end()) throw core::InvalidInput(path + ": missing column '" + name + "'");
-      return static_cast<std::size_t>(it - header.begin());
-    };
-    const std::size_t ce = col("experiment"), cr = col("run"), ci = col("id"), cc = col("camera"), ct = col("t"),
-                      cu = col("u"), cv = col("v");
+    const detail::CsvTable csv = detail::CsvTable::read(path, "the detections.csv of dart_tracking --log");
+    const std::size_t ce = csv.col("experiment"), cr = csv.col("run"), ci = csv.col("id"), cc = csv.col("camera"),
+                      ct = csv.col("t"), cu = csv.col("u"), cv = csv.col("v");
     auto d = std::make_unique<DartReplayData>();
     std::map<std::string, std::size_t> index;
-    std::size_t line_no = 1;
-    while (std::getline(in, line)) {
-      ++line_no;
-      if (line.empty()) continue;
-      const std::vector<std::string> f = split(line);
-      if (f.size() != header.size()) throw core::InvalidInput(path + ":" + std::to_string(line_no) + ": wrong number of columns");
-      if (!opt_.log_experiment.empty() && f[ce] != opt_.log_experiment) continue;
-      const std::string key = f[ce] + "/" + f[cr];
+    for (std::size_t row = 0; row < csv.rows(); ++row) {
+      if (!opt_.log_experiment.empty() && csv.text(row, ce) != opt_.log_experiment) continue;
+      const std::string key = csv.text(row, ce) + "/" + csv.text(row, cr);
       auto it = index.find(key);
       if (it == index.end()) {
         it = index.emplace(key, d->flights.size()).first;
@@ -194,16 +179,11 @@ public:
       }
       tracking::SimDetection det;
       det.truth.setZero();
-      try {
-        det.m.id = std::stoull(f[ci]);
-        det.m.camera = std::stoul(f[cc]);
-        det.m.t = std::stod(f[ct]);
-        det.m.uv = Eigen::Vector2d(std::stod(f[cu]), std::stod(f[cv]));
-      } catch (const std::exception&) {
-        throw core::InvalidInput(path + ":" + std::to_string(line_no) + ": expected numbers in id, camera, t, u, v");
-      }
-      if (det.m.camera >= cams_.size())
-        throw core::InvalidInput(path + ":" + std::to_string(line_no) + ": camera index beyond the config's cameras");
+      det.m.id = static_cast<std::uint64_t>(csv.number(row, ci));
+      det.m.camera = static_cast<std::size_t>(csv.number(row, cc));
+      det.m.t = csv.number(row, ct);
+      det.m.uv = Eigen::Vector2d(csv.number(row, cu), csv.number(row, cv));
+      if (det.m.camera >= cams_.size()) throw core::InvalidInput(csv.where(row) + ": camera index beyond the config's cameras");
       d->flights[it->second].dets.push_back(det);
     }
     for (auto& fl : d->flights)
@@ -244,23 +224,6 @@ public:
   }
 
 private:
-  static std::vector<std::string> split(const std::string& line) {
-    std::vector<std::string> out;
-    std::string cur;
-    bool q = false;
-    for (char c : line) {
-      if (c == '"') q = !q;
-      else if (c == ',' && !q) {
-        out.push_back(cur);
-        cur.clear();
-      } else if (c != '\r') {
-        cur += c;
-      }
-    }
-    out.push_back(cur);
-    return out;
-  }
-
   std::shared_ptr<RunSeries> makeSeries() const {
     auto s = std::make_shared<RunSeries>();
     s->time_label = "time since the first detection [s]";
@@ -291,46 +254,16 @@ private:
       ImageMeasurement m = det.m;
       m.sigma_px = sigma;
       // The innovation the tracker will see (prior at the capture time).
-      bool have = false;
-      Eigen::Vector2d dv = Eigen::Vector2d::Zero();
-      Eigen::Matrix2d S = Eigen::Matrix2d::Identity();
-      double nis = 0.0, u = 0.0;
-      const tracking::TrackState& ts0 = tracker.trackState();
-      const bool in_stats = tracker.initialised() && ts0.fused_in_track >= opt_.burn_in && m.t >= tracker.state().t();
-      if (in_stats) {
-        try {
-          const estimation::StateEstimate pred = tracker.predictAt(m.t);
-          const Eigen::MatrixXd P = pred.P();
-          const tracking::Vector6 x = pred.x();
-          const tracking::Matrix6 P6 = P;
-          const tracking::ViewlineRows rows = tracking::viewlineRows(cams_[m.camera], m.uv, sigma, x, P6, 0.0, tc.model,
-                                                                     tc.min_depth, tc.depth_variance_in_noise);
-          dv = rows.y - rows.C * x;
-          S = rows.R + rows.C * P6 * rows.C.transpose();
-          const Eigen::LLT<Eigen::Matrix2d> llt(S);
-          if (llt.info() == Eigen::Success) {
-            nis = dv.dot(llt.solve(dv));
-            const core::Camera& cam = cams_[m.camera];
-            u = sigma * sigma / (static_cast<double>(cam.width) * cam.height * std::sqrt(rows.R.determinant()));
-            have = std::isfinite(nis) && std::isfinite(u);
-          }
-        } catch (const core::Error&) {
-          have = false;
-        }
-      }
+      const detail::ViewlineInnovation inn = detail::viewlineInnovation(tracker, cams_, tc, m, opt_.burn_in);
+      const bool have = inn.valid;
+      const Eigen::Vector2d& dv = inn.d;
+      const Eigen::Matrix2d& S = inn.S;
+      const double nis = inn.nis;
       tracker.submit(m);
       const auto out = tracker.outcome(m.id);
       const bool fused = out && out->fate == tracking::Fate::Fused;
       if (have) {
-        // −2 log[(1 − ε) N(d; 0, S) + ε u], by log-sum-exp.
-        const double log_gauss = -0.5 * nis - std::log(2.0 * kPi) - 0.5 * std::log(S.determinant());
-        double lp = log_gauss;
-        if (eps > 0.0) {
-          const double l1 = std::log1p(-eps) + log_gauss, l2 = std::log(eps) + std::log(u);
-          const double mx = std::max(l1, l2);
-          lp = mx + std::log(std::exp(l1 - mx) + std::exp(l2 - mx));
-        }
-        a.cost += -2.0 * lp;
+        a.cost += detail::innovationCost(nis, std::log(S.determinant()), 2, eps, inn.log_u);
         ++a.terms;
         if (fused && !out->seed) {
           a.nis.add(nis, 2.0);

@@ -29,6 +29,7 @@
 #include <sstream>
 #include <unistd.h>
 
+#include "adapter_util.h"
 #include "viewline/control/pan_tilt_servo.h"
 #include "viewline/core/error.h"
 #include "viewline/core/random.h"
@@ -42,7 +43,6 @@ namespace viewline::tuning {
 namespace {
 
 namespace fs = std::filesystem;
-constexpr double kPi = 3.14159265358979323846;
 
 struct Frame {
   double t = 0.0;
@@ -72,51 +72,18 @@ public:
   }
 };
 
-std::vector<std::string> splitCsv(const std::string& line) {
-  std::vector<std::string> out;
-  std::string cur;
-  for (char c : line) {
-    if (c == ',') {
-      out.push_back(cur);
-      cur.clear();
-    } else if (c != '\r' && c != '"') {
-      cur += c;
-    }
-  }
-  out.push_back(cur);
-  return out;
-}
-
 std::vector<Frame> readFrames(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw core::InvalidInput(path + ": cannot read (expected predictive_frames.csv of pan_tilt_tracking --log)");
-  std::string line;
-  std::getline(in, line);
-  const std::vector<std::string> h = splitCsv(line);
-  auto col = [&](const char* n) {
-    const auto it = std::find(h.begin(), h.end(), n);
-    if (it == h.end()) throw core::InvalidInput(path + ": missing column '" + std::string(n) + "'");
-    return static_cast<std::size_t>(it - h.begin());
-  };
-  const std::size_t ct = col("t"), cd = col("detected"), cx = col("meas_x"), cy = col("meas_y"), tx = col("truth_x"),
-                    ty = col("truth_y"), ce = col("error_px");
+  const detail::CsvTable csv = detail::CsvTable::read(path, "predictive_frames.csv of pan_tilt_tracking --log");
+  const std::size_t ct = csv.col("t"), cd = csv.col("detected"), cx = csv.col("meas_x"), cy = csv.col("meas_y"),
+                    tx = csv.col("truth_x"), ty = csv.col("truth_y"), ce = csv.col("error_px");
   std::vector<Frame> frames;
-  std::size_t n = 1;
-  while (std::getline(in, line)) {
-    ++n;
-    if (line.empty()) continue;
-    const auto f = splitCsv(line);
-    if (f.size() != h.size()) throw core::InvalidInput(path + ":" + std::to_string(n) + ": wrong number of columns");
+  for (std::size_t row = 0; row < csv.rows(); ++row) {
     Frame fr;
-    try {
-      fr.t = std::stod(f[ct]);
-      fr.detected = std::stod(f[cd]) > 0.5;
-      if (fr.detected) fr.z = Eigen::Vector2d(std::stod(f[cx]), std::stod(f[cy]));
-      fr.truth = Eigen::Vector2d(std::stod(f[tx]), std::stod(f[ty]));
-      fr.error_px = std::stod(f[ce]);
-    } catch (const std::exception&) {
-      throw core::InvalidInput(path + ":" + std::to_string(n) + ": expected numbers");
-    }
+    fr.t = csv.number(row, ct);
+    fr.detected = csv.number(row, cd) > 0.5;
+    if (fr.detected) fr.z = Eigen::Vector2d(csv.number(row, cx), csv.number(row, cy));
+    fr.truth = Eigen::Vector2d(csv.number(row, tx), csv.number(row, ty));
+    fr.error_px = csv.number(row, ce);
     frames.push_back(fr);
   }
   return frames;
@@ -156,12 +123,10 @@ public:
   }
 
   Recorded recordOne(std::uint64_t seed, const RunOptions& ro, scenarios::PanTiltRunMetrics* metrics) const {
-    static std::atomic<unsigned> counter{0};
-    const fs::path dir = fs::temp_directory_path() /
-                         ("viewline_tune_" + std::to_string(::getpid()) + "_" + std::to_string(counter.fetch_add(1)));
+    const detail::TempLogDir tmp;
     Recorded rec;
-    try {
-      io::LogDirectory log(dir.string());
+    {
+      io::LogDirectory log(tmp.dir());
       // --display: the scenario's camera view (vpDisplayX) and the live error curve during the run.
       std::unique_ptr<scenarios::PanTiltDisplay> view;
       if (ro.display) {
@@ -182,17 +147,11 @@ public:
           scenarios::runPanTilt(cfg_, seed, scenarios::PanTiltControllerKind::Predictive, sink, &log, ro.progress);
       log.flush();
       if (metrics != nullptr) *metrics = m;
-      rec.frames = readFrames((dir / "predictive_frames.csv").string());
+      rec.frames = readFrames(tmp.file("predictive_frames.csv"));
       if (ro.log != nullptr && ro.log->enabled())
-        fs::copy_file(dir / "predictive_frames.csv", fs::path(ro.log->dir()) / "predictive_frames.csv",
+        fs::copy_file(tmp.file("predictive_frames.csv"), fs::path(ro.log->dir()) / "predictive_frames.csv",
                       fs::copy_options::overwrite_existing);
-    } catch (...) {
-      std::error_code ec;
-      fs::remove_all(dir, ec);
-      throw;
     }
-    std::error_code ec;
-    fs::remove_all(dir, ec);
     rec.R = trueR(seed);
     return rec;
   }
@@ -341,13 +300,7 @@ private:
         last_accepted = f.t;
       }
       if (have) {
-        const double lg = -0.5 * nis - std::log(2.0 * kPi) - 0.5 * std::log(S.determinant());
-        double lp = lg;
-        if (eps > 0.0) {
-          const double l1 = std::log1p(-eps) + lg, l2 = std::log(eps) + std::log(u), mx = std::max(l1, l2);
-          lp = mx + std::log(std::exp(l1 - mx) + std::exp(l2 - mx));
-        }
-        a.cost += -2.0 * lp;
+        a.cost += detail::innovationCost(nis, std::log(S.determinant()), 2, eps, std::log(u));
         ++a.terms;
         if (up.accepted && !up.reinitialized) {
           a.nis.add(nis, 2.0);

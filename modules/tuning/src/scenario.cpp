@@ -48,6 +48,27 @@ std::string combinedVerdict(const Consistency& nees, const Consistency& nis, dou
   return "consistent";
 }
 
+namespace {
+[[noreturn]] void unsupported(const ScenarioInstance& i) {
+  const std::string why = i.autotuneUnsupported();
+  throw core::InvalidInput("noise auto-tuning is not supported by this scenario adapter" +
+                           (why.empty() ? std::string(" (no replay implemented)") : ": " + why));
+}
+}  // namespace
+
+std::vector<NoiseParameter> ScenarioInstance::noiseParameters() const { unsupported(*this); }
+std::unique_ptr<ReplayData> ScenarioInstance::record(std::uint64_t, int) const { unsupported(*this); }
+std::unique_ptr<ReplayData> ScenarioInstance::loadLog(const std::string&) const { unsupported(*this); }
+ReplayResult ScenarioInstance::replay(const ReplayData&, const std::vector<double>&, double, bool) const {
+  unsupported(*this);
+}
+std::unique_ptr<ScenarioInstance> ScenarioInstance::withNoise(const std::vector<double>&) const { unsupported(*this); }
+
+void ScenarioInstance::requireAutotune(const std::string& scenario) const {
+  const std::string why = autotuneUnsupported();
+  if (!why.empty()) throw core::InvalidInput(scenario + ": noise auto-tuning is not supported by this adapter: " + why);
+}
+
 void AdapterRegistry::add(std::unique_ptr<ScenarioAdapter> adapter) {
   if (has(adapter->name())) throw core::InvalidInput("adapter '" + adapter->name() + "' registered twice");
   adapters_.push_back(std::move(adapter));

@@ -286,6 +286,13 @@ nlohmann::json runSweepSession(const AdapterRegistry& registry, const std::strin
   const std::string text = readText(config_path);
   const YAML::Node tree = parseYaml(text, config_path);
   const std::unique_ptr<ScenarioInstance> base = adapter.load(tree, config_path, spec.adapter_options);
+  if (spec.autotune.enabled && !opt.skip_autotune) {
+    try {
+      base->requireAutotune(spec.scenario);
+    } catch (const core::InvalidInput& e) {
+      throw core::InvalidInput(sweep_file + ": section 'autotune': " + e.what() + " (remove the section or run with --no-autotune)");
+    }
+  }
 
   // Every setting must give a config the scenario accepts: errors name the sweep file's line and key.
   const std::vector<Setting> settings = generateSettings(spec);
@@ -614,6 +621,7 @@ nlohmann::json runAutotuneSession(const AdapterRegistry& registry, const Autotun
     aopt[k] = v;
   }
   const std::unique_ptr<ScenarioInstance> base = adapter.load(parseYaml(text, o.config), o.config, aopt);
+  base->requireAutotune(o.scenario);
   fs::create_directories(o.out_dir);
   std::unique_ptr<ReplayData> data;
   if (!o.log_dir.empty()) data = base->loadLog(o.log_dir);

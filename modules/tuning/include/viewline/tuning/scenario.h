@@ -129,17 +129,26 @@ public:
   virtual double confidence() const { return 0.99; }
 
   // --- noise auto-tuning
-  virtual std::vector<NoiseParameter> noiseParameters() const = 0;
+  /// Empty when this instance supports noise auto-tuning; otherwise why not (shown to the user,
+  /// e.g. "the filter's measurements depend on the filter itself (closed loop), so they cannot be
+  /// replayed"). An instance that does not support it need not override the methods below: their
+  /// defaults throw core::InvalidInput with that reason.
+  virtual std::string autotuneUnsupported() const { return {}; }
+  virtual std::vector<NoiseParameter> noiseParameters() const;
   /// Runs the scenario (`runs` seeded runs from `seed`) and records the replay data.
-  virtual std::unique_ptr<ReplayData> record(std::uint64_t seed, int runs) const = 0;
+  virtual std::unique_ptr<ReplayData> record(std::uint64_t seed, int runs) const;
   /// Reads the replay data from the scenario app's --log directory.
-  virtual std::unique_ptr<ReplayData> loadLog(const std::string& dir) const = 0;
+  virtual std::unique_ptr<ReplayData> loadLog(const std::string& dir) const;
   /// Re-runs the filter on the data with the given noise values (in noiseParameters() order).
   /// `outlier_prior` is the prior probability that a measurement is a gross outlier (0: none).
   virtual ReplayResult replay(const ReplayData& data, const std::vector<double>& noise, double outlier_prior,
-                              bool series) const = 0;
+                              bool series) const;
   /// A copy using these noise values.
-  virtual std::unique_ptr<ScenarioInstance> withNoise(const std::vector<double>& noise) const = 0;
+  virtual std::unique_ptr<ScenarioInstance> withNoise(const std::vector<double>& noise) const;
+
+  /// Throws core::InvalidInput "<scenario>: noise auto-tuning is not supported: <reason>" when
+  /// autotuneUnsupported() is not empty.
+  void requireAutotune(const std::string& scenario) const;
 };
 
 /// An option of an adapter, given in the sweep file's `adapter:` map.

@@ -1,0 +1,130 @@
+#include "adapter_util.h"
+
+#include <Eigen/Cholesky>
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <unistd.h>
+
+#include "viewline/core/error.h"
+#include "viewline/tracking/viewline.h"
+
+namespace viewline::tuning::detail {
+
+namespace fs = std::filesystem;
+
+bool xDisplayAvailable() {
+  const char* d = std::getenv("DISPLAY");
+  return d != nullptr && *d != '\0';
+}
+
+std::vector<std::string> splitCsvLine(const std::string& line) {
+  std::vector<std::string> out;
+  std::string cur;
+  bool quoted = false;
+  for (char c : line) {
+    if (c == '"') {
+      quoted = !quoted;
+    } else if (c == ',' && !quoted) {
+      out.push_back(cur);
+      cur.clear();
+    } else if (c != '\r') {
+      cur += c;
+    }
+  }
+  out.push_back(cur);
+  return out;
+}
+
+CsvTable CsvTable::read(const std::string& path, const std::string& what) {
+  std::ifstream in(path);
+  if (!in) throw core::InvalidInput(path + ": cannot read (expected " + what + ")");
+  CsvTable t;
+  t.path_ = path;
+  std::string line;
+  if (!std::getline(in, line)) throw core::InvalidInput(path + ": empty (expected " + what + ")");
+  t.header_ = splitCsvLine(line);
+  std::size_t n = 1;
+  while (std::getline(in, line)) {
+    ++n;
+    if (line.empty() || line == "\r") continue;
+    std::vector<std::string> f = splitCsvLine(line);
+    if (f.size() != t.header_.size()) throw core::InvalidInput(path + ":" + std::to_string(n) + ": wrong number of columns");
+    t.rows_.push_back(std::move(f));
+    t.lines_.push_back(n);
+  }
+  return t;
+}
+
+std::size_t CsvTable::col(const std::string& name) const {
+  const auto it = std::find(header_.begin(), header_.end(), name);
+  if (it == header_.end()) throw core::InvalidInput(path_ + ": missing column '" + name + "'");
+  return static_cast<std::size_t>(it - header_.begin());
+}
+
+double CsvTable::number(std::size_t row, std::size_t c) const {
+  const std::string& s = rows_[row][c];
+  char* end = nullptr;
+  const double v = std::strtod(s.c_str(), &end);
+  if (s.empty() || end == s.c_str() || *end != '\0')
+    throw core::InvalidInput(where(row) + ": column '" + header_[c] + "': expected a number, got '" + s + "'");
+  return v;
+}
+
+TempLogDir::TempLogDir() {
+  static std::atomic<unsigned> counter{0};
+  dir_ = (fs::temp_directory_path() /
+          ("viewline_tune_" + std::to_string(::getpid()) + "_" + std::to_string(counter.fetch_add(1))))
+             .string();
+}
+
+TempLogDir::~TempLogDir() {
+  std::error_code ec;
+  fs::remove_all(dir_, ec);
+}
+
+std::string TempLogDir::file(const std::string& name) const { return (fs::path(dir_) / name).string(); }
+
+double innovationCost(double nis, double log_det_S, int dim, double eps, double log_u) {
+  constexpr double kLog2Pi = 1.8378770664093454836;
+  const double log_gauss = -0.5 * nis - 0.5 * dim * kLog2Pi - 0.5 * log_det_S;
+  double lp = log_gauss;
+  if (eps > 0.0) {
+    const double l1 = std::log1p(-eps) + log_gauss, l2 = std::log(eps) + log_u;
+    const double mx = std::max(l1, l2);
+    lp = mx + std::log(std::exp(l1 - mx) + std::exp(l2 - mx));
+  }
+  return -2.0 * lp;
+}
+
+ViewlineInnovation viewlineInnovation(const tracking::ViewlineTracker& tracker, const std::vector<core::Camera>& cameras,
+                                      const tracking::TrackerConfig& config, const tracking::ImageMeasurement& m,
+                                      int burn_in) {
+  ViewlineInnovation r;
+  if (!tracker.initialised() || tracker.trackState().fused_in_track < burn_in || m.t < tracker.state().t()) return r;
+  if (m.camera >= cameras.size()) return r;
+  try {
+    const estimation::StateEstimate pred = tracker.predictAt(m.t);
+    const tracking::Vector6 x = pred.x();
+    const tracking::Matrix6 P = pred.P();
+    const core::Camera& cam = cameras[m.camera];
+    const tracking::ViewlineRows rows = tracking::viewlineRows(cam, m.uv, m.sigma_px, x, P, 0.0, config.model,
+                                                               config.min_depth, config.depth_variance_in_noise);
+    r.d = rows.y - rows.C * x;
+    r.S = rows.R + rows.C * P * rows.C.transpose();
+    const Eigen::LLT<Eigen::Matrix2d> llt(r.S);
+    if (llt.info() != Eigen::Success) return r;
+    r.nis = r.d.dot(llt.solve(r.d));
+    r.log_u = std::log(m.sigma_px * m.sigma_px /
+                       (static_cast<double>(cam.width) * cam.height * std::sqrt(rows.R.determinant())));
+    r.valid = std::isfinite(r.nis) && std::isfinite(r.log_u);
+  } catch (const core::Error&) {
+    r.valid = false;
+  }
+  return r;
+}
+
+}  // namespace viewline::tuning::detail

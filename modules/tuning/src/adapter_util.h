@@ -1,0 +1,83 @@
+#pragma once
+// Pieces shared by the scenario adapters (internal to modules/tuning):
+//  - CsvTable: reads a CSV the scenario apps' --log writes (header row, named columns), with
+//    errors that name the file and line;
+//  - TempLogDir: a private log folder for one run (scenarios that expose their filter only
+//    through their --log CSV), removed on destruction;
+//  - innovationCost: the −2 log-likelihood term of one innovation under the outlier mixture of
+//    autotune.h;
+//  - viewlineInnovation: the innovation a tracking::ViewlineTracker is about to see for an image
+//    measurement (dart and ball-catching adapters).
+
+#include <Eigen/Core>
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "viewline/core/camera.h"
+#include "viewline/tracking/tracker.h"
+
+namespace viewline::tuning::detail {
+
+/// True when an X display is configured (DISPLAY set): the scenarios' live views need one.
+bool xDisplayAvailable();
+
+/// Splits one CSV line (fields may be "quoted"; no embedded newlines).
+std::vector<std::string> splitCsvLine(const std::string& line);
+
+class CsvTable {
+public:
+  /// Reads `path`; `what` says what file was expected (in the error when it cannot be read).
+  static CsvTable read(const std::string& path, const std::string& what);
+  std::size_t col(const std::string& name) const;  ///< throws InvalidInput naming the file
+  std::size_t rows() const { return rows_.size(); }
+  const std::string& text(std::size_t row, std::size_t col) const { return rows_[row][col]; }
+  double number(std::size_t row, std::size_t col) const;  ///< throws InvalidInput naming file:line
+  std::string where(std::size_t row) const { return path_ + ":" + std::to_string(lines_[row]); }
+
+private:
+  std::string path_;
+  std::vector<std::string> header_;
+  std::vector<std::vector<std::string>> rows_;
+  std::vector<std::size_t> lines_;
+};
+
+/// A fresh folder under the system temporary directory, unique per process and call; removed
+/// (with its contents) on destruction.
+class TempLogDir {
+public:
+  TempLogDir();
+  ~TempLogDir();
+  TempLogDir(const TempLogDir&) = delete;
+  TempLogDir& operator=(const TempLogDir&) = delete;
+  const std::string& dir() const { return dir_; }
+  std::string file(const std::string& name) const;
+
+private:
+  std::string dir_;
+};
+
+/// −2 log[(1 − ε) N(d; 0, S) + ε u] for an innovation of dimension `dim` with NIS dᵀS⁻¹d and
+/// log det S (ε = 0: the plain Gaussian term), by log-sum-exp. `log_u` is the log density of a
+/// gross outlier in innovation space (unused when ε = 0).
+double innovationCost(double nis, double log_det_S, int dim, double eps, double log_u);
+
+/// The innovation of an image measurement for a ViewlineTracker, formed exactly as the tracker
+/// forms it (tracking::viewlineRows at the predicted state x̂(t|t−)):
+///   d = y − C x̂,  S = R2 + C P Cᵀ,  NIS = dᵀ S⁻¹ d (2 dof);
+/// `log_u` is the log density of a gross outlier uniform over the W x H image, mapped to the two
+/// rows (|det| = sqrt(det R2) / σ², viewline.h): u = σ² / (W H sqrt(det R2)).
+struct ViewlineInnovation {
+  bool valid = false;
+  Eigen::Vector2d d = Eigen::Vector2d::Zero();
+  Eigen::Matrix2d S = Eigen::Matrix2d::Identity();
+  double nis = 0.0;
+  double log_u = 0.0;
+};
+/// Valid only when the tracker is initialised, has fused at least `burn_in` images in its track
+/// and the measurement is not older than its state (what the tracker would fuse directly).
+ViewlineInnovation viewlineInnovation(const tracking::ViewlineTracker& tracker, const std::vector<core::Camera>& cameras,
+                                      const tracking::TrackerConfig& config, const tracking::ImageMeasurement& m,
+                                      int burn_in);
+
+}  // namespace viewline::tuning::detail
