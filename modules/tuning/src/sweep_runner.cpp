@@ -9,6 +9,10 @@
 #include <mutex>
 #include <sstream>
 #include <thread>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+#include <opencv2/core/utility.hpp>
 
 #include "viewline/core/error.h"
 #include "viewline/core/random.h"
@@ -42,6 +46,43 @@ nlohmann::json consistencyJson(const Consistency& c, double confidence) {
           {"samples", c.count},
           {"verdict", c.verdict(confidence)}};
 }
+
+/// The runs are the unit of parallelism: while parallelFor runs, OpenCV's own pool (TBB in
+/// Debian's build) is switched off (cv::setNumThreads(0): every OpenCV call runs sequentially in
+/// the calling worker), so a run's image processing does not compete with the other workers for
+/// the cores (oversubscription, and one worker's parallel_for_ waiting for threads busy with
+/// another's). Restored afterwards. Every parallelFor does this, whatever its worker count, so a
+/// 1-worker and an N-worker sweep run the libraries the same way (same results).
+class SerialLibraryThreads {
+public:
+  SerialLibraryThreads() : previous_(cv::getNumThreads()) { cv::setNumThreads(0); }
+  ~SerialLibraryThreads() { cv::setNumThreads(previous_); }
+  SerialLibraryThreads(const SerialLibraryThreads&) = delete;
+  SerialLibraryThreads& operator=(const SerialLibraryThreads&) = delete;
+
+private:
+  int previous_;
+};
+
+/// ViSP's targets compile with -fopenmp: an OpenMP region inside a run would start a team of
+/// OMP_NUM_THREADS (= cores) threads per worker. The team size is a per-thread setting, so each
+/// worker (and the caller, restored) uses one thread. (Eigen is already EIGEN_DONT_PARALLELIZE.)
+class OpenMpSerialInThisThread {
+public:
+#ifdef _OPENMP
+  OpenMpSerialInThisThread() : previous_(omp_get_max_threads()) { omp_set_num_threads(1); }
+  ~OpenMpSerialInThisThread() { omp_set_num_threads(previous_); }
+#else
+  OpenMpSerialInThisThread() = default;
+#endif
+  OpenMpSerialInThisThread(const OpenMpSerialInThisThread&) = delete;
+  OpenMpSerialInThisThread& operator=(const OpenMpSerialInThisThread&) = delete;
+
+private:
+#ifdef _OPENMP
+  int previous_;
+#endif
+};
 
 }  // namespace
 
@@ -134,10 +175,12 @@ std::size_t parallelFor(std::size_t n, int workers, const std::function<void(std
                         const std::atomic<bool>* stop, const std::function<void(std::size_t)>& after) {
   if (workers <= 0) workers = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   workers = static_cast<int>(std::min<std::size_t>(static_cast<std::size_t>(workers), std::max<std::size_t>(n, 1)));
+  const SerialLibraryThreads serial_libraries;
   std::atomic<std::size_t> next{0};
   std::atomic<std::size_t> ran{0};
   std::mutex after_mutex;
   auto loop = [&]() {
+    const OpenMpSerialInThisThread omp_serial;
     for (;;) {
       if (stop != nullptr && stop->load()) return;
       const std::size_t i = next.fetch_add(1);

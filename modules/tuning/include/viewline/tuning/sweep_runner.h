@@ -83,7 +83,10 @@ std::optional<std::size_t> bestSetting(const SweepSpec& spec, const std::vector<
 bool sameResults(const SweepOutcome& a, const SweepOutcome& b, std::string* first_difference = nullptr);
 
 /// Runs `n` indexed jobs on `workers` threads (fixed hand-out order; `job(i)` must write only its
-/// own slot). Returns the number of jobs run (fewer when *stop became true).
+/// own slot). Returns the number of jobs run (fewer when *stop became true). The jobs are the
+/// only parallelism while it runs: OpenCV's thread pool is off (cv::setNumThreads(0), restored
+/// after) and each worker runs OpenMP regions on one thread, so runs do not compete with the
+/// workers for the cores.
 std::size_t parallelFor(std::size_t n, int workers, const std::function<void(std::size_t)>& job,
                         const std::atomic<bool>* stop = nullptr,
                         const std::function<void(std::size_t)>& after = nullptr);
