@@ -11,6 +11,7 @@
 
 #include "viewline/core/error.h"
 #include "viewline/tracking/viewline.h"
+#include "viewline/tuning/yaml_edit.h"
 
 namespace viewline::tuning::detail {
 
@@ -125,6 +126,36 @@ ViewlineInnovation viewlineInnovation(const tracking::ViewlineTracker& tracker, 
     r.valid = false;
   }
   return r;
+}
+
+namespace {
+
+class InfoAdapter final : public ScenarioAdapter {
+public:
+  InfoAdapter(AdapterInfo info, AdapterLoader load) : info_(std::move(info)), load_(std::move(load)) {}
+  std::string name() const override { return info_.name; }
+  std::string description() const override { return info_.description; }
+  std::string appCommand(const std::string& config_path) const override {
+    return info_.app + " --config " + config_path + (info_.app_arguments.empty() ? "" : " " + info_.app_arguments);
+  }
+  std::string defaultMetric() const override { return info_.default_metric; }
+  bool defaultMinimize() const override { return info_.minimize; }
+  std::vector<std::string> metricNames() const override { return info_.metrics; }
+  std::vector<AdapterOption> options() const override { return info_.options; }
+  std::unique_ptr<ScenarioInstance> load(const YAML::Node& scenario, const std::string& name,
+                                         const AdapterOptions& options) const override {
+    return load_(emitYaml(scenario), name, options);
+  }
+
+private:
+  AdapterInfo info_;
+  AdapterLoader load_;
+};
+
+}  // namespace
+
+std::unique_ptr<ScenarioAdapter> makeAdapter(AdapterInfo info, AdapterLoader load) {
+  return std::make_unique<InfoAdapter>(std::move(info), std::move(load));
 }
 
 }  // namespace viewline::tuning::detail

@@ -7,15 +7,20 @@
 //  - innovationCost: the −2 log-likelihood term of one innovation under the outlier mixture of
 //    autotune.h;
 //  - viewlineInnovation: the innovation a tracking::ViewlineTracker is about to see for an image
-//    measurement (dart and ball-catching adapters).
+//    measurement (dart and ball-catching adapters);
+//  - makeAdapter: a ScenarioAdapter from its description (name, metrics, options) and a loader,
+//    so each adapter file holds only what is specific to its scenario.
 
 #include <Eigen/Core>
 #include <cstddef>
+#include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "viewline/core/camera.h"
 #include "viewline/tracking/tracker.h"
+#include "viewline/tuning/scenario.h"
 
 namespace viewline::tuning::detail {
 
@@ -79,5 +84,22 @@ struct ViewlineInnovation {
 ViewlineInnovation viewlineInnovation(const tracking::ViewlineTracker& tracker, const std::vector<core::Camera>& cameras,
                                       const tracking::TrackerConfig& config, const tracking::ImageMeasurement& m,
                                       int burn_in);
+
+/// What the tuning tool shows and checks about an adapter (see ScenarioAdapter).
+struct AdapterInfo {
+  std::string name;
+  std::string description;
+  std::string app;             ///< the scenario app that reads the same config, e.g. "table_ball_balancing"
+  std::string app_arguments;   ///< what follows "--config <path>" in the ready-to-use command line
+  std::string default_metric;
+  bool minimize = true;
+  std::vector<std::string> metrics;
+  std::vector<AdapterOption> options;
+};
+/// Parses the scenario config (YAML text, `name` names the file in errors) with the scenario's own
+/// loader and returns the instance; throws core::InvalidInput.
+using AdapterLoader =
+    std::function<std::unique_ptr<ScenarioInstance>(const std::string& yaml, const std::string& name, const AdapterOptions&)>;
+std::unique_ptr<ScenarioAdapter> makeAdapter(AdapterInfo info, AdapterLoader load);
 
 }  // namespace viewline::tuning::detail

@@ -36,7 +36,6 @@
 #include "viewline/scenarios/ball_catching.h"
 #include "viewline/scenarios/ball_catching_display.h"
 #include "viewline/tuning/scenario.h"
-#include "viewline/tuning/yaml_edit.h"
 
 namespace viewline::tuning {
 
@@ -236,33 +235,27 @@ private:
   CatchOptions opt_;
 };
 
-class CatchAdapter final : public ScenarioAdapter {
-public:
-  std::string name() const override { return "ball_catching"; }
-  std::string description() const override {
-    return "ball catching of [L] VI.C (rendered free-running cameras, viewline tracker, catch planner, robot; "
-           "config/ball_catching.yaml)";
-  }
-  std::string appCommand(const std::string& config_path) const override {
-    return "ball_catching --config " + config_path + " --throws 100 --headless --summary ball_catching_summary.json";
-  }
-  std::string defaultMetric() const override { return "catch_rate_reachable"; }
-  bool defaultMinimize() const override { return false; }
-  std::vector<std::string> metricNames() const override {
-    return {"catch_rate_all", "catch_rate_reachable", "reachable_fraction", "prediction_error_mm_median",
-            "prediction_error_mm_p95", "prediction_error_lead_mm_median", "decision_time_s_median",
-            "miss_distance_mm_median_reachable", "gave_up_reachable_fraction", "detection_rate", "limit_violations",
-            "replay_fate_mismatch", "nis_mean", "nees_mean"};
-  }
-  std::vector<AdapterOption> options() const override {
-    return {{"throws", "10", {}, "throws per run (throw i from deriveSeed(seed, i), as ball_catching --throws)"},
-            {"burn_in", "4", {}, "fused images of a track before its innovations count in NIS"},
-            {"nees_fused", "8", {}, "the NEES sample of a throw is taken after this many fused images"}};
-  }
-  std::unique_ptr<ScenarioInstance> load(const YAML::Node& scenario, const std::string& name,
-                                         const AdapterOptions& options) const override {
-    scenarios::BallCatchingConfig cfg =
-        scenarios::loadBallCatchingConfig(io::ConfigNode::fromString(emitYaml(scenario), name));
+}  // namespace
+
+void registerBallCatchingAdapter(AdapterRegistry& registry) {
+  detail::AdapterInfo info;
+  info.name = "ball_catching";
+  info.description = "ball catching of [L] VI.C (rendered free-running cameras, viewline tracker, catch planner, robot; "
+                     "config/ball_catching.yaml)";
+  info.app = "ball_catching";
+  info.app_arguments = "--throws 100 --headless --summary ball_catching_summary.json";
+  info.default_metric = "catch_rate_reachable";
+  info.minimize = false;
+  info.metrics = {"catch_rate_all", "catch_rate_reachable", "reachable_fraction", "prediction_error_mm_median",
+                  "prediction_error_mm_p95", "prediction_error_lead_mm_median", "decision_time_s_median",
+                  "miss_distance_mm_median_reachable", "gave_up_reachable_fraction", "detection_rate", "limit_violations",
+                  "replay_fate_mismatch", "nis_mean", "nees_mean"};
+  info.options = {{"throws", "10", {}, "throws per run (throw i from deriveSeed(seed, i), as ball_catching --throws)"},
+                  {"burn_in", "4", {}, "fused images of a track before its innovations count in NIS"},
+                  {"nees_fused", "8", {}, "the NEES sample of a throw is taken after this many fused images"}};
+  registry.add(detail::makeAdapter(std::move(info), [](const std::string& yaml, const std::string& name,
+                                                       const AdapterOptions& options) {
+    scenarios::BallCatchingConfig cfg = scenarios::loadBallCatchingConfig(io::ConfigNode::fromString(yaml, name));
     CatchOptions o;
     const double throws = optionNumber(options, "throws");
     if (!(throws >= 1.0 && throws <= 1e5)) throw core::InvalidInput("adapter option 'throws': expected 1 to 1e5");
@@ -270,12 +263,8 @@ public:
     o.burn_in = static_cast<int>(optionNumber(options, "burn_in"));
     o.nees_fused = static_cast<int>(optionNumber(options, "nees_fused"));
     if (o.burn_in < 1 || o.nees_fused < 1) throw core::InvalidInput("adapter options burn_in, nees_fused: expected >= 1");
-    return std::make_unique<CatchInstance>(std::move(cfg), o);
-  }
-};
-
-}  // namespace
-
-void registerBallCatchingAdapter(AdapterRegistry& registry) { registry.add(std::make_unique<CatchAdapter>()); }
+    return std::unique_ptr<ScenarioInstance>(std::make_unique<CatchInstance>(std::move(cfg), o));
+  }));
+}
 
 }  // namespace viewline::tuning

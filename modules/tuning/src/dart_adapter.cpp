@@ -42,7 +42,6 @@
 #include "viewline/tracking/tracker.h"
 #include "viewline/tracking/viewline.h"
 #include "viewline/tuning/scenario.h"
-#include "viewline/tuning/yaml_edit.h"
 
 namespace viewline::tuning {
 
@@ -365,33 +364,28 @@ private:
   std::vector<core::Camera> cams_;
 };
 
-class DartAdapter final : public ScenarioAdapter {
-public:
-  std::string name() const override { return "dart"; }
-  std::string description() const override {
-    return "dart flights of [L] VI seen by the viewline tracker (measurement level; config/dart_tracking.yaml)";
-  }
-  std::string appCommand(const std::string& config_path) const override {
-    return "dart_tracking --config " + config_path + " --runs 500 --summary dart_summary.json";
-  }
-  std::string defaultMetric() const override { return "rmse_position_m"; }
-  std::vector<std::string> metricNames() const override {
-    return {"rmse_position_m", "final_error_m", "prediction_error_m", "nees_mean", "nis_mean",
-            "outlier_rejected_fraction", "inlier_rejected_fraction", "restarts_per_flight"};
-  }
-  std::vector<AdapterOption> options() const override {
-    return {{"flights", "50", {}, "throws per run"},
-            {"clock", "free_running", {"free_running", "alternating"},
-             "free-running unsynchronised cameras (the full scenario) or alternating 100 Hz steps ([L] VI.A)"},
-            {"outliers", "config", {"config", "none"}, "gross outliers at the config's outlier_rate, or none"},
-            {"assumed_pixel_noise_px", "0", {}, "> 0: pixel noise the tracker assumes (simulation keeps pixel_noise_px)"},
-            {"burn_in", "4", {}, "fused images of a track before its innovations count in NIS / likelihood"},
-            {"log_experiment", "A_alternating", {"A_alternating", "D_scenario"},
-             "which experiment of a dart_tracking --log folder the auto-tuner replays"}};
-  }
-  std::unique_ptr<ScenarioInstance> load(const YAML::Node& scenario, const std::string& name,
-                                         const AdapterOptions& options) const override {
-    DartScenarioConfig cfg = apps::dartScenarioFromString(emitYaml(scenario), name);
+}  // namespace
+
+void registerDartAdapter(AdapterRegistry& registry) {
+  detail::AdapterInfo info;
+  info.name = "dart";
+  info.description = "dart flights of [L] VI seen by the viewline tracker (measurement level; config/dart_tracking.yaml)";
+  info.app = "dart_tracking";
+  info.app_arguments = "--runs 500 --summary dart_summary.json";
+  info.default_metric = "rmse_position_m";
+  info.metrics = {"rmse_position_m", "final_error_m", "prediction_error_m", "nees_mean", "nis_mean",
+                  "outlier_rejected_fraction", "inlier_rejected_fraction", "restarts_per_flight"};
+  info.options = {{"flights", "50", {}, "throws per run"},
+                  {"clock", "free_running", {"free_running", "alternating"},
+                   "free-running unsynchronised cameras (the full scenario) or alternating 100 Hz steps ([L] VI.A)"},
+                  {"outliers", "config", {"config", "none"}, "gross outliers at the config's outlier_rate, or none"},
+                  {"assumed_pixel_noise_px", "0", {}, "> 0: pixel noise the tracker assumes (simulation keeps pixel_noise_px)"},
+                  {"burn_in", "4", {}, "fused images of a track before its innovations count in NIS / likelihood"},
+                  {"log_experiment", "A_alternating", {"A_alternating", "D_scenario"},
+                   "which experiment of a dart_tracking --log folder the auto-tuner replays"}};
+  registry.add(detail::makeAdapter(std::move(info), [](const std::string& yaml, const std::string& name,
+                                                       const AdapterOptions& options) {
+    DartScenarioConfig cfg = apps::dartScenarioFromString(yaml, name);
     DartOptions o;
     const double flights = optionNumber(options, "flights");
     if (!(flights >= 1.0 && flights <= 1e6)) throw core::InvalidInput("adapter option 'flights': expected 1 to 1e6");
@@ -405,12 +399,8 @@ public:
     o.log_experiment = optionText(options, "log_experiment");
     if (o.clock == tracking::ClockMode::Alternating && cfg.cameras.size() < 2)
       throw core::InvalidInput(name + ": adapter option clock: alternating needs two cameras");
-    return std::make_unique<DartInstance>(std::move(cfg), std::move(o));
-  }
-};
-
-}  // namespace
-
-void registerDartAdapter(AdapterRegistry& registry) { registry.add(std::make_unique<DartAdapter>()); }
+    return std::unique_ptr<ScenarioInstance>(std::make_unique<DartInstance>(std::move(cfg), std::move(o)));
+  }));
+}
 
 }  // namespace viewline::tuning

@@ -27,7 +27,6 @@
 #include "viewline/scenarios/mobile_capture.h"
 #include "viewline/scenarios/mobile_capture_display.h"
 #include "viewline/tuning/scenario.h"
-#include "viewline/tuning/yaml_edit.h"
 
 namespace viewline::tuning {
 
@@ -184,42 +183,32 @@ private:
   MobileOptions opt_;
 };
 
-class MobileAdapter final : public ScenarioAdapter {
-public:
-  std::string name() const override { return "mobile_capture"; }
-  std::string description() const override {
-    return "mobile capture of [K] (rendered head camera, curvilinear EKF, capture planner, grasp; "
-           "config/mobile_capture.yaml)";
-  }
-  std::string appCommand(const std::string& config_path) const override {
-    return "mobile_capture --config " + config_path + " --headless --summary mobile_capture_summary.json";
-  }
-  std::string defaultMetric() const override { return "capture_time_s"; }
-  std::vector<std::string> metricNames() const override {
-    return {"captured", "capture_time_s", "oracle_captured", "capture_time_ratio_to_oracle", "grasp_attempts",
-            "detection_rate", "longest_lost_s", "localization_rmse_mm", "estimate_rmse_mm", "nees_mean"};
-  }
-  std::vector<AdapterOption> options() const override {
-    return {{"max_time", "0", {}, "s, time limit of a chase (0: the config's world.max_time)"},
-            {"nees_spacing_s", "1", {}, "s between the 1-dof NEES samples (nearly independent)"},
-            {"settle_s", "2", {}, "s a track must have been valid before its NEES samples count"}};
-  }
-  std::unique_ptr<ScenarioInstance> load(const YAML::Node& scenario, const std::string& name,
-                                         const AdapterOptions& options) const override {
-    scenarios::MobileCaptureConfig cfg =
-        scenarios::loadMobileCaptureConfig(io::ConfigNode::fromString(emitYaml(scenario), name));
+}  // namespace
+
+void registerMobileCaptureAdapter(AdapterRegistry& registry) {
+  detail::AdapterInfo info;
+  info.name = "mobile_capture";
+  info.description = "mobile capture of [K] (rendered head camera, curvilinear EKF, capture planner, grasp; "
+                     "config/mobile_capture.yaml)";
+  info.app = "mobile_capture";
+  info.app_arguments = "--headless --summary mobile_capture_summary.json";
+  info.default_metric = "capture_time_s";
+  info.metrics = {"captured", "capture_time_s", "oracle_captured", "capture_time_ratio_to_oracle", "grasp_attempts",
+                  "detection_rate", "longest_lost_s", "localization_rmse_mm", "estimate_rmse_mm", "nees_mean"};
+  info.options = {{"max_time", "0", {}, "s, time limit of a chase (0: the config's world.max_time)"},
+                  {"nees_spacing_s", "1", {}, "s between the 1-dof NEES samples (nearly independent)"},
+                  {"settle_s", "2", {}, "s a track must have been valid before its NEES samples count"}};
+  registry.add(detail::makeAdapter(std::move(info), [](const std::string& yaml, const std::string& name,
+                                                       const AdapterOptions& options) {
+    scenarios::MobileCaptureConfig cfg = scenarios::loadMobileCaptureConfig(io::ConfigNode::fromString(yaml, name));
     MobileOptions o;
     o.max_time = optionNumber(options, "max_time");
     o.nees_spacing = optionNumber(options, "nees_spacing_s");
     o.settle = optionNumber(options, "settle_s");
     if (!(o.max_time >= 0.0) || !(o.nees_spacing > 0.0) || !(o.settle >= 0.0))
       throw core::InvalidInput("mobile_capture adapter options: max_time >= 0, nees_spacing_s > 0, settle_s >= 0");
-    return std::make_unique<MobileInstance>(std::move(cfg), o);
-  }
-};
-
-}  // namespace
-
-void registerMobileCaptureAdapter(AdapterRegistry& registry) { registry.add(std::make_unique<MobileAdapter>()); }
+    return std::unique_ptr<ScenarioInstance>(std::make_unique<MobileInstance>(std::move(cfg), o));
+  }));
+}
 
 }  // namespace viewline::tuning

@@ -36,7 +36,6 @@
 #include "viewline/scenarios/pan_tilt_display.h"
 #include "viewline/scenarios/pan_tilt_scenario.h"
 #include "viewline/tuning/scenario.h"
-#include "viewline/tuning/yaml_edit.h"
 
 namespace viewline::tuning {
 
@@ -344,30 +343,24 @@ private:
   double r_scale_ = 1.0;
 };
 
-class PanTiltAdapter final : public ScenarioAdapter {
-public:
-  std::string name() const override { return "pan_tilt"; }
-  std::string description() const override {
-    return "pan-tilt tracking of [T] (rendered screen target, predictive controller; config/pan_tilt_*.yaml)";
-  }
-  std::string appCommand(const std::string& config_path) const override {
-    return "pan_tilt_tracking --config " + config_path + " --headless --summary pan_tilt_summary.json";
-  }
-  std::string defaultMetric() const override { return "image_error_rms_px"; }
-  std::vector<std::string> metricNames() const override {
-    return {"image_error_rms_px", "image_error_max_px", "rmse_filtered_cm", "rmse_filtered_x_cm", "rmse_filtered_y_cm",
-            "rmse_measured_cm", "reacquisition_delay_s", "nis_mean", "nees_mean"};
-  }
-  std::vector<AdapterOption> options() const override {
-    return {{"duration", "0", {}, "s of each run (0: the config's run.duration)"},
-            {"burn_in", "5", {}, "accepted measurements of a track before its innovations count"},
-            {"nees_spacing_s", "2", {}, "s between NEES samples (nearly independent)"},
-            {"log_seed", "1", {}, "seed of a pan_tilt_tracking --log run (its path amplitude gives R)"}};
-  }
-  std::unique_ptr<ScenarioInstance> load(const YAML::Node& scenario, const std::string& name,
-                                         const AdapterOptions& options) const override {
-    scenarios::PanTiltScenarioConfig cfg =
-        scenarios::loadPanTiltScenarioConfig(io::ConfigNode::fromString(emitYaml(scenario), name));
+}  // namespace
+
+void registerPanTiltAdapter(AdapterRegistry& registry) {
+  detail::AdapterInfo info;
+  info.name = "pan_tilt";
+  info.description = "pan-tilt tracking of [T] (rendered screen target, predictive controller; config/pan_tilt_*.yaml)";
+  info.app = "pan_tilt_tracking";
+  info.app_arguments = "--headless --summary pan_tilt_summary.json";
+  info.default_metric = "image_error_rms_px";
+  info.metrics = {"image_error_rms_px", "image_error_max_px", "rmse_filtered_cm", "rmse_filtered_x_cm", "rmse_filtered_y_cm",
+                  "rmse_measured_cm", "reacquisition_delay_s", "nis_mean", "nees_mean"};
+  info.options = {{"duration", "0", {}, "s of each run (0: the config's run.duration)"},
+                  {"burn_in", "5", {}, "accepted measurements of a track before its innovations count"},
+                  {"nees_spacing_s", "2", {}, "s between NEES samples (nearly independent)"},
+                  {"log_seed", "1", {}, "seed of a pan_tilt_tracking --log run (its path amplitude gives R)"}};
+  registry.add(detail::makeAdapter(std::move(info), [](const std::string& yaml, const std::string& name,
+                                                       const AdapterOptions& options) {
+    scenarios::PanTiltScenarioConfig cfg = scenarios::loadPanTiltScenarioConfig(io::ConfigNode::fromString(yaml, name));
     PanTiltOptions o;
     o.duration = optionNumber(options, "duration");
     if (!(o.duration >= 0.0)) throw core::InvalidInput("adapter option 'duration': expected >= 0");
@@ -376,12 +369,8 @@ public:
     o.log_seed = static_cast<std::uint64_t>(optionNumber(options, "log_seed"));
     if (o.burn_in < 1 || !(o.nees_spacing > 0.0)) throw core::InvalidInput("adapter options burn_in >= 1, nees_spacing_s > 0");
     cfg.validate();
-    return std::make_unique<PanTiltInstance>(std::move(cfg), o, 1.0);
-  }
-};
-
-}  // namespace
-
-void registerPanTiltAdapter(AdapterRegistry& registry) { registry.add(std::make_unique<PanTiltAdapter>()); }
+    return std::unique_ptr<ScenarioInstance>(std::make_unique<PanTiltInstance>(std::move(cfg), o, 1.0));
+  }));
+}
 
 }  // namespace viewline::tuning

@@ -39,7 +39,6 @@
 #include "viewline/scenarios/table_ball_display.h"
 #include "viewline/scenarios/table_ball_observer.h"
 #include "viewline/tuning/scenario.h"
-#include "viewline/tuning/yaml_edit.h"
 
 namespace viewline::tuning {
 
@@ -335,42 +334,33 @@ private:
   TableBallOptions opt_;
 };
 
-class TableBallAdapter final : public ScenarioAdapter {
-public:
-  std::string name() const override { return "table_ball"; }
-  std::string description() const override {
-    return "table-ball balancing of [M] (rendered table and ball, rolling-ball observer, LQR; config/table_ball.yaml)";
-  }
-  std::string appCommand(const std::string& config_path) const override {
-    return "table_ball_balancing --config " + config_path + " --headless --summary table_ball_summary.json";
-  }
-  std::string defaultMetric() const override { return "observer_rmse_mm"; }
-  std::vector<std::string> metricNames() const override {
-    return {"observer_rmse_mm", "measurement_rmse_mm", "prediction_rmse_mm_10", "tilt_rmse_deg", "overshoot_pct",
-            "settling_time_s", "steady_state_error_mm", "push_recovery_s", "max_commanded_angle_deg",
-            "limits_respected", "ball_detection_rate", "observer_rmse_mm_M_sw1_sv0005", "observer_rmse_mm_M_sw1_sv1",
-            "observer_rmse_mm_stationary", "nis_mean", "nees_mean"};
-  }
-  std::vector<AdapterOption> options() const override {
-    return {{"duration", "0", {}, "s of each run (0: the config's duration)"},
-            {"burn_in", "5", {}, "ball measurements of the track before its innovations count"},
-            {"nees_spacing_s", "0.5", {}, "s between NEES samples (nearly independent)"}};
-  }
-  std::unique_ptr<ScenarioInstance> load(const YAML::Node& scenario, const std::string& name,
-                                         const AdapterOptions& options) const override {
-    scenarios::TableBallConfig cfg = scenarios::tableBallConfigFromYaml(io::ConfigNode::fromString(emitYaml(scenario), name));
+}  // namespace
+
+void registerTableBallAdapter(AdapterRegistry& registry) {
+  detail::AdapterInfo info;
+  info.name = "table_ball";
+  info.description = "table-ball balancing of [M] (rendered table and ball, rolling-ball observer, LQR; config/table_ball.yaml)";
+  info.app = "table_ball_balancing";
+  info.app_arguments = "--headless --summary table_ball_summary.json";
+  info.default_metric = "observer_rmse_mm";
+  info.metrics = {"observer_rmse_mm", "measurement_rmse_mm", "prediction_rmse_mm_10", "tilt_rmse_deg", "overshoot_pct",
+                  "settling_time_s", "steady_state_error_mm", "push_recovery_s", "max_commanded_angle_deg",
+                  "limits_respected", "ball_detection_rate", "observer_rmse_mm_M_sw1_sv0005", "observer_rmse_mm_M_sw1_sv1",
+                  "observer_rmse_mm_stationary", "nis_mean", "nees_mean"};
+  info.options = {{"duration", "0", {}, "s of each run (0: the config's duration)"},
+                  {"burn_in", "5", {}, "ball measurements of the track before its innovations count"},
+                  {"nees_spacing_s", "0.5", {}, "s between NEES samples (nearly independent)"}};
+  registry.add(detail::makeAdapter(std::move(info), [](const std::string& yaml, const std::string& name,
+                                                       const AdapterOptions& options) {
+    scenarios::TableBallConfig cfg = scenarios::tableBallConfigFromYaml(io::ConfigNode::fromString(yaml, name));
     TableBallOptions o;
     o.duration = optionNumber(options, "duration");
     o.burn_in = static_cast<int>(optionNumber(options, "burn_in"));
     o.nees_spacing = optionNumber(options, "nees_spacing_s");
     if (!(o.duration >= 0.0) || o.burn_in < 1 || !(o.nees_spacing > 0.0))
       throw core::InvalidInput("table_ball adapter options: duration >= 0, burn_in >= 1, nees_spacing_s > 0");
-    return std::make_unique<TableBallInstance>(std::move(cfg), o);
-  }
-};
-
-}  // namespace
-
-void registerTableBallAdapter(AdapterRegistry& registry) { registry.add(std::make_unique<TableBallAdapter>()); }
+    return std::unique_ptr<ScenarioInstance>(std::make_unique<TableBallInstance>(std::move(cfg), o));
+  }));
+}
 
 }  // namespace viewline::tuning
