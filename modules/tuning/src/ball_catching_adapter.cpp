@@ -29,6 +29,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <optional>
 
 #include "adapter_util.h"
 #include "viewline/core/error.h"
@@ -180,6 +181,8 @@ private:
     const bool keep_traj = series != nullptr && tr.index < 5;
     Curve err{"throw " + std::to_string(tr.index), {}, {}}, tru{"truth", {}, {}}, est{"estimate", {}, {}};
     int fused_count = 0;
+    std::optional<estimation::StateEstimate> half_state;  // the prediction drawn: from mid-flight on
+    std::vector<double> est_t;
     for (const LoggedMeasurement& lm : list) {
       if (lm.m.camera >= cams.size()) throw core::InvalidInput("ball_catching replay: camera index beyond the cameras seen");
       const detail::ViewlineInnovation inn = detail::viewlineInnovation(tracker, cams, cfg_.tracker, lm.m, opt_.burn_in);
@@ -219,15 +222,25 @@ private:
         tru.y.push_back(xt(1));
         est.x.push_back(s.x()(0));
         est.y.push_back(s.x()(1));
+        est_t.push_back(s.t());
+        if (!half_state && 2 * fused_count >= tr.fused) half_state = s;
       }
     }
     if (series == nullptr) return;
     if (truth && !err.x.empty()) series->error.push_back(err);
     if (truth && !tru.x.empty()) series->truth.push_back(tru);
     if (!est.x.empty()) series->estimate.push_back(est);
-    if (keep_traj && tr.had_target) {
-      // The planner's final crossing target (a point on the box plane) as the "prediction".
-      series->prediction.push_back({"planner target", {tr.target.x()}, {tr.target.y()}});
+    if (half_state && half_state->dim() == 6) {
+      // The tracker's own (drag-free ballistic) model rolled forward from its mid-flight state.
+      Curve pre{"prediction from mid-flight", {}, {}};
+      const tracking::Vector6 x0 = half_state->x();
+      for (double t : est_t) {
+        if (t < half_state->t()) continue;
+        const tracking::Vector6 xp = cfg_.tracker.model.propagate(x0, t - half_state->t());
+        pre.x.push_back(xp(0));
+        pre.y.push_back(xp(1));
+      }
+      if (!pre.x.empty()) series->prediction.push_back(pre);
     }
   }
 
