@@ -128,6 +128,15 @@ ViewlineInnovation viewlineInnovation(const tracking::ViewlineTracker& tracker, 
   return r;
 }
 
+ReplayResult replayResult(double cost, std::size_t terms, const Consistency& nis, std::shared_ptr<RunSeries> series) {
+  ReplayResult r;
+  r.cost = cost;
+  r.terms = terms;
+  r.nis = nis;
+  r.series = std::move(series);
+  return r;
+}
+
 namespace {
 
 class InfoAdapter final : public ScenarioAdapter {

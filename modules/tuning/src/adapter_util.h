@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "viewline/core/camera.h"
+#include "viewline/core/error.h"
 #include "viewline/tracking/tracker.h"
 #include "viewline/tuning/scenario.h"
 
@@ -84,6 +85,21 @@ struct ViewlineInnovation {
 ViewlineInnovation viewlineInnovation(const tracking::ViewlineTracker& tracker, const std::vector<core::Camera>& cameras,
                                       const tracking::TrackerConfig& config, const tracking::ImageMeasurement& m,
                                       int burn_in);
+
+/// The checked input of a ScenarioInstance::replay: the data were recorded by this adapter (type
+/// D) and `noise` holds `count` values; throws core::InvalidInput naming `scenario` otherwise.
+template <class D>
+const D& replayInput(const ReplayData& data, const std::vector<double>& noise, std::size_t count,
+                     const std::string& scenario) {
+  const auto* d = dynamic_cast<const D*>(&data);
+  if (d == nullptr) throw core::InvalidInput(scenario + " replay: data of another scenario");
+  if (noise.size() != count)
+    throw core::InvalidInput(scenario + " replay: expected " + std::to_string(count) + " noise values");
+  return *d;
+}
+
+/// A replay's result from its accumulated cost, terms and NIS.
+ReplayResult replayResult(double cost, std::size_t terms, const Consistency& nis, std::shared_ptr<RunSeries> series);
 
 /// What the tuning tool shows and checks about an adapter (see ScenarioAdapter).
 struct AdapterInfo {

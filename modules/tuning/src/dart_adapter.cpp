@@ -195,22 +195,15 @@ public:
 
   ReplayResult replay(const ReplayData& data, const std::vector<double>& noise, double outlier_prior,
                       bool want_series) const override {
-    const auto* d = dynamic_cast<const DartReplayData*>(&data);
-    if (d == nullptr) throw core::InvalidInput("dart replay: data of another scenario");
-    if (noise.size() != 2) throw core::InvalidInput("dart replay: expected (q, sigma_px)");
+    const DartReplayData& d = detail::replayInput<DartReplayData>(data, noise, 2, "dart");
     Accum a;
     std::shared_ptr<RunSeries> series;
     if (want_series) series = makeSeries();
     RunOptions ro;
-    for (std::size_t f = 0; f < d->flights.size(); ++f)
-      processFlight(d->flights[f], static_cast<int>(f), noise[0], noise[1], outlier_prior, a, series.get(), nullptr,
+    for (std::size_t f = 0; f < d.flights.size(); ++f)
+      processFlight(d.flights[f], static_cast<int>(f), noise[0], noise[1], outlier_prior, a, series.get(), nullptr,
                     nullptr, ro);
-    ReplayResult r;
-    r.cost = a.cost;
-    r.terms = a.terms;
-    r.nis = a.nis;
-    r.series = series;
-    return r;
+    return detail::replayResult(a.cost, a.terms, a.nis, series);
   }
 
   std::unique_ptr<ScenarioInstance> withNoise(const std::vector<double>& noise) const override {

@@ -219,19 +219,12 @@ public:
 
   ReplayResult replay(const ReplayData& data, const std::vector<double>& noise, double outlier_prior,
                       bool want_series) const override {
-    const auto* d = dynamic_cast<const PanTiltReplayData*>(&data);
-    if (d == nullptr) throw core::InvalidInput("pan-tilt replay: data of another scenario");
-    if (noise.size() != 2) throw core::InvalidInput("pan-tilt replay: expected (q, R_scale)");
+    const PanTiltReplayData& d = detail::replayInput<PanTiltReplayData>(data, noise, 2, "pan-tilt");
     Accum a;
     std::shared_ptr<RunSeries> series;
     if (want_series) series = makeSeries();
-    for (const auto& rec : d->runs) replayRun(rec, noise[0], noise[1], outlier_prior, a, series.get(), nullptr, {});
-    ReplayResult r;
-    r.cost = a.cost;
-    r.terms = a.terms;
-    r.nis = a.nis;
-    r.series = series;
-    return r;
+    for (const auto& rec : d.runs) replayRun(rec, noise[0], noise[1], outlier_prior, a, series.get(), nullptr, {});
+    return detail::replayResult(a.cost, a.terms, a.nis, series);
   }
 
   std::unique_ptr<ScenarioInstance> withNoise(const std::vector<double>& noise) const override {

@@ -174,19 +174,12 @@ public:
 
   ReplayResult replay(const ReplayData& data, const std::vector<double>& noise, double outlier_prior,
                       bool want_series) const override {
-    const auto* d = dynamic_cast<const TableBallReplayData*>(&data);
-    if (d == nullptr) throw core::InvalidInput("table_ball replay: data of another scenario");
-    if (noise.size() != 2) throw core::InvalidInput("table_ball replay: expected (sigma_w, sigma_v)");
+    const TableBallReplayData& d = detail::replayInput<TableBallReplayData>(data, noise, 2, "table_ball");
     Accum a;
     std::shared_ptr<RunSeries> series;
     if (want_series) series = makeSeries();
-    for (const auto& run : d->runs) replayRun(run, noise[0], noise[1], outlier_prior, a, series.get(), nullptr);
-    ReplayResult r;
-    r.cost = a.cost;
-    r.terms = a.terms;
-    r.nis = a.nis;
-    r.series = series;
-    return r;
+    for (const auto& run : d.runs) replayRun(run, noise[0], noise[1], outlier_prior, a, series.get(), nullptr);
+    return detail::replayResult(a.cost, a.terms, a.nis, series);
   }
 
   std::unique_ptr<ScenarioInstance> withNoise(const std::vector<double>& noise) const override {
