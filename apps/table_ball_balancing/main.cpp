@@ -57,11 +57,18 @@ int main(int argc, char** argv) {
     };
     const scenarios::TableBallResult r = scenarios::runTableBall(cfg, seed, hooks);
     std::fprintf(stderr, "\n");
-    const nlohmann::json j = scenarios::toJson(r);
+    nlohmann::json j = scenarios::toJson(r);
+    j["rig"] = cfg.rig ? nlohmann::json(cfg.rig->folder) : nlohmann::json(nullptr);
     if (!summary_path.empty()) io::writeJsonFile(summary_path, j);
     std::printf("table_ball_balancing: %.1f s, seed %llu, %d frames (%d dropped), table found %d, ball found %d\n",
                 r.duration, static_cast<unsigned long long>(r.seed), r.frames, r.frames_dropped, r.table_detections,
                 r.ball_detections);
+    if (cfg.rig) {
+      std::printf("  camera: rig %s (renders with truth.yaml; the observer uses rig.yaml + ground.yaml)\n",
+                  cfg.rig->folder.c_str());
+    } else {
+      std::printf("  camera: inline config keys (one perfect camera)\n");
+    }
     std::printf("  observer RMSE %.2f mm (measurements %.2f mm); [M] tunings: sw=1,sv=0.005 %.2f mm, sw=sv=1 %.2f mm; "
                 "stationary gain %.2f mm\n",
                 r.observer_rmse_mm, r.measurement_rmse_mm, r.observer_rmse_mm_M_sw1_sv0005, r.observer_rmse_mm_M_sw1_sv1,

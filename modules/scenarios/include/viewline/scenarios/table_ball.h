@@ -14,6 +14,15 @@
 // observer (with optional noise `ground_rotation_noise_deg`, as from an IMU or the neck joints).
 // Frames are rendered by sim::CameraRig (sensor noise, motion blur, dropped frames).
 //
+// Camera parameters (issue 9). Inline camera keys (width, height, hfov_deg, position, look_at):
+// the renderer and the observer share one perfect camera. With `rig: <folder>` (a default
+// simulated rig, calib/rigs/table): the renderer uses the TRUE head camera of truth.yaml
+// (intrinsics, distortion, rest pose) and the observer the CALIBRATED one: rig.yaml's intrinsics,
+// and its rest-pose rotation to the ground from ground.yaml (g_R_c, camera-to-ground from floor
+// board images). The head's sway is measured (neck joints / IMU), so the observer's camera at
+// frame k is  c_M_w_obs(t) = D(t) · c_M_w_cal  with D(t) = c_M_w_true(t) · c_M_w_true(0)⁻¹ the true
+// sway (plus the ground_rotation_noise); the calibration error stays in every frame.
+//
 // Loop timing (one 1 ms physics tick): frame k is captured at t_k (middle of the exposure),
 // processed once the exposure is over, and the controller's tilt ramp starts at
 // t_k + latency; the arm's trajectory interpolator sends the ramp to the wrist as 1 kHz
@@ -44,6 +53,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 #include <string>
@@ -54,9 +64,13 @@
 #include "viewline/io/config.h"
 #include "viewline/robots/table_tilt.h"
 #include "viewline/scenarios/table_ball_observer.h"
+#include "viewline/vision/apriltag_detector.h"
 
 namespace viewline::io {
 class LogDirectory;
+}
+namespace viewline::sim {
+class TableWorld;
 }
 
 namespace viewline::scenarios {
@@ -96,6 +110,14 @@ struct TableBallConfig {
   int blur_samples = 3;
   double drop_probability = 0.0;
   int supersampling = 3;
+  /// Calibrated rig (key `rig`): when set, it replaces width, height, hfov, camera_position and
+  /// camera_look_at (see the header comment).
+  struct RigCameras {
+    std::string folder;
+    core::Camera truth;       ///< renders; c_M_w = rest pose (before the sway)
+    core::Camera calibrated;  ///< the observer's; c_M_w = calibrated rest pose, rotation from ground.yaml
+  };
+  std::optional<RigCameras> rig;
   // Observer, controller
   TableBallObserverConfig observer;
   bool border_aware_pnp = true;                                ///< correct the PnP for the border occlusion
@@ -118,7 +140,18 @@ struct TableBallConfig {
 };
 
 /// Reads the YAML scenario (documented in config/table_ball.yaml); unknown keys are errors.
+/// `rig:` (a folder relative to the config file) loads the rig's truth.yaml, rig.yaml and
+/// ground.yaml; with it the inline camera geometry keys are errors (one source of truth).
 TableBallConfig tableBallConfigFromYaml(const io::ConfigNode& root);
+
+/// Loads the head camera of a table rig folder: truth.yaml (renders), rig.yaml (calibrated
+/// intrinsics and rest pose) and ground.yaml (calibrated camera-to-ground rotation g_R_c, which
+/// must agree with rig.yaml's within 0.01°). Errors name the file.
+TableBallConfig::RigCameras loadTableRig(const std::string& folder);
+
+/// The AprilTag layout of the simulated table (tags ids, sizes, and their poses in the table frame
+/// in vpDetectorAprilTag's tag frame: sim::TableWorld::table_M_vispTag).
+std::vector<vision::TagOnTable> tableTagLayout(const sim::TableWorld& world);
 
 struct StepMetrics {
   double t = 0.0;
