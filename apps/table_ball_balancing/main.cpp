@@ -79,6 +79,9 @@ int main(int argc, char** argv) {
                 r.overshoot_pct, r.settling_time_s, r.steady_state_error_mm, r.push_recovery_s);
     std::printf("  frame cost: observer %.3f ms, plain OpenCV reference %.3f ms, ratio %.3f\n", r.observer_frame_ms,
                 r.reference_frame_ms, r.frame_time_ratio_to_reference);
+    std::printf("  fast path (edge tracking) on %d of %d frames\n", r.tracked_frames, r.frames);
+    std::printf("  frame CPU time (this thread): observer %.3f ms, reference %.3f ms, ratio %.3f\n",
+                r.observer_frame_cpu_ms, r.reference_frame_cpu_ms, r.frame_cpu_ratio_to_reference);
     std::printf("  commands: max |tilt| %.2f deg, max rate %.1f deg/s, limits %s; wall %.1f s\n",
                 r.max_commanded_angle_deg, r.max_commanded_rate_deg_s, r.limits_respected ? "respected" : "VIOLATED",
                 r.wall_seconds);

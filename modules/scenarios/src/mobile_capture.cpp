@@ -4,6 +4,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <filesystem>
 #include <mutex>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -289,7 +290,7 @@ MobileCaptureConfig loadMobileCaptureConfig(const io::ConfigNode& root) {
 MobileCaptureConfig::RigCameras loadMobileRig(const std::string& folder, const robots::MobilePanTiltParams& head_params) {
   const SimulatedRig rig = loadSimulatedRig(folder);
   MobileCaptureConfig::RigCameras out;
-  out.folder = rig.folder;
+  out.folder = std::filesystem::path(rig.folder).lexically_normal().string();
   out.truth = rig.trueCamera("head");
   out.calibrated = rig.calibratedCamera("head");
   const Eigen::Matrix3d g_R_c = loadGroundRotation(rig, "head");  // checked against rig.yaml

@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <chrono>
+#include <ctime>
 #include <cmath>
+#include <filesystem>
 #include <limits>
 #include <optional>
 #include <sstream>
@@ -59,6 +61,14 @@ struct HeadSway {
 };
 
 double rms(double sum_sq, int n) { return n > 0 ? std::sqrt(sum_sq / n) : kNaN; }
+
+/// CPU time of the calling thread, s (the observer and the reference run on it, one after the
+/// other; unlike wall time it does not count the time the thread waits for a core).
+double threadCpuSeconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
 
 struct TrackAccumulator {
   double sum_sq = 0.0;
@@ -250,7 +260,7 @@ TableBallConfig tableBallConfigFromYaml(const io::ConfigNode& root) {
 TableBallConfig::RigCameras loadTableRig(const std::string& folder) {
   const SimulatedRig rig = loadSimulatedRig(folder);
   TableBallConfig::RigCameras out;
-  out.folder = rig.folder;
+  out.folder = std::filesystem::path(rig.folder).lexically_normal().string();
   out.truth = rig.trueCamera("head");
   out.calibrated = rig.calibratedCamera("head");
   // ground.yaml (camera-to-ground): the calibrated rotation of the head at rest to the ground
@@ -280,6 +290,7 @@ nlohmann::json toJson(const TableBallResult& r) {
   j["frames_dropped"] = r.frames_dropped;
   j["table_detections"] = r.table_detections;
   j["ball_detections"] = r.ball_detections;
+  j["tracked_frames"] = r.tracked_frames;
   j["observer_rmse_mm"] = num(r.observer_rmse_mm);
   j["measurement_rmse_mm"] = num(r.measurement_rmse_mm);
   j["tunings"] = {{"M_sigma_w_1_sigma_v_0.005_rmse_mm", num(r.observer_rmse_mm_M_sw1_sv0005)},
@@ -295,6 +306,9 @@ nlohmann::json toJson(const TableBallResult& r) {
   j["frame_time_ratio_to_reference"] = num(r.frame_time_ratio_to_reference);
   j["observer_frame_ms"] = num(r.observer_frame_ms);
   j["reference_frame_ms"] = num(r.reference_frame_ms);
+  j["frame_cpu_ratio_to_reference"] = num(r.frame_cpu_ratio_to_reference);
+  j["observer_frame_cpu_ms"] = num(r.observer_frame_cpu_ms);
+  j["reference_frame_cpu_ms"] = num(r.reference_frame_cpu_ms);
   j["max_commanded_angle_deg"] = r.max_commanded_angle_deg;
   j["max_commanded_rate_deg_s"] = r.max_commanded_rate_deg_s;
   j["limits_respected"] = r.limits_respected;
@@ -499,7 +513,7 @@ TableBallResult runTableBall(const TableBallConfig& cfg_in, std::uint64_t seed, 
   std::vector<std::pair<double, Eigen::Vector2d>> pending_pred;  // (time, predicted position 10 frames ahead)
   double nis_sum = 0.0;
   int nis_n = 0;
-  double obs_time = 0.0, ref_time = 0.0;
+  double obs_time = 0.0, ref_time = 0.0, obs_cpu = 0.0, ref_cpu = 0.0;
   int timed = 0;
   double next_progress = 0.0;
   core::Camera view_camera = obs_camera;
@@ -530,7 +544,9 @@ TableBallResult runTableBall(const TableBallConfig& cfg_in, std::uint64_t seed, 
                     .toRotationMatrix() * c_R_w;
       }
       const Eigen::Isometry3d c_M_t_nominal = obs_c_M_w * w_M_t_nominal;
+      const double c0 = threadCpuSeconds();
       of = &observer.process(frame->image, t, c_R_w, c_M_t_nominal);
+      const double c1 = threadCpuSeconds();
       if (cfg.time_reference) {
         const auto r0 = std::chrono::steady_clock::now();
         const vision::TableScene rs = vision::referenceTableScene(frame->image, t, obs_camera, ref_det, c_M_t_nominal);
@@ -543,13 +559,16 @@ TableBallResult runTableBall(const TableBallConfig& cfg_in, std::uint64_t seed, 
         }
         if (ref_tracker.initialized() || ry) ref_tracker.step(t, ra, ry);
         ref_time += std::chrono::duration<double>(std::chrono::steady_clock::now() - r0).count();
+        ref_cpu += threadCpuSeconds() - c1;
         obs_time += of->seconds;
+        obs_cpu += c1 - c0;
         ++timed;
       }
     } else {
       ++res.frames_dropped;
       of = &observer.predictOnly(t);
     }
+    if (of->tracked) ++res.tracked_frames;
     if (of->table_found) ++res.table_detections;
     if (of->ball_found) ++res.ball_detections;
     const std::optional<Eigen::Vector2d> y = of->ball_found ? std::optional<Eigen::Vector2d>(of->measured) : std::nullopt;
@@ -634,8 +653,12 @@ TableBallResult runTableBall(const TableBallConfig& cfg_in, std::uint64_t seed, 
     res.observer_frame_ms = 1000.0 * obs_time / timed;
     res.reference_frame_ms = 1000.0 * ref_time / timed;
     res.frame_time_ratio_to_reference = obs_time / ref_time;
+    res.observer_frame_cpu_ms = 1000.0 * obs_cpu / timed;
+    res.reference_frame_cpu_ms = 1000.0 * ref_cpu / timed;
+    res.frame_cpu_ratio_to_reference = obs_cpu / ref_cpu;
   } else {
     res.observer_frame_ms = res.reference_frame_ms = res.frame_time_ratio_to_reference = kNaN;
+    res.observer_frame_cpu_ms = res.reference_frame_cpu_ms = res.frame_cpu_ratio_to_reference = kNaN;
   }
 
   // Event windows: each event is scored up to the next event (set-point change or push).
