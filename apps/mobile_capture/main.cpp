@@ -85,6 +85,12 @@ int main(int argc, char** argv) {
     const auto j = nlohmann::json::parse(json);
     std::printf("mobile_capture: %d runs, seed %llu, %.0f s wall\n", runs, static_cast<unsigned long long>(seed),
                 summary.wall_time);
+    if (cfg.rig) {
+      std::printf("  camera: rig %s (renders with truth.yaml; estimators use rig.yaml + ground.yaml)\n",
+                  cfg.rig->folder.c_str());
+    } else {
+      std::printf("  camera: inline config keys (one perfect camera)\n");
+    }
     std::printf("  capture success %.3f (oracle %.3f); time median %.1f s, p95 %.1f s; oracle median %.1f s\n",
                 summary.success_rate, summary.oracle_success_rate, summary.time_median, summary.time_p95,
                 summary.oracle_time_median);

@@ -57,11 +57,18 @@ int main(int argc, char** argv) {
     };
     const scenarios::TableBallResult r = scenarios::runTableBall(cfg, seed, hooks);
     std::fprintf(stderr, "\n");
-    const nlohmann::json j = scenarios::toJson(r);
+    nlohmann::json j = scenarios::toJson(r);
+    j["rig"] = cfg.rig ? nlohmann::json(cfg.rig->folder) : nlohmann::json(nullptr);
     if (!summary_path.empty()) io::writeJsonFile(summary_path, j);
     std::printf("table_ball_balancing: %.1f s, seed %llu, %d frames (%d dropped), table found %d, ball found %d\n",
                 r.duration, static_cast<unsigned long long>(r.seed), r.frames, r.frames_dropped, r.table_detections,
                 r.ball_detections);
+    if (cfg.rig) {
+      std::printf("  camera: rig %s (renders with truth.yaml; the observer uses rig.yaml + ground.yaml)\n",
+                  cfg.rig->folder.c_str());
+    } else {
+      std::printf("  camera: inline config keys (one perfect camera)\n");
+    }
     std::printf("  observer RMSE %.2f mm (measurements %.2f mm); [M] tunings: sw=1,sv=0.005 %.2f mm, sw=sv=1 %.2f mm; "
                 "stationary gain %.2f mm\n",
                 r.observer_rmse_mm, r.measurement_rmse_mm, r.observer_rmse_mm_M_sw1_sv0005, r.observer_rmse_mm_M_sw1_sv1,
@@ -72,6 +79,9 @@ int main(int argc, char** argv) {
                 r.overshoot_pct, r.settling_time_s, r.steady_state_error_mm, r.push_recovery_s);
     std::printf("  frame cost: observer %.3f ms, plain OpenCV reference %.3f ms, ratio %.3f\n", r.observer_frame_ms,
                 r.reference_frame_ms, r.frame_time_ratio_to_reference);
+    std::printf("  fast path (edge tracking) on %d of %d frames\n", r.tracked_frames, r.frames);
+    std::printf("  frame CPU time (this thread): observer %.3f ms, reference %.3f ms, ratio %.3f\n",
+                r.observer_frame_cpu_ms, r.reference_frame_cpu_ms, r.frame_cpu_ratio_to_reference);
     std::printf("  commands: max |tilt| %.2f deg, max rate %.1f deg/s, limits %s; wall %.1f s\n",
                 r.max_commanded_angle_deg, r.max_commanded_rate_deg_s, r.limits_respected ? "respected" : "VIOLATED",
                 r.wall_seconds);

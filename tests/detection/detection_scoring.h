@@ -149,12 +149,8 @@ inline TableScores scoreTable(int n, std::uint64_t seed, bool refine = true,
   cfg.border_height_m = look.border_height;  // the sim's raised black borders
   vision::TableDetector det(cam, cfg);
   std::vector<vision::TagOnTable> layout;
-  // sim's tag frame has z into the table; vpDetectorAprilTag's pose frame has z out of the tag
-  // (towards the viewer): they differ by a half turn about x.
-  Eigen::Isometry3d sim_M_visp = Eigen::Isometry3d::Identity();
-  sim_M_visp.linear() = core::rotation(Eigen::Vector3d::UnitX(), core::kPi);
-  for (int i = 0; i < 4; ++i)
-    layout.push_back({look.first_tag_id + i, look.tag_size, world.table_M_tag(i) * sim_M_visp});
+  // vpDetectorAprilTag's tag frame (z out of the tag), not the simulator's (z into the table).
+  for (int i = 0; i < 4; ++i) layout.push_back({look.first_tag_id + i, look.tag_size, world.table_M_vispTag(i)});
   vision::AprilTagTableDetector tags(cam, layout);
   sim::Renderer renderer;
   TableScores s;

@@ -80,3 +80,28 @@ TEST(TableBallScenario, ConfigErrorsNameTheKey) {
     EXPECT_NE(std::string(e.what()).find("events.setpoints[0].xy"), std::string::npos) << e.what();
   }
 }
+
+TEST(TableBallScenario, ShippedConfigRunsOnTheCalibratedRig) {
+  const scenarios::TableBallConfig c = scenarios::tableBallConfigFromYaml(io::ConfigNode::loadFile("config/table_ball.yaml"));
+  ASSERT_TRUE(c.rig.has_value());
+  const core::Camera& truth = c.rig->truth;
+  const core::Camera& cal = c.rig->calibrated;
+  EXPECT_EQ(truth.width, 320u);
+  EXPECT_EQ(c.width, 320u);
+  EXPECT_DOUBLE_EQ(truth.intrinsics.get_px(), 160.0);  // [M]'s camera, 90° horizontal field of view
+  // Calibrated, not copied: close to the truth, not equal.
+  EXPECT_NE(cal.intrinsics.get_px(), truth.intrinsics.get_px());
+  EXPECT_LT(std::abs(cal.intrinsics.get_px() / truth.intrinsics.get_px() - 1.0), 0.005);
+  const double rot = core::rad2deg(core::rotationAngle(cal.c_M_w.linear(), truth.c_M_w.linear()));
+  EXPECT_GT(rot, 0.001);
+  EXPECT_LT(rot, 0.5);
+  // Inline camera geometry beside a rig is ambiguous: an error naming the key.
+  const std::string yaml = "rig: calib/rigs/table\nevents: {setpoints: [{t: 0.0, xy: [0.0, 0.0]}]}\ntable: {}\n"
+                           "wrist: {}\ncamera: {hfov_deg: 90}\nobserver: {}\ncontroller: {}\n";
+  try {
+    scenarios::tableBallConfigFromYaml(io::ConfigNode::fromString(yaml, "rig.yaml"));
+    FAIL() << "camera.hfov_deg accepted beside rig";
+  } catch (const core::InvalidInput& e) {
+    EXPECT_NE(std::string(e.what()).find("camera.hfov_deg"), std::string::npos) << e.what();
+  }
+}

@@ -4,6 +4,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <filesystem>
 #include <mutex>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -19,6 +20,7 @@
 #include "viewline/estimation/models/unicycle_predictor.h"
 #include "viewline/estimation/nonlinear.h"
 #include "viewline/robots/mobile_ground_localization.h"
+#include "viewline/scenarios/simulated_rig.h"
 #include "viewline/sim/effects.h"
 #include "viewline/sim/physics.h"
 #include "viewline/sim/renderer.h"
@@ -147,6 +149,14 @@ MobileCaptureConfig loadMobileCaptureConfig(const io::ConfigNode& root) {
   c.planner.period = c.vision_period;
   if (root.has("camera")) {
     const auto cam = root.child("camera");
+    if (root.has("rig")) {
+      for (const char* key : {"width", "height", "hfov_deg", "vfov_deg"}) {
+        if (cam.has(key)) {
+          throw core::InvalidInput(cam.location(key) + ": key '" + cam.keyPath(key) +
+                                   "': not allowed with 'rig' (the rig's truth.yaml and rig.yaml set the camera)");
+        }
+      }
+    }
     readOpt(cam, "width", c.width);
     readOpt(cam, "height", c.height);
     readAngle(cam, "hfov_deg", c.hfov);
@@ -255,6 +265,19 @@ MobileCaptureConfig loadMobileCaptureConfig(const io::ConfigNode& root) {
     readOpt(f, "pixel_sigma", c.fov_sweep_pixel_sigma);
   }
   readOpt(root, "threads", c.threads);
+  if (root.has("rig")) {
+    const std::string folder = root.getPath("rig");
+    try {
+      c.rig = loadMobileRig(folder, c.head);
+    } catch (const core::InvalidInput& e) {
+      throw core::InvalidInput(root.location("rig") + ": key 'rig': " + e.what());
+    }
+    c.width = c.rig->truth.width;
+    c.height = c.rig->truth.height;
+    // [K]'s angle-per-pixel method with the calibrated view angles.
+    c.hfov = 2.0 * std::atan(0.5 * c.width / c.rig->calibrated.intrinsics.get_px());
+    c.vfov = 2.0 * std::atan(0.5 * c.height / c.rig->calibrated.intrinsics.get_py());
+  }
   root.finish();
   try {
     c.validate();
@@ -264,12 +287,43 @@ MobileCaptureConfig loadMobileCaptureConfig(const io::ConfigNode& root) {
   return c;
 }
 
+MobileCaptureConfig::RigCameras loadMobileRig(const std::string& folder, const robots::MobilePanTiltParams& head_params) {
+  const SimulatedRig rig = loadSimulatedRig(folder);
+  MobileCaptureConfig::RigCameras out;
+  out.folder = std::filesystem::path(rig.folder).lexically_normal().string();
+  out.truth = rig.trueCamera("head");
+  out.calibrated = rig.calibratedCamera("head");
+  const Eigen::Matrix3d g_R_c = loadGroundRotation(rig, "head");  // checked against rig.yaml
+  out.calibrated.c_M_w.linear() = g_R_c.transpose();
+  // The rest joints q0: the head pointing its optical axis where truth.yaml's camera looks; then
+  // truth.yaml's pose must be the DH camera at q0 (the simulator renders the DH head).
+  head_params.validate();
+  const robots::MobilePanTilt head(head_params);
+  const Eigen::Isometry3d w_M_c = out.truth.c_M_w.inverse();
+  out.q0 = head.pointAtBest(w_M_c * Vector3d(0.0, 0.0, 2.0));
+  const Eigen::Isometry3d dh = robots::headCamera_c_M_w(head, out.q0, 0.0, 0.0, 0.0);
+  const double pos_off = (dh.inverse().translation() - w_M_c.translation()).norm();
+  const double rot_off = core::rotationAngle(dh.linear(), out.truth.c_M_w.linear());
+  if (pos_off > 1e-3 || rot_off > core::deg2rad(0.05)) {
+    std::ostringstream msg;
+    msg << rig.file("truth.yaml") << ": camera 'head' is not the head's DH camera (head: l1, l2, l3) at any joints: "
+        << "closest (tilt " << core::rad2deg(out.q0.tilt) << " deg, pan " << core::rad2deg(out.q0.pan) << " deg) is "
+        << 1000.0 * pos_off << " mm and " << core::rad2deg(rot_off) << " deg off";
+    throw core::InvalidInput(msg.str());
+  }
+  out.cal_M_c = out.calibrated.c_M_w * dh.inverse();
+  return out;
+}
+
 // ------------------------------------------------------------------------------------------------
 // Pieces shared by the loops.
 
 namespace {
 
+/// The camera that renders (truth) and the one estimators use (calibrated with a rig; the same
+/// perfect pinhole camera without).
 core::Camera makeCamera(const MobileCaptureConfig& cfg) {
+  if (cfg.rig) return cfg.rig->truth;
   core::Camera cam;
   cam.name = "head";
   cam.width = cfg.width;
@@ -278,6 +332,16 @@ core::Camera makeCamera(const MobileCaptureConfig& cfg) {
   const double py = 0.5 * cfg.height / std::tan(0.5 * cfg.vfov);
   cam.intrinsics = vpCameraParameters(px, py, 0.5 * cfg.width, 0.5 * cfg.height);
   return cam;
+}
+core::Camera makeEstimatorCamera(const MobileCaptureConfig& cfg) {
+  return cfg.rig ? cfg.rig->calibrated : makeCamera(cfg);
+}
+/// The two cameras at the true head joints q and base pose: the true one renders the DH head,
+/// the estimators' adds the calibrated mount correction c'_M_c.
+void placeCameras(const MobileCaptureConfig& cfg, const robots::MobilePanTilt& head, const robots::PanTiltJoints& q,
+                  double x, double y, double theta, core::Camera& truth, core::Camera& estimator) {
+  truth.c_M_w = robots::headCamera_c_M_w(head, q, x, y, theta);
+  estimator.c_M_w = cfg.rig ? cfg.rig->cal_M_c * truth.c_M_w : truth.c_M_w;
 }
 
 sim::GroundTargetParams targetParams(const MobileCaptureConfig& cfg, sim::GroundProfile profile, double duration) {
@@ -514,7 +578,8 @@ MobileCaptureRun runMobileCapture(const MobileCaptureConfig& cfg, std::uint64_t 
   std::optional<sim::NoisePool> noise;
   if (cfg.sensor_noise > 0.0) noise.emplace(sim::SensorNoise{cfg.sensor_noise, 1u << 18}, rng.render);
   vision::BallDetector detector(cfg.detector);
-  core::Camera camera = makeCamera(cfg);
+  core::Camera true_camera = makeCamera(cfg);        // renders
+  core::Camera camera = makeEstimatorCamera(cfg);    // detection ROI, ground localisation
   const robots::AnglePerPixel printed{cfg.hfov, cfg.vfov, robots::AngleRange::PrintedSlant};
   const robots::AnglePerPixel horizontal{cfg.hfov, cfg.vfov, robots::AngleRange::Horizontal};
   const double plane_z = 0.5 * cfg.object_height;
@@ -571,8 +636,8 @@ MobileCaptureRun runMobileCapture(const MobileCaptureConfig& cfg, std::uint64_t 
     // Vision, filter, prediction, plan.
     if (i % vision_every == 0) {
       ++run.frames;
-      camera.c_M_w = robots::headCamera_c_M_w(robot.head, robot.q, pose.x, pose.y, pose.theta);
-      image = renderer.render(world, camera, sim::ExposureSpec{t, 0.0, 1});
+      placeCameras(cfg, robot.head, robot.q, pose.x, pose.y, pose.theta, true_camera, camera);
+      image = renderer.render(world, true_camera, sim::ExposureSpec{t, 0.0, 1});
       if (noise) noise->apply(image, rng.render);
       std::optional<Vector2d> predicted_px;
       if (filter.valid()) {
@@ -747,7 +812,8 @@ FovSweepResult compareGroundLocalization(const MobileCaptureConfig& cfg, std::ui
   cfg.validate();
   core::Rng rng = core::makeRng(core::deriveSeed(seed, 99));
   const robots::MobilePanTilt head(cfg.head);
-  core::Camera camera = makeCamera(cfg);
+  core::Camera true_camera = makeCamera(cfg);      // makes the floor points of the pixels
+  core::Camera camera = makeEstimatorCamera(cfg);  // locates them
   const robots::AnglePerPixel printed{cfg.hfov, cfg.vfov, robots::AngleRange::PrintedSlant};
   const robots::AnglePerPixel horizontal{cfg.hfov, cfg.vfov, robots::AngleRange::Horizontal};
   const double plane_z = 0.5 * cfg.object_height;
@@ -756,11 +822,11 @@ FovSweepResult compareGroundLocalization(const MobileCaptureConfig& cfg, std::ui
     // A head looking at a floor point 0.5-4 m ahead within ±45° (what the chase produces).
     const double range = core::uniform(rng, 0.5, 4.0), bearing = core::uniform(rng, -0.8, 0.8);
     const auto q = head.pointAtBest(Vector3d(range * std::cos(bearing), range * std::sin(bearing), plane_z));
-    camera.c_M_w = robots::headCamera_c_M_w(head, q, 0.0, 0.0, 0.0);
+    placeCameras(cfg, head, q, 0.0, 0.0, 0.0, true_camera, camera);
     int done = 0;
     for (int attempt = 0; attempt < 50 * cfg.fov_sweep_points && done < cfg.fov_sweep_points; ++attempt) {
       const Vector2d uv(core::uniform(rng, 0.0, cfg.width - 1.0), core::uniform(rng, 0.0, cfg.height - 1.0));
-      const auto p = robots::groundPointExact(camera, uv, plane_z);
+      const auto p = robots::groundPointExact(true_camera, uv, plane_z);
       if (!p || (p->norm() > 5.0)) continue;  // the chase happens within 5 m; beyond, the object is a few pixels
       const Vector2d noisy = uv + Vector2d(core::gaussian(rng, cfg.fov_sweep_pixel_sigma),
                                            core::gaussian(rng, cfg.fov_sweep_pixel_sigma));
@@ -912,6 +978,7 @@ std::string summaryJson(const MobileCaptureSummary& s, const MobileCaptureConfig
                       {"rmse_omega_vs_nominal_rad_s", s.filter_rmse_omega_nominal},
                       {"rmse_position_m", s.filter_rmse_position},
                       {"rmse_measurement_m", s.filter_rmse_measurement}};
+  j["rig"] = cfg.rig ? nlohmann::json(cfg.rig->folder) : nlohmann::json(nullptr);
   j["wall_time_s"] = s.wall_time;
   return j.dump(indent);
 }

@@ -3,6 +3,7 @@
 #include <sstream>
 
 #include "viewline/core/error.h"
+#include "viewline/core/frames.h"
 #include "viewline/io/rig.h"
 
 namespace viewline::scenarios {
@@ -58,6 +59,27 @@ SimulatedRig loadSimulatedRig(const io::ConfigNode& cfg, const std::string& key)
   } catch (const core::InvalidInput& e) {
     throw core::InvalidInput(cfg.location(key) + ": key '" + cfg.keyPath(key) + "': " + e.what());
   }
+}
+
+Eigen::Matrix3d loadGroundRotation(const SimulatedRig& rig, const std::string& camera_name) {
+  const core::Camera& cam = rig.calibratedCamera(camera_name);
+  const std::string file = rig.file("ground.yaml");
+  const io::ConfigNode g = io::ConfigNode::loadFile(file);
+  const Eigen::Matrix3d g_R_c = g.get<Eigen::Matrix3d>("g_R_c");
+  g.ignore("c_M_g");  // the full pose is rig.yaml's c_M_w (the board placed at its surveyed spot)
+  g.ignore("height_m");
+  g.ignore("pitch_deg");
+  g.ignore("roll_deg");
+  g.finish();
+  if ((g_R_c.transpose() * g_R_c - Eigen::Matrix3d::Identity()).norm() > 1e-6 || g_R_c.determinant() < 0.0) {
+    throw core::InvalidInput(file + ": g_R_c is not a rotation");
+  }
+  const double off = core::rotationAngle(g_R_c.transpose(), cam.c_M_w.linear());
+  if (off > core::deg2rad(0.01)) {
+    throw core::InvalidInput(file + ": g_R_c differs from the rotation of camera '" + camera_name + "' in rig.yaml by " +
+                             std::to_string(core::rad2deg(off)) + " deg (re-run scripts/calibrate-default-rigs)");
+  }
+  return g_R_c;
 }
 
 }  // namespace viewline::scenarios

@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <chrono>
+#include <ctime>
 #include <cmath>
+#include <filesystem>
 #include <limits>
 #include <optional>
 #include <sstream>
@@ -12,6 +14,7 @@
 #include "viewline/core/frames.h"
 #include "viewline/core/random.h"
 #include "viewline/io/log.h"
+#include "viewline/scenarios/simulated_rig.h"
 #include "viewline/sim/physics.h"
 #include "viewline/sim/renderer.h"
 #include "viewline/sim/rig.h"
@@ -58,6 +61,14 @@ struct HeadSway {
 };
 
 double rms(double sum_sq, int n) { return n > 0 ? std::sqrt(sum_sq / n) : kNaN; }
+
+/// CPU time of the calling thread, s (the observer and the reference run on it, one after the
+/// other; unlike wall time it does not count the time the thread waits for a core).
+double threadCpuSeconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
 
 struct TrackAccumulator {
   double sum_sq = 0.0;
@@ -153,8 +164,26 @@ TableBallConfig tableBallConfigFromYaml(const io::ConfigNode& root) {
     c.wrist.max_rate = n.getOr<double>("max_rate", c.wrist.max_rate);
     c.wrist.delay = n.getOr<double>("delay", c.wrist.delay);
   }
+  if (root.has("rig")) {
+    const std::string folder = root.getPath("rig");
+    try {
+      c.rig = loadTableRig(folder);
+    } catch (const core::InvalidInput& e) {
+      throw core::InvalidInput(root.location("rig") + ": key 'rig': " + e.what());
+    }
+    c.width = c.rig->truth.width;
+    c.height = c.rig->truth.height;
+  }
   {
     const auto n = root.child("camera");
+    if (c.rig) {
+      for (const char* key : {"width", "height", "hfov_deg", "position", "look_at"}) {
+        if (n.has(key)) {
+          throw core::InvalidInput(n.location(key) + ": key '" + n.keyPath(key) +
+                                   "': not allowed with 'rig' (the rig's truth.yaml and rig.yaml set the camera)");
+        }
+      }
+    }
     c.width = n.getOr<unsigned>("width", c.width);
     c.height = n.getOr<unsigned>("height", c.height);
     c.hfov = n.getAngleOr("hfov_deg", c.hfov);
@@ -228,6 +257,27 @@ TableBallConfig tableBallConfigFromYaml(const io::ConfigNode& root) {
   return c;
 }
 
+TableBallConfig::RigCameras loadTableRig(const std::string& folder) {
+  const SimulatedRig rig = loadSimulatedRig(folder);
+  TableBallConfig::RigCameras out;
+  out.folder = std::filesystem::path(rig.folder).lexically_normal().string();
+  out.truth = rig.trueCamera("head");
+  out.calibrated = rig.calibratedCamera("head");
+  // ground.yaml (camera-to-ground): the calibrated rotation of the head at rest to the ground
+  // (z up), which is all the observer needs of the rest pose besides the nominal table prior.
+  const Eigen::Matrix3d g_R_c = loadGroundRotation(rig, "head");
+  out.calibrated.c_M_w.linear() = g_R_c.transpose();
+  return out;
+}
+
+std::vector<vision::TagOnTable> tableTagLayout(const sim::TableWorld& world) {
+  const sim::TableAppearance& look = world.appearance();
+  std::vector<vision::TagOnTable> layout;
+  if (!look.tags) return layout;
+  for (int i = 0; i < 4; ++i) layout.push_back({look.first_tag_id + i, look.tag_size, world.table_M_vispTag(i)});
+  return layout;
+}
+
 // ---------------------------------------------------------------------------------------------
 
 nlohmann::json toJson(const TableBallResult& r) {
@@ -240,6 +290,7 @@ nlohmann::json toJson(const TableBallResult& r) {
   j["frames_dropped"] = r.frames_dropped;
   j["table_detections"] = r.table_detections;
   j["ball_detections"] = r.ball_detections;
+  j["tracked_frames"] = r.tracked_frames;
   j["observer_rmse_mm"] = num(r.observer_rmse_mm);
   j["measurement_rmse_mm"] = num(r.measurement_rmse_mm);
   j["tunings"] = {{"M_sigma_w_1_sigma_v_0.005_rmse_mm", num(r.observer_rmse_mm_M_sw1_sv0005)},
@@ -255,6 +306,9 @@ nlohmann::json toJson(const TableBallResult& r) {
   j["frame_time_ratio_to_reference"] = num(r.frame_time_ratio_to_reference);
   j["observer_frame_ms"] = num(r.observer_frame_ms);
   j["reference_frame_ms"] = num(r.reference_frame_ms);
+  j["frame_cpu_ratio_to_reference"] = num(r.frame_cpu_ratio_to_reference);
+  j["observer_frame_cpu_ms"] = num(r.observer_frame_cpu_ms);
+  j["reference_frame_cpu_ms"] = num(r.reference_frame_cpu_ms);
   j["max_commanded_angle_deg"] = r.max_commanded_angle_deg;
   j["max_commanded_rate_deg_s"] = r.max_commanded_rate_deg_s;
   j["limits_respected"] = r.limits_respected;
@@ -311,12 +365,15 @@ TableBallResult runTableBall(const TableBallConfig& cfg_in, std::uint64_t seed, 
   look.border_height = cfg.border_height;
   sim::TableWorld world(table, sim::makeRoom(room, room_rng), look);
 
+  // `camera` renders (truth); `obs_camera` is what the observer believes (calibrated with a rig).
   core::Camera camera;
   camera.name = "head";
   camera.width = cfg.width;
   camera.height = cfg.height;
   camera.intrinsics = core::intrinsicsFromFov(cfg.hfov, cfg.width, cfg.height);
   camera.c_M_w = core::lookAt(cfg.camera_position, cfg.camera_look_at, Eigen::Vector3d::UnitZ());
+  if (cfg.rig) camera = cfg.rig->truth;
+  const core::Camera obs_camera = cfg.rig ? cfg.rig->calibrated : camera;
   HeadSway sway{camera.c_M_w, cfg.sway, cfg.sway_hz, cfg.sway_translation, {}};
   for (double& ph : sway.phase) ph = core::uniform(rng, 0.0, 2.0 * core::kPi);
 
@@ -344,13 +401,10 @@ TableBallResult runTableBall(const TableBallConfig& cfg_in, std::uint64_t seed, 
   ocfg.border_height = cfg.border_aware_pnp ? cfg.border_height : 0.0;  // the table's known design
   if (ocfg.table_pose == TablePoseSource::AprilTag) {
     if (!cfg.table_tags) throw core::InvalidInput("observer.table_pose: apriltag needs table.tags: true");
-    ocfg.tag_layout.clear();
-    for (int i = 0; i < 4; ++i) {
-      ocfg.tag_layout.push_back({look.first_tag_id + i, cfg.tag_size, world.table_M_tag(i)});
-    }
+    ocfg.tag_layout = tableTagLayout(world);  // in vpDetectorAprilTag's tag frame (z out of the tag)
     ocfg.tag_detector.tag_size_m = cfg.tag_size;
   }
-  TableBallObserver observer(camera, ocfg);
+  TableBallObserver observer(obs_camera, ocfg);
 
   std::vector<std::pair<std::string, RollingBallTracker>> side;
   if (cfg.compare_tunings) {
@@ -459,9 +513,10 @@ TableBallResult runTableBall(const TableBallConfig& cfg_in, std::uint64_t seed, 
   std::vector<std::pair<double, Eigen::Vector2d>> pending_pred;  // (time, predicted position 10 frames ahead)
   double nis_sum = 0.0;
   int nis_n = 0;
-  double obs_time = 0.0, ref_time = 0.0;
+  double obs_time = 0.0, ref_time = 0.0, obs_cpu = 0.0, ref_cpu = 0.0;
   int timed = 0;
   double next_progress = 0.0;
+  core::Camera view_camera = obs_camera;
 
   while (true) {
     const sim::Capture cap = rig.peek();
@@ -476,7 +531,11 @@ TableBallResult runTableBall(const TableBallConfig& cfg_in, std::uint64_t seed, 
 
     const ObserverFrame* of = nullptr;
     if (frame) {
-      Eigen::Matrix3d c_R_w = frame->camera.c_M_w.linear();
+      // The observer's camera pose: the measured sway applied to the (calibrated) rest pose.
+      Eigen::Isometry3d obs_c_M_w = frame->camera.c_M_w;
+      if (cfg.rig) obs_c_M_w = frame->camera.c_M_w * camera.c_M_w.inverse() * obs_camera.c_M_w;
+      view_camera.c_M_w = obs_c_M_w;
+      Eigen::Matrix3d c_R_w = obs_c_M_w.linear();
       if (cfg.ground_rotation_noise > 0.0) {
         const Eigen::Vector3d e(core::gaussian(imu_rng, cfg.ground_rotation_noise),
                                 core::gaussian(imu_rng, cfg.ground_rotation_noise),
@@ -484,11 +543,13 @@ TableBallResult runTableBall(const TableBallConfig& cfg_in, std::uint64_t seed, 
         c_R_w = Eigen::AngleAxisd(e.norm(), e.norm() > 0 ? Eigen::Vector3d(e.normalized()) : Eigen::Vector3d::UnitX())
                     .toRotationMatrix() * c_R_w;
       }
-      const Eigen::Isometry3d c_M_t_nominal = frame->camera.c_M_w * w_M_t_nominal;
+      const Eigen::Isometry3d c_M_t_nominal = obs_c_M_w * w_M_t_nominal;
+      const double c0 = threadCpuSeconds();
       of = &observer.process(frame->image, t, c_R_w, c_M_t_nominal);
+      const double c1 = threadCpuSeconds();
       if (cfg.time_reference) {
         const auto r0 = std::chrono::steady_clock::now();
-        const vision::TableScene rs = vision::referenceTableScene(frame->image, t, camera, ref_det, c_M_t_nominal);
+        const vision::TableScene rs = vision::referenceTableScene(frame->image, t, obs_camera, ref_det, c_M_t_nominal);
         std::optional<Eigen::Vector2d> ry;
         Eigen::Vector2d ra = of->a_xy;
         if (rs.table) {
@@ -498,13 +559,16 @@ TableBallResult runTableBall(const TableBallConfig& cfg_in, std::uint64_t seed, 
         }
         if (ref_tracker.initialized() || ry) ref_tracker.step(t, ra, ry);
         ref_time += std::chrono::duration<double>(std::chrono::steady_clock::now() - r0).count();
+        ref_cpu += threadCpuSeconds() - c1;
         obs_time += of->seconds;
+        obs_cpu += c1 - c0;
         ++timed;
       }
     } else {
       ++res.frames_dropped;
       of = &observer.predictOnly(t);
     }
+    if (of->tracked) ++res.tracked_frames;
     if (of->table_found) ++res.table_detections;
     if (of->ball_found) ++res.ball_detections;
     const std::optional<Eigen::Vector2d> y = of->ball_found ? std::optional<Eigen::Vector2d>(of->measured) : std::nullopt;
@@ -558,7 +622,7 @@ TableBallResult runTableBall(const TableBallConfig& cfg_in, std::uint64_t seed, 
     if (hooks.on_frame) {
       TableBallFrameView view;
       view.image = frame ? &frame->image : nullptr;
-      view.camera = frame ? &frame->camera : &camera;
+      view.camera = &view_camera;  // the observer's camera (calibrated with a rig) at the last frame
       view.observer = of;
       view.truth = truth.p;
       view.setpoint = ref;
@@ -589,8 +653,12 @@ TableBallResult runTableBall(const TableBallConfig& cfg_in, std::uint64_t seed, 
     res.observer_frame_ms = 1000.0 * obs_time / timed;
     res.reference_frame_ms = 1000.0 * ref_time / timed;
     res.frame_time_ratio_to_reference = obs_time / ref_time;
+    res.observer_frame_cpu_ms = 1000.0 * obs_cpu / timed;
+    res.reference_frame_cpu_ms = 1000.0 * ref_cpu / timed;
+    res.frame_cpu_ratio_to_reference = obs_cpu / ref_cpu;
   } else {
     res.observer_frame_ms = res.reference_frame_ms = res.frame_time_ratio_to_reference = kNaN;
+    res.observer_frame_cpu_ms = res.reference_frame_cpu_ms = res.frame_cpu_ratio_to_reference = kNaN;
   }
 
   // Event windows: each event is scored up to the next event (set-point change or push).

@@ -2,13 +2,12 @@
 
 #include <chrono>
 #include <cmath>
-#include <opencv2/calib3d.hpp>
-#include <opencv2/core/eigen.hpp>
 
 #include "viewline/core/checks.h"
 #include "viewline/core/error.h"
 #include "viewline/core/frames.h"
 #include "viewline/estimation/kalman_filter.h"
+#include "viewline/vision/table_geometry.h"
 
 namespace viewline::scenarios {
 
@@ -21,12 +20,12 @@ Eigen::Isometry3d borderAwareTablePose(const core::Camera& camera, const std::ar
                                        const Eigen::Isometry3d& c_M_t, double side, double border_height,
                                        int iterations) {
   if (!(border_height > 0.0)) return c_M_t;
-  std::vector<cv::Point2d> image;
-  for (const auto& c : corners) {
-    const Eigen::Vector2d n = camera.pixelToNormalized(c);
-    image.emplace_back(n.x(), n.y());
-  }
-  const cv::Matx33d K = cv::Matx33d::eye();
+  // Normalised image points (distortion removed); the re-solution minimises the reprojection
+  // error in normalised coordinates by Gauss-Newton from the current pose (vision::
+  // refinePoseOnPoints: an analytic 6x6 step, no cv::solvePnP set-up per call, the same cost as
+  // cv::solvePnP(SOLVEPNP_ITERATIVE, K = I) from that guess).
+  std::array<Eigen::Vector2d, 4> image;
+  for (std::size_t k = 0; k < 4; ++k) image[k] = camera.pixelToNormalized(corners[k]);
   Eigen::Isometry3d pose = c_M_t;
   const double h = 0.5 * side;
   for (int it = 0; it < iterations; ++it) {
@@ -35,19 +34,9 @@ Eigen::Isometry3d borderAwareTablePose(const core::Camera& camera, const std::ar
     auto shift = [&](double coord) { return border_height * std::max(0.0, coord - h) / (cam_t.z() - border_height); };
     const double dxp = shift(cam_t.x()), dxm = shift(-cam_t.x()), dyp = shift(cam_t.y()), dym = shift(-cam_t.y());
     // P0 = (-,-), P1 = (+,-), P2 = (+,+), P3 = (-,+).
-    const std::vector<cv::Point3d> object = {{-h + dxm, -h + dym, 0.0}, {h - dxp, -h + dym, 0.0},
-                                             {h - dxp, h - dyp, 0.0}, {-h + dxm, h - dyp, 0.0}};
-    cv::Mat R, rvec, tvec;
-    Eigen::Matrix3d Re = pose.linear();
-    cv::eigen2cv(Re, R);
-    cv::Rodrigues(R, rvec);
-    tvec = (cv::Mat_<double>(3, 1) << pose.translation().x(), pose.translation().y(), pose.translation().z());
-    if (!cv::solvePnP(object, image, K, cv::noArray(), rvec, tvec, true, cv::SOLVEPNP_ITERATIVE)) break;
-    cv::Rodrigues(rvec, R);
-    cv::cv2eigen(R, Re);
-    Eigen::Isometry3d next = Eigen::Isometry3d::Identity();
-    next.linear() = Re;
-    next.translation() = Eigen::Vector3d(tvec.at<double>(0), tvec.at<double>(1), tvec.at<double>(2));
+    const std::array<Eigen::Vector3d, 4> object = {Eigen::Vector3d(-h + dxm, -h + dym, 0.0), Eigen::Vector3d(h - dxp, -h + dym, 0.0),
+                                                   Eigen::Vector3d(h - dxp, h - dyp, 0.0), Eigen::Vector3d(-h + dxm, h - dyp, 0.0)};
+    const Eigen::Isometry3d next = vision::refinePoseOnPoints(pose, object, image, 1.0, 1.0, 0.0, 0.0);
     if (!next.matrix().allFinite() || next.translation().z() <= 0.0) break;
     pose = next;
   }

@@ -6,6 +6,10 @@
 
 #include "viewline/core/frames.h"
 #include "viewline/core/random.h"
+#include "viewline/scenarios/table_ball.h"
+#include "viewline/sim/physics.h"
+#include "viewline/sim/renderer.h"
+#include "viewline/sim/worlds.h"
 
 using namespace viewline;
 
@@ -105,4 +109,62 @@ TEST(TableBallObserver, StationaryGainMatchesTheTimeVaryingFilterInSteadyState) 
   }
   EXPECT_LT((a.position() - b.position()).norm(), 1e-5);
   EXPECT_LT((a.P() - b.P()).cwiseAbs().maxCoeff(), 1e-6);
+}
+
+// Issue 7: the AprilTag table pose. A tagged table rendered at a known tilt must come back at
+// that pose. The layout has to be in vpDetectorAprilTag's tag frame (z out of the tag); with the
+// simulator's tag frame (z into the table) every tag's corners are mirrored and the pose came out
+// flipped (tilt error 179.8°).
+TEST(TableBallObserver, AprilTagTablePoseMatchesTheRenderedTable) {
+  sim::TiltTableParams params;
+  params.w_M_base.translation() = Eigen::Vector3d(0.0, 0.0, 0.9);
+  params.delay = 0.0;
+  sim::TiltTable table(params, sim::TiltTableState{0.0, {0.0, 0.0}, {0.03, -0.02}, {0.0, 0.0}});
+  const Eigen::Vector2d tilt(core::deg2rad(4.0), core::deg2rad(-3.0));
+  table.command(0.0, tilt);
+  table.advanceTo(0.5);  // well past the rate-limited ramp
+  const sim::TiltTableState truth = table.stateAt(0.5);
+  ASSERT_NEAR((truth.tilt - tilt).norm(), 0.0, 1e-9);
+  sim::TableAppearance look;
+  look.tags = true;
+  look.tag_size = 0.05;
+  core::Rng rng = core::makeRng(5);
+  sim::RoomParams room;
+  room.floor_texture.resolution = 256;
+  room.wall_texture.resolution = 256;
+  const sim::TableWorld world(table, sim::makeRoom(room, rng), look);
+  // The scenario's head camera (config/table_ball.yaml).
+  core::Camera cam;
+  cam.width = 320;
+  cam.height = 240;
+  cam.intrinsics = core::intrinsicsFromFov(core::deg2rad(90.0), 320, 240);
+  cam.c_M_w = core::lookAt({0.0, -0.30, 1.32}, {0.0, 0.0, 0.9}, {0.0, 0.0, 1.0});
+  sim::RenderSettings rs;
+  rs.supersampling = 3;
+  sim::Renderer renderer(rs);
+  const cv::Mat image = renderer.render(world, cam, sim::ExposureSpec{0.5, 0.0, 1});
+  const Eigen::Isometry3d w_M_t = table.tablePose(truth.tilt);
+  const Eigen::Isometry3d c_M_t_true = cam.c_M_w * w_M_t;
+
+  const std::vector<vision::TagOnTable> layout = scenarios::tableTagLayout(world);
+  ASSERT_EQ(layout.size(), 4u);
+  // The tag frames sit on the table plane with z along the table normal.
+  for (const auto& tag : layout) EXPECT_NEAR(tag.t_M_tag.linear()(2, 2), 1.0, 1e-12);
+
+  scenarios::TableBallObserverConfig ocfg;
+  ocfg.table_pose = scenarios::TablePoseSource::AprilTag;
+  ocfg.tag_layout = layout;
+  ocfg.tag_detector.tag_size_m = look.tag_size;
+  scenarios::TableBallObserver observer(cam, ocfg);
+  // A prior that is only roughly right (the arm's nominal pose, level table).
+  const scenarios::ObserverFrame& of = observer.process(image, 0.5, cam.c_M_w.linear(), cam.c_M_w * table.tablePose({0.0, 0.0}));
+  ASSERT_TRUE(of.table_found) << of.failure;
+  const double rot_err = core::rad2deg(core::rotationAngle(of.c_M_t.linear(), c_M_t_true.linear()));
+  const double pos_err = (of.c_M_t.translation() - c_M_t_true.translation()).norm();
+  EXPECT_LT(rot_err, 0.75) << "table rotation error, deg";
+  EXPECT_LT(pos_err, 0.005) << "table origin error, m";
+  EXPECT_LT(core::rad2deg((of.measured_tilt - truth.tilt).cwiseAbs().maxCoeff()), 0.75);
+  // The ball measured on that table frame lies where it is.
+  ASSERT_TRUE(of.ball_found) << of.failure;
+  EXPECT_LT((of.measured - truth.p).norm(), 0.005);
 }

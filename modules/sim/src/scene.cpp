@@ -160,6 +160,12 @@ Primitive makeTag36h11(const std::string& name, int id, double tag_size, const E
   return p;
 }
 
+Eigen::Isometry3d simTag_M_vispTag() {
+  Eigen::Isometry3d m = Eigen::Isometry3d::Identity();
+  m.linear() = Eigen::Vector3d(1.0, -1.0, -1.0).asDiagonal();  // Rx(π)
+  return m;
+}
+
 std::shared_ptr<const Texture> makeNoiseTexture(const NoiseTextureParams& params, core::Rng& rng) {
   if (params.resolution < 2) throw InvalidInput("NoiseTextureParams.resolution must be >= 2");
   if (params.octaves < 1) throw InvalidInput("NoiseTextureParams.octaves must be >= 1");

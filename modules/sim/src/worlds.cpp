@@ -111,8 +111,15 @@ Eigen::Isometry3d TableWorld::table_M_tag(int i) const {
   const double c = 0.5 * L + look_.border_width + 0.55 * s_total;
   const double sx = (i == 1 || i == 2) ? 1.0 : -1.0;
   const double sy = (i == 2 || i == 3) ? 1.0 : -1.0;
-  // Tag z into the table (down), x along the table x: rotation of π about x.
+  // Simulator tag frame (makeTag36h11): z into the table (down), x along the table x, so that the
+  // code reads upright from above: rotation of π about x.
   return pose(core::rotation(Vector3d::UnitX(), core::kPi), Vector3d(sx * c, sy * c, 0.0005));
+}
+
+Eigen::Isometry3d TableWorld::table_M_vispTag(int i) const {
+  // ViSP's tag frame is the simulator's turned by π about x: x along the table x, y along the
+  // table y, z along the table normal (out of the tag), origin at the tag centre.
+  return table_M_tag(i) * simTag_M_vispTag();
 }
 
 void TableWorld::dynamicObjects(double t, std::vector<Primitive>& out) const {

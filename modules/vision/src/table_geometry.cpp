@@ -17,6 +17,8 @@ namespace {
 
 Eigen::Vector2d toEigen(const cv::Point& p) { return {p.x, p.y}; }
 
+}  // namespace
+
 /// Gauss-Newton on the pixel reprojection error of the four corners (what
 /// cv::solvePnPRefineLM minimises, without its per-iteration projectPoints/Jacobian matrices):
 /// pose perturbed as R ← exp([δω]×) R, t ← t + δt; for X = R P + t,
@@ -70,8 +72,6 @@ Eigen::Isometry3d refinePoseOnPoints(const Eigen::Isometry3d& c_M_t, const std::
   }
   return M;
 }
-
-}  // namespace
 
 Result<TableCorners> findTableCorners(const std::vector<cv::Point>& contour,
                                       const std::optional<Circle>& ball, int image_width,

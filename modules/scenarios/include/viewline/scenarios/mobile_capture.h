@@ -32,6 +32,18 @@
 // with that noise (no images), the same EKF; errors of θ, v, ω over time and their RMSE after a
 // convergence time, against the true (noisy) inputs and against the nominal profile.
 //
+// Camera parameters (issue 9). Inline camera keys (width, height, hfov_deg, vfov_deg): one
+// perfect pinhole camera renders and estimates. With `rig: <folder>` (calib/rigs/mobile): the
+// renderer uses the TRUE head camera of truth.yaml (intrinsics with barrel distortion) on the
+// true head (the DH chain of robots::MobilePanTilt: truth.yaml's pose is that chain at a rest
+// joint position q0, found and checked at load), and every estimator uses the CALIBRATED camera:
+// rig.yaml's intrinsics, and a pose from the camera-to-ground calibration taken at q0
+// (rig.yaml's c_M_w = ground.yaml's c_M_g placed at the surveyed board spot). The calibrated pose
+// differs from the DH camera at q0 by a fixed correction of the camera on its mount,
+//   c'_M_c = c_M_w_cal · c_M_w_DH(q0)⁻¹,
+// so the estimators' camera at joints q and base pose b is  c'_M_w(q, b) = c'_M_c · c_M_w_DH(q, b).
+// The angle-per-pixel method then uses the calibrated fields of view (2 atan(W / 2 px), ...).
+//
 // Ground localisation: every detection is also located with [K]'s angle-per-pixel formula
 // (printed slant range and corrected horizontal range); errors against the true object centre.
 // compareGroundLocalization additionally sweeps the field of view with projected floor points.
@@ -39,11 +51,13 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <opencv2/core.hpp>
 #include <string>
 #include <vector>
 
 #include "viewline/control/mobile_capture_control.h"
+#include "viewline/core/camera.h"
 #include "viewline/io/config.h"
 #include "viewline/io/log.h"
 #include "viewline/planning/capture_planner.h"
@@ -84,6 +98,16 @@ struct MobileCaptureConfig {
   double vfov = 0.6981317008965228;     ///< rad (40°)
   double sensor_noise = 2.0;            ///< grey levels (std)
   int supersampling = 2;                ///< renderer anti-aliasing sub-samples on edges
+
+  /// Calibrated rig (key `rig`): replaces width, height, hfov, vfov (see the header comment).
+  struct RigCameras {
+    std::string folder;
+    core::Camera truth;                 ///< renders (intrinsics; its pose is the DH head at q0)
+    core::Camera calibrated;            ///< estimators (intrinsics; c_M_w = calibrated pose at q0)
+    robots::PanTiltJoints q0;           ///< head joints of truth.yaml's pose
+    Eigen::Isometry3d cal_M_c = Eigen::Isometry3d::Identity();  ///< c'_M_c, calibrated vs DH camera
+  };
+  std::optional<RigCameras> rig;
 
   // Robot.
   robots::MobilePanTiltParams head;
@@ -138,7 +162,14 @@ struct MobileCaptureConfig {
 };
 
 /// Reads the YAML keys documented in config/mobile_capture.yaml (unknown keys rejected).
+/// `rig:` (folder relative to the config file) loads truth.yaml, rig.yaml and ground.yaml; with it
+/// the camera's width, height, hfov_deg and vfov_deg keys are errors.
 MobileCaptureConfig loadMobileCaptureConfig(const io::ConfigNode& root);
+
+/// Loads the head camera of a mobile rig folder for the head `head` (see the header comment);
+/// throws core::InvalidInput when truth.yaml's pose is not the DH head camera at some joints
+/// (1 mm, 0.05°) or ground.yaml disagrees with rig.yaml.
+MobileCaptureConfig::RigCameras loadMobileRig(const std::string& folder, const robots::MobilePanTiltParams& head);
 
 /// Ground-localisation error accumulator (squared errors against truth, m²).
 struct LocalizationErrors {

@@ -42,4 +42,11 @@ SimulatedRig loadSimulatedRig(const std::string& folder);
 /// rig files are reported with the config's file:line:key in front.
 SimulatedRig loadSimulatedRig(const io::ConfigNode& cfg, const std::string& key = "rig");
 
+/// The calibrated camera-to-ground rotation g_R_c of a rig folder's ground.yaml (written by
+/// calib's camera-to-ground for the table and mobile rigs; ground frame g: z up, x along the
+/// floor board). The rig's world has no yaw with respect to g (scripts/calibrate-default-rigs puts
+/// the board at yaw 0), so g_R_c must equal the calibrated camera's w_R_c in rig.yaml: checked
+/// within 0.01°. Throws core::InvalidInput naming the file.
+Eigen::Matrix3d loadGroundRotation(const SimulatedRig& rig, const std::string& camera_name);
+
 }  // namespace viewline::scenarios

@@ -12,8 +12,8 @@
 //     table frame, the border's top inner edge casts (from the camera) a line on z = 0 shifted
 //     inwards by  δ = h · max(0, t'·n − L/2) / (t'_z − h)  (n the side's outward normal), the
 //     same along the whole side; the object corners are moved accordingly and the pose is
-//     re-solved (cv::solvePnP iterative from the previous solution, twice). Without it a
-//     2 cm border seen from a head 0.45 m away tilts the pose by about a degree.
+//     re-solved (Gauss-Newton on the reprojection error from the previous solution, twice).
+//     Without it a 2 cm border seen from a head 0.45 m away tilts the pose by about a degree.
 //  2. ball on the table from its image circle: cone half-angle α, d = r / sin α (the corrected
 //     [M] eq 4.12), p_t = t' + d v1 with t' = −Rᵀ t, v1 = Rᵀ v̂ (vision::ballOnTableKnownRadius);
 //     the unknown-radius variant solves r from z = r first;

@@ -82,9 +82,21 @@ Primitive makeDisc(const std::string& name, const Eigen::Isometry3d& w_M_o, doub
                    const Eigen::Vector3d& albedo_bgr);
 
 /// An AprilTag tag36h11 code `id` whose black square has side `tag_size`, in the frame w_M_tag
-/// (origin at the tag centre, x right and y down along the printed code, z into the surface, as
-/// ViSP's tag frame). The rectangle includes the one-cell white quiet ring (side 10/8 tag_size).
+/// (the simulator's tag frame: origin at the tag centre, x right and y down along the printed
+/// code, z into the surface, i.e. away from a viewer who reads the code). This is NOT the frame
+/// of vpDetectorAprilTag::getPose(), whose z points out of the tag: see simTag_M_vispTag().
+/// The rectangle includes the one-cell white quiet ring (side 10/8 tag_size).
 Primitive makeTag36h11(const std::string& name, int id, double tag_size, const Eigen::Isometry3d& w_M_tag);
+
+/// The tag frame of vpDetectorAprilTag::getPose() (ViSP 3.5, default setZAlignedWithCameraAxis(false):
+/// origin at the tag centre, x right and y UP along the printed code, z OUT of the tag towards the
+/// viewer; the frame vision::AprilTagDetector's c_M_o and vision::TagOnTable::t_M_tag use)
+/// expressed in the simulator's tag frame of makeTag36h11 (x right, y down, z into the surface):
+/// a half turn about x, simTag_M_vispTag = Rx(π) = diag(1, -1, -1). A layout for a detector is
+/// therefore  t_M_vispTag = t_M_simTag * simTag_M_vispTag();  feeding t_M_simTag directly mirrors
+/// every tag's corners about its x axis and the PnP returns the plane seen from behind (a table
+/// flipped by ~180°). Checked against ViSP by sim's renderer test and scenarios' observer test.
+Eigen::Isometry3d simTag_M_vispTag();
 
 /// The tag36h11 code image (10x10 cells incl. the white ring). Throws for an id
 /// outside the family.

@@ -92,8 +92,14 @@ public:
   const Scene& staticScene() const override { return environment_; }
   void dynamicObjects(double t, std::vector<Primitive>& out) const override;
   Lighting lighting() const override { return lighting_; }
-  /// Tag frame of the i-th table tag (i = 0..3) in the table frame.
+  /// The simulator's tag frame (makeTag36h11: z into the table) of the i-th table tag (i = 0..3)
+  /// in the table frame (surface centre, z = surface normal, up).
   Eigen::Isometry3d table_M_tag(int i) const;
+  /// vpDetectorAprilTag's tag frame (z out of the tag, i.e. along the table normal) of the i-th
+  /// table tag in the table frame: table_M_tag(i) * simTag_M_vispTag(). This is what a
+  /// vision::TagOnTable layout needs.
+  Eigen::Isometry3d table_M_vispTag(int i) const;
+  const TableAppearance& appearance() const { return look_; }
 
 private:
   const TiltTable& table_;

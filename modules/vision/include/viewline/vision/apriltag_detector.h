@@ -75,7 +75,10 @@ private:
   cv::Mat gray_cv_;
 };
 
-/// A tag fixed on the table: its pose in the table frame (see table_geometry.h).
+/// A tag fixed on the table: its pose in the table frame (see table_geometry.h). The tag frame is
+/// vpDetectorAprilTag's (the frame of TagObservation::c_M_o: origin at the tag centre, x right and
+/// y up along the printed code, z out of the tag towards the viewer). A simulated tag
+/// (sim::makeTag36h11, z into the surface) needs sim::simTag_M_vispTag() on the right.
 struct TagOnTable {
   int id = 0;
   double size_m = 0.05;

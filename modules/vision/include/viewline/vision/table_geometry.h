@@ -77,6 +77,15 @@ Result<TablePose> solveTablePose(const std::array<Eigen::Vector2d, 4>& ordered_c
                                  const core::Camera& camera, double side_m, bool refine,
                                  const std::optional<Eigen::Isometry3d>& prior);
 
+/// Gauss-Newton on the reprojection error of four object points P (table frame) seen at `uv`
+/// through a pinhole (px, py, u0, v0; undistort the pixels first), from c_M_t (close to the
+/// minimum): pose perturbed as R ← exp([δω]×) R, t ← t + δt; a step that does not lower the cost
+/// ends it (at most 20). Used by solveTablePose's refinement; px = py = 1, u0 = v0 = 0 works on
+/// normalised coordinates. Returns c_M_t when a point is behind the camera at the start.
+Eigen::Isometry3d refinePoseOnPoints(const Eigen::Isometry3d& c_M_t, const std::array<Eigen::Vector3d, 4>& P,
+                                     const std::array<Eigen::Vector2d, 4>& uv, double px, double py, double u0,
+                                     double v0);
+
 /// The k with c_M_t · Rz(k·90°) closest to `reference` (k in 0..3).
 int yawQuarterTurnsTo(const Eigen::Isometry3d& c_M_t, const Eigen::Isometry3d& reference);
 /// c_M_t · Rz(k·90°): the same square table with its frame turned by k quarter turns.
