@@ -3,7 +3,10 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
+#include <fstream>
 #include <memory>
+#include <sstream>
 
 #include "viewline/core/checks.h"
 #include "viewline/core/error.h"
@@ -328,6 +331,7 @@ nlohmann::json PanTiltRunMetrics::toJson() const {
             {"reacquisition_delay_s", num(reacquisition_delay_s)},
             {"reacquisitions", reacquisitions},
             {"frames_searching", frames_searching}}},
+          {"filter_jumps", filter_jumps},
           {"wall_ms_per_frame", wall_ms_per_frame}};
 }
 
@@ -557,6 +561,7 @@ PanTiltRunMetrics runPanTilt(const PanTiltScenarioConfig& cfg, std::uint64_t see
   if (ours != nullptr) {
     m.rmse_filtered_cm = 100.0 * Vector2d(fx_.rms(), fy_.rms());
     m.reacquisitions = ours->reacquisitions();
+    m.filter_jumps = ours->filter().jumps();
   }
   m.detection_pixel_rmse_px = det_px.rms();
   m.rate_violations = unit.rateViolations();
@@ -567,6 +572,97 @@ PanTiltRunMetrics runPanTilt(const PanTiltScenarioConfig& cfg, std::uint64_t see
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - wall0).count();
   m.wall_ms_per_frame = m.frames ? wall / static_cast<double>(m.frames) : 0.0;
   return m;
+}
+
+nlohmann::json PanTiltReplayMetrics::toJson() const {
+  return {{"measurements", measurements},
+          {"jumps", jumps},
+          {"rmse_measured_cm", {rmse_measured_cm.x(), rmse_measured_cm.y()}},
+          {"rmse_filtered_cm", {rmse_filtered_cm.x(), rmse_filtered_cm.y()}},
+          {"horizon_s", horizon_s},
+          {"rmse_predicted_cm", {rmse_predicted_cm.x(), rmse_predicted_cm.y()}},
+          {"predicted_error_px", predicted_error_px}};
+}
+
+PanTiltReplayMetrics replayPanTiltFilter(const PanTiltScenarioConfig& cfg, std::uint64_t seed,
+                                         const std::string& frames_csv) {
+  cfg.validate();
+  core::Rng path_rng = core::makeRng(core::deriveSeed(seed, 1));  // the run's path stream
+  sim::ScreenPathParams pp = cfg.path;
+  pp.duration = cfg.duration + 10.0;
+  const sim::ScreenPath path(pp, path_rng);
+  double amplitude_span = cfg.duration;  // (as runPanTilt)
+  if (pp.shape == sim::PathShape::Rectangle) amplitude_span = 2.0 * (pp.width + pp.height) / pp.speed;
+  if (pp.shape == sim::PathShape::Circle) amplitude_span = 2.0 * core::kPi * pp.radius / pp.speed;
+  const Vector2d sigma = cfg.noise_fraction * pathAmplitude(path, amplitude_span);
+  Eigen::Matrix2d R = sigma.cwiseProduct(sigma).asDiagonal();
+  if (R.determinant() <= 0.0) R += 1e-8 * Eigen::Matrix2d::Identity();
+
+  std::ifstream in(frames_csv);
+  if (!in) throw core::InvalidInput(frames_csv + ": cannot read (predictive_frames.csv of pan_tilt_tracking --log)");
+  std::string line;
+  std::getline(in, line);
+  std::vector<std::string> header;
+  {
+    std::stringstream ss(line);
+    std::string f;
+    while (std::getline(ss, f, ',')) header.push_back(f);
+  }
+  const auto col = [&](const std::string& name) {
+    const auto it = std::find(header.begin(), header.end(), name);
+    if (it == header.end()) throw core::InvalidInput(frames_csv + ": no column '" + name + "'");
+    return static_cast<std::size_t>(it - header.begin());
+  };
+  const std::size_t ct = col("t"), cd = col("detected"), cx = col("meas_x"), cy = col("meas_y");
+
+  control::PredictivePanTiltController ctrl(cfg.control, cfg.unit.limits, cfg.unit.latency, screenPose(cfg));
+  const double occ0 = cfg.occlusion_start >= 0.0 ? cfg.occlusion_start : 1e300;
+  const double occ1 = cfg.occlusion_start >= 0.0 ? cfg.occlusion_start + cfg.occlusion_duration : 1e300;
+  PanTiltReplayMetrics out;
+  out.horizon_s = cfg.processing_delay + cfg.unit.latency + cfg.control.lead;
+  Accumulator mx, my, fx_, fy_, px_, py_;
+  std::size_t row = 1;
+  while (std::getline(in, line)) {
+    ++row;
+    if (line.empty()) continue;
+    std::vector<double> v;
+    std::stringstream ss(line);
+    std::string f;
+    while (std::getline(ss, f, ',')) v.push_back(f.empty() || f == "nan" ? std::nan("") : std::strtod(f.c_str(), nullptr));
+    if (v.size() != header.size()) throw core::InvalidInput(frames_csv + ":" + std::to_string(row) + ": wrong number of columns");
+    const double t = v[ct];
+    if (t >= cfg.duration) break;
+    control::TargetObservation obs;
+    obs.stamp = t;
+    obs.detected = v[cd] > 0.5;
+    if (obs.detected) {
+      obs.plane = Vector2d(v[cx], v[cy]);
+      obs.plane_cov = R;
+      ++out.measurements;
+    }
+    ctrl.observe(obs);
+    if (!(t >= cfg.metrics_start && !(t >= occ0 && t < occ1 + 2.0))) continue;
+    const Vector2d truth = path.position(t);
+    if (obs.detected) {
+      mx.add(std::pow(obs.plane.x() - truth.x(), 2));
+      my.add(std::pow(obs.plane.y() - truth.y(), 2));
+      if (ctrl.lastUpdate().accepted) {
+        fx_.add(std::pow(ctrl.filteredPlane().x() - truth.x(), 2));
+        fy_.add(std::pow(ctrl.filteredPlane().y() - truth.y(), 2));
+      }
+    }
+    if (ctrl.filter().initialized()) {
+      const Vector2d e = ctrl.filter().at(t + out.horizon_s).p - path.position(t + out.horizon_s);
+      px_.add(e.x() * e.x());
+      py_.add(e.y() * e.y());
+    }
+  }
+  out.jumps = ctrl.filter().jumps();
+  out.rmse_measured_cm = 100.0 * Vector2d(mx.rms(), my.rms());
+  out.rmse_filtered_cm = 100.0 * Vector2d(fx_.rms(), fy_.rms());
+  out.rmse_predicted_cm = 100.0 * Vector2d(px_.rms(), py_.rms());
+  out.predicted_error_px = std::hypot(px_.rms(), py_.rms()) * cfg.fx / cfg.screen_distance;
+  return out;
 }
 
 PanTiltComparison runPanTiltComparison(const PanTiltScenarioConfig& config, std::uint64_t seed,
@@ -600,7 +696,9 @@ nlohmann::json PanTiltComparison::toJson(const PanTiltScenarioConfig& cfg) const
   j["camera"] = {{"width", cfg.image_width}, {"height", cfg.image_height}, {"fx", cfg.fx}, {"fy", cfg.fy}, {"fps", cfg.fps}};
   j["path_speed_m_s"] = cfg.path.speed;
   j["filter_model"] = control::toString(cfg.control.filter.model);
-  j["servo_gain"] = cfg.control.servo.gain;
+  j["servo_gain"] = cfg.control.servo.gain;  // the baseline's (and ours unless predictive_gain is set)
+  j["predictive_gain"] = cfg.control.gain > 0.0 ? cfg.control.gain : cfg.control.servo.gain;
+  j["rig"] = cfg.rig_folder;
   j["noise_definition"] =
       "per axis, white Gaussian noise with std = measurement_noise_fraction x (max - min)/2 of the true path "
       "along that axis, added to the measured target position on the screen plane";

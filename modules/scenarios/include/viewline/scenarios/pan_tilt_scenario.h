@@ -150,6 +150,7 @@ struct PanTiltRunMetrics {
   double reacquisition_delay_s = std::nan("");
   std::size_t reacquisitions = 0;
   std::size_t frames_searching = 0;
+  std::size_t filter_jumps = 0;              ///< velocity jumps (corners) the filter detected (ours)
   double wall_ms_per_frame = 0.0;
 
   nlohmann::json toJson() const;
@@ -175,6 +176,22 @@ struct PanTiltComparison {
 PanTiltComparison runPanTiltComparison(const PanTiltScenarioConfig& config, std::uint64_t seed,
                                        const PanTiltFrameSink& sink = nullptr, io::LogDirectory* log = nullptr,
                                        const std::function<void(double)>& progress = nullptr);
+
+/// Filter-only replay: the predictive controller's target filter (same config, same reacquisition
+/// rule) re-run on the measurements of a logged run (`<log>/predictive_frames.csv` of
+/// pan_tilt_tracking --log), scored against the path of `seed` with the run's metric windows.
+/// Used to compare filters on identical measurements without rendering; the closed loop is not
+/// re-run (the measurements depend on it only through the detector's sub-pixel error).
+struct PanTiltReplayMetrics {
+  std::size_t measurements = 0, jumps = 0;
+  Eigen::Vector2d rmse_measured_cm = Eigen::Vector2d::Zero(), rmse_filtered_cm = Eigen::Vector2d::Zero();
+  double horizon_s = 0.0;  ///< processing delay + latency + lead: how far ahead the law predicts
+  Eigen::Vector2d rmse_predicted_cm = Eigen::Vector2d::Zero();  ///< x(t + horizon | t) − truth, every frame
+  double predicted_error_px = 0.0;  ///< its RMS norm × fx / screen distance (px near the image centre)
+  nlohmann::json toJson() const;
+};
+PanTiltReplayMetrics replayPanTiltFilter(const PanTiltScenarioConfig& config, std::uint64_t seed,
+                                         const std::string& frames_csv);
 
 /// [T] Table 1 (RMSE in cm, (x, y)): noisy measurement and Kalman filter; nothing for the random path.
 struct TTable1Row {
