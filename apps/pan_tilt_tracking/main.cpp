@@ -4,6 +4,7 @@
 // (viewline/scenarios/pan_tilt_scenario.h).
 //
 //   pan_tilt_tracking --config config/pan_tilt_circle.yaml --duration 60 --seed 1 --headless --summary out.json
+//   pan_tilt_tracking --config <variant>.yaml --seed 1 --replay <log>/predictive_frames.csv   (filter only)
 
 #include <CLI/CLI.hpp>
 #include <cmath>
@@ -22,7 +23,7 @@ using namespace viewline;
 
 int main(int argc, char** argv) {
   CLI::App app{"viewline pan-tilt tracking ([T]): predictive servo vs ViSP's point servo on a simulated FLIR PTU-D46"};
-  std::string config_path, log_dir, summary_path;
+  std::string config_path, log_dir, summary_path, replay_path;
   std::uint64_t seed = 1;
   double duration = -1.0;
   bool headless = false, display = false, no_baseline = false;
@@ -34,6 +35,9 @@ int main(int argc, char** argv) {
   app.add_option("--log", log_dir, "directory for CSV logs (truth, measurements, estimates, commands)");
   app.add_option("--summary", summary_path, "metrics JSON file");
   app.add_flag("--no-baseline", no_baseline, "skip the ViSP baseline run");
+  app.add_option("--replay", replay_path,
+                 "filter only: re-run this config's target filter on the measurements of a --log run "
+                 "(<log>/predictive_frames.csv, same --seed and --duration) instead of simulating");
   CLI11_PARSE(app, argc, argv);
   if (headless && display) {
     std::cerr << "--headless and --display are exclusive\n";
@@ -47,6 +51,18 @@ int main(int argc, char** argv) {
     }
     if (no_baseline) cfg.run_baseline = false;
     cfg.validate();
+    if (!replay_path.empty()) {
+      const scenarios::PanTiltReplayMetrics r = scenarios::replayPanTiltFilter(cfg, seed, replay_path);
+      if (!summary_path.empty()) io::writeJsonFile(summary_path, r.toJson());
+      std::printf("replay of %s (seed %llu, filter %s): %zu measurements, %zu velocity jumps detected\n",
+                  replay_path.c_str(), static_cast<unsigned long long>(seed), control::toString(cfg.control.filter.model),
+                  r.measurements, r.jumps);
+      std::printf("  rmse measured (cm)          x %.4f  y %.4f\n", r.rmse_measured_cm.x(), r.rmse_measured_cm.y());
+      std::printf("  rmse filtered (cm)          x %.4f  y %.4f\n", r.rmse_filtered_cm.x(), r.rmse_filtered_cm.y());
+      std::printf("  rmse predicted %.4f s ahead (cm)  x %.4f  y %.4f  (%.2f px)\n", r.horizon_s, r.rmse_predicted_cm.x(),
+                  r.rmse_predicted_cm.y(), r.predicted_error_px);
+      return 0;
+    }
 
     std::unique_ptr<scenarios::PanTiltDisplay> view;
     if (display) view = std::make_unique<scenarios::PanTiltDisplay>();
@@ -67,9 +83,13 @@ int main(int argc, char** argv) {
     if (!summary_path.empty()) io::writeJsonFile(summary_path, j);
 
     const auto& o = result.ours;
-    std::printf("pan-tilt %s, seed %llu, %.0f s at %.0f fps (%ux%u, fx %.0f fy %.0f), filter %s, gain %.2f\n",
+    std::printf("pan-tilt %s, seed %llu, %.0f s at %.0f fps (%ux%u, fx %.0f fy %.0f), filter %s, gain %.2f (ours %.2f)\n",
                 result.path.c_str(), static_cast<unsigned long long>(seed), cfg.duration, cfg.fps, cfg.image_width,
-                cfg.image_height, cfg.fx, cfg.fy, control::toString(cfg.control.filter.model), cfg.control.servo.gain);
+                cfg.image_height, cfg.fx, cfg.fy, control::toString(cfg.control.filter.model), cfg.control.servo.gain,
+                cfg.control.gain > 0.0 ? cfg.control.gain : cfg.control.servo.gain);
+    if (!cfg.rig_folder.empty()) {
+      std::printf("  rig %s: renders with truth.yaml, controls with rig.yaml + e_M_c.yaml\n", cfg.rig_folder.c_str());
+    }
     std::printf("  [T] noise sigma (cm)        x %.3f  y %.3f\n", o.noise_sigma_cm.x(), o.noise_sigma_cm.y());
     std::printf("  rmse measured (cm)          x %.4f  y %.4f\n", o.rmse_measured_cm.x(), o.rmse_measured_cm.y());
     std::printf("  rmse filtered (cm)          x %.4f  y %.4f\n", o.rmse_filtered_cm.x(), o.rmse_filtered_cm.y());
@@ -97,6 +117,7 @@ int main(int argc, char** argv) {
       if (o.reacquired) std::printf(" %.3f s after it ended", o.reacquisition_delay_s);
       std::printf("\n");
     }
+    std::printf("  filter: %zu velocity jumps (corners) detected\n", o.filter_jumps);
     std::printf("  %.1f ms per frame (render + detect + control)\n", o.wall_ms_per_frame);
     return 0;
   } catch (const core::Error& e) {

@@ -17,20 +17,33 @@ vpColVector toCol(const Eigen::Vector2d& q) {
 }
 }  // namespace
 
+Eigen::Isometry3d PanTiltKinematics::nominalEyeInHand() {
+  vpPtu46 ptu;
+  vpHomogeneousMatrix cMe;
+  ptu.get_cMe(cMe);
+  return core::toEigen(cMe.inverse());
+}
+
+PanTiltKinematics::PanTiltKinematics() : PanTiltKinematics(nominalEyeInHand()) {}
+
+PanTiltKinematics::PanTiltKinematics(const Eigen::Isometry3d& e_M_c) : e_M_c_(e_M_c) {
+  core::requireFinite(e_M_c.matrix(), "PanTiltKinematics: e_M_c");
+  ptu_.get_cMe(c_M_e_nominal_);
+  e_M_c_vp_ = core::toVisp(e_M_c);
+  cVe_.buildFrom(e_M_c_vp_.inverse());
+}
+
 vpHomogeneousMatrix PanTiltKinematics::f_M_c(const Eigen::Vector2d& q) const {
   core::requireFinite(q, "PanTiltKinematics: q");
-  return ptu_.computeMGD(toCol(q));
+  // f_M_e(q) = f_M_c_nominal(q) c_M_e_nominal; then the actual mount.
+  return ptu_.computeMGD(toCol(q)) * c_M_e_nominal_ * e_M_c_vp_;
 }
 
 Eigen::Isometry3d PanTiltKinematics::c_M_f(const Eigen::Vector2d& q) const {
   return core::toEigen(f_M_c(q).inverse());
 }
 
-vpVelocityTwistMatrix PanTiltKinematics::cVe() const {
-  vpVelocityTwistMatrix v;
-  ptu_.get_cVe(v);
-  return v;
-}
+vpVelocityTwistMatrix PanTiltKinematics::cVe() const { return cVe_; }
 
 vpMatrix PanTiltKinematics::eJe(const Eigen::Vector2d& q) const {
   core::requireFinite(q, "PanTiltKinematics: q");

@@ -34,6 +34,41 @@ TEST(PanTiltKinematics, JacobianMatchesDerivativeOfPose) {
   }
 }
 
+TEST(PanTiltKinematics, OtherCameraMount) {
+  // The nominal mount reproduces vpPtu46's chain exactly.
+  const PanTiltKinematics nominal;
+  const PanTiltKinematics same(PanTiltKinematics::nominalEyeInHand());
+  const Eigen::Vector2d q0(0.3, -0.2);
+  EXPECT_LT((nominal.c_M_f(q0).matrix() - same.c_M_f(q0).matrix()).cwiseAbs().maxCoeff(), 1e-12);
+  // A camera mounted with errors (translation and a few tenths of a degree, as calib/rigs/pan_tilt):
+  // f_M_c = f_M_e e_M_c, and cVe eJe still gives the camera twist.
+  Eigen::Isometry3d e_M_c = PanTiltKinematics::nominalEyeInHand();
+  e_M_c.translation() += Eigen::Vector3d(0.002, 0.0025, 0.0035);
+  e_M_c.linear() = e_M_c.linear() * Eigen::AngleAxisd(0.012, Eigen::Vector3d(0.6, -0.5, 0.62).normalized()).toRotationMatrix();
+  const PanTiltKinematics k(e_M_c);
+  const Eigen::Isometry3d f_M_e = nominal.c_M_f(q0).inverse() * PanTiltKinematics::nominalEyeInHand().inverse();
+  EXPECT_LT(((f_M_e * e_M_c).matrix() - k.c_M_f(q0).inverse().matrix()).cwiseAbs().maxCoeff(), 1e-12);
+  EXPECT_GT((k.c_M_f(q0).matrix() - nominal.c_M_f(q0).matrix()).cwiseAbs().maxCoeff(), 1e-3);
+  core::Rng rng = core::makeRng(4);
+  for (int trial = 0; trial < 10; ++trial) {
+    const Eigen::Vector2d q(core::uniform(rng, -2.5, 2.5), core::uniform(rng, -0.8, 0.5));
+    const Eigen::Vector2d qd(core::uniform(rng, -1, 1), core::uniform(rng, -1, 1));
+    const double h = 1e-6;
+    const vpColVector v_fd = vpExponentialMap::inverse(k.f_M_c(q).inverse() * k.f_M_c(q + h * qd), h);
+    vpColVector qdv(2);
+    qdv[0] = qd(0);
+    qdv[1] = qd(1);
+    const vpColVector v = k.cVe() * k.eJe(q) * qdv;
+    for (unsigned i = 0; i < 6; ++i) EXPECT_NEAR(v[i], v_fd[i], 1e-5) << "component " << i;
+  }
+  // pointAt uses the mount: the point lands on this camera's optical axis.
+  const Eigen::Vector3d p(1.3, 0.2, -0.3);
+  const Eigen::Vector3d s = k.project(k.pointAt(p), p);
+  EXPECT_NEAR(s.x(), 0.0, 1e-10);
+  EXPECT_NEAR(s.y(), 0.0, 1e-10);
+  EXPECT_GT(std::abs(nominal.project(k.pointAt(p), p).x()), 1e-4);
+}
+
 TEST(PanTiltKinematics, ConventionsAndPointAt) {
   PanTiltKinematics k;
   // q = 0 looks along +x_f; image y is down (−z_f).

@@ -3,20 +3,29 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
+#include <fstream>
 #include <memory>
+#include <sstream>
 
 #include "viewline/core/checks.h"
 #include "viewline/core/error.h"
 #include "viewline/core/frames.h"
 #include "viewline/core/random.h"
+#include "viewline/io/rig.h"
 #include "viewline/robots/pan_tilt_kinematics.h"
 #include "viewline/sim/rig.h"
 #include "viewline/sim/worlds.h"
+#include "viewline/scenarios/simulated_rig.h"
 
 namespace viewline::scenarios {
 
 using Eigen::Vector2d;
 using Eigen::Vector3d;
+
+namespace {
+constexpr const char* kRigCamera = "ptu_camera";  ///< the camera's name in a pan-tilt rig folder
+}  // namespace
 
 // ---------------------------------------------------------------------------------------------
 // Config
@@ -44,6 +53,13 @@ void PanTiltScenarioConfig::validate() const {
   core::requirePositive(duration, "run.duration");
   if (!(metrics_start >= 0.0 && metrics_start < duration)) throw core::InvalidInput("run.metrics_start must be in [0, duration)");
   if (occlusion_start >= 0.0) core::requirePositive(occlusion_duration, "run.occlusion_duration");
+  const bool any_rig = true_camera || calibrated_camera || true_e_M_c || calibrated_e_M_c;
+  if (any_rig && !(true_camera && calibrated_camera && true_e_M_c && calibrated_e_M_c)) {
+    throw core::InvalidInput("rig: the true and calibrated cameras and camera mounts are set together");
+  }
+  if (true_camera && (true_camera->width != calibrated_camera->width || true_camera->height != calibrated_camera->height)) {
+    throw core::InvalidInput("rig: true and calibrated cameras of different image sizes");
+  }
 }
 
 PanTiltScenarioConfig loadPanTiltScenarioConfig(const io::ConfigNode& root) {
@@ -67,12 +83,42 @@ PanTiltScenarioConfig loadPanTiltScenarioConfig(const io::ConfigNode& root) {
     c.screen_height = s.getOr<double>("height", c.screen_height);
     c.disc_radius = s.get<double>("disc_radius");
   }
+  if (root.has("rig")) {
+    // Default simulated rig (issue 9): truth for the simulator, calibration for the controllers.
+    const SimulatedRig rig = loadSimulatedRig(root, "rig");
+    const auto where = [&](const std::string& what) {
+      return root.location("rig") + ": key '" + root.keyPath("rig") + "': " + what;
+    };
+    if (!rig.truth.e_M_c) throw core::InvalidInput(where(rig.folder + "/truth.yaml has no hand_eye section (not a pan-tilt rig)"));
+    c.rig_folder = rig.folder;
+    c.true_camera = rig.trueCamera(kRigCamera);
+    c.calibrated_camera = rig.calibratedCamera(kRigCamera);
+    c.true_e_M_c = *rig.truth.e_M_c;
+    try {
+      const auto he = io::ConfigNode::loadFile(rig.file("e_M_c.yaml"));  // calibrate-hand-eye output
+      c.calibrated_e_M_c = io::readPose(he.child("e_M_c"));
+      for (const char* k : {"r_M_o", "rms_translation_m", "rms_rotation_deg"}) he.ignore(k);
+      he.finish();
+    } catch (const core::InvalidInput& e) {
+      throw core::InvalidInput(where(e.what()));
+    }
+    c.image_width = c.true_camera->width;
+    c.image_height = c.true_camera->height;
+    c.fx = c.true_camera->intrinsics.get_px();
+    c.fy = c.true_camera->intrinsics.get_py();
+  }
   {
     const auto cam = root.child("camera");
-    c.image_width = cam.get<unsigned>("width");
-    c.image_height = cam.get<unsigned>("height");
-    c.fx = cam.get<double>("fx");
-    c.fy = cam.get<double>("fy");
+    if (c.rig_folder.empty()) {
+      c.image_width = cam.get<unsigned>("width");
+      c.image_height = cam.get<unsigned>("height");
+      c.fx = cam.get<double>("fx");
+      c.fy = cam.get<double>("fy");
+    } else {
+      for (const char* k : {"width", "height", "fx", "fy"}) {
+        if (cam.has(k)) cam.fail(k, "no inline camera with `rig:` (the rig's truth.yaml and rig.yaml give the camera)");
+      }
+    }
     c.fps = cam.get<double>("fps");
     c.sensor_noise = cam.getOr<double>("sensor_noise", c.sensor_noise);
     c.exposure = cam.getOr<double>("exposure", c.exposure);
@@ -108,6 +154,7 @@ PanTiltScenarioConfig loadPanTiltScenarioConfig(const io::ConfigNode& root) {
     const auto k = root.child("control");
     c.control.servo.gain = k.get<double>("gain");
     c.control.servo.interaction = k.getChoiceOr("interaction", {"desired", "current", "mean"}, "desired");
+    c.control.gain = k.getOr<double>("predictive_gain", 0.0);
     c.control.lead = k.getOr<double>("lead", 0.0);
     c.control.feed_forward = k.getOr<bool>("feed_forward", true);
     c.control.coast_time = k.getOr<double>("coast_time", c.control.coast_time);
@@ -137,6 +184,9 @@ PanTiltScenarioConfig loadPanTiltScenarioConfig(const io::ConfigNode& root) {
     c.control.filter.ct_q_accel = f.getOr<double>("ct_q_accel", c.control.filter.ct_q_accel);
     c.control.filter.ct_q_omega = f.getOr<double>("ct_q_omega", c.control.filter.ct_q_omega);
     c.control.filter.maneuver_q = f.getOr<double>("maneuver_q", c.control.filter.maneuver_q);
+    c.control.filter.jump_window = f.getOr<double>("jump_window", c.control.filter.jump_window);
+    c.control.filter.jump_threshold = f.getOr<double>("jump_threshold", c.control.filter.jump_threshold);
+    c.control.filter.jump_min_samples = f.getOr<int>("jump_min_samples", c.control.filter.jump_min_samples);
     c.control.filter.imm_sojourn = f.getOr<Eigen::Vector3d>("imm_sojourn", c.control.filter.imm_sojourn);
   }
   {
@@ -154,6 +204,27 @@ PanTiltScenarioConfig loadPanTiltScenarioConfig(const io::ConfigNode& root) {
     throw core::InvalidInput(root.fileName() + ": " + e.what());
   }
   return c;
+}
+
+core::Camera panTiltTrueCamera(const PanTiltScenarioConfig& c) {
+  if (c.true_camera) {
+    core::Camera cam = *c.true_camera;
+    cam.c_M_w = Eigen::Isometry3d::Identity();
+    return cam;
+  }
+  core::Camera cam;
+  cam.name = kRigCamera;
+  cam.width = c.image_width;
+  cam.height = c.image_height;
+  cam.intrinsics.initPersProjWithoutDistortion(c.fx, c.fy, 0.5 * (c.image_width - 1.0), 0.5 * (c.image_height - 1.0));
+  return cam;
+}
+
+core::Camera panTiltModelCamera(const PanTiltScenarioConfig& c) {
+  if (!c.calibrated_camera) return panTiltTrueCamera(c);
+  core::Camera cam = *c.calibrated_camera;
+  cam.c_M_w = Eigen::Isometry3d::Identity();
+  return cam;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -260,6 +331,7 @@ nlohmann::json PanTiltRunMetrics::toJson() const {
             {"reacquisition_delay_s", num(reacquisition_delay_s)},
             {"reacquisitions", reacquisitions},
             {"frames_searching", frames_searching}}},
+          {"filter_jumps", filter_jumps},
           {"wall_ms_per_frame", wall_ms_per_frame}};
 }
 
@@ -297,7 +369,11 @@ PanTiltRunMetrics runPanTilt(const PanTiltScenarioConfig& cfg, std::uint64_t see
   if (R.determinant() <= 0.0) R += 1e-8 * Eigen::Matrix2d::Identity();
 
   // Unit, pointing at the start point plus the configured offset.
-  robots::PanTiltKinematics kin;
+  // The true unit (simulator) and the unit as the controllers know it (calibrated mount).
+  const robots::PanTiltKinematics kin =
+      cfg.true_e_M_c ? robots::PanTiltKinematics(*cfg.true_e_M_c) : robots::PanTiltKinematics();
+  const robots::PanTiltKinematics kin_model =
+      cfg.calibrated_e_M_c ? robots::PanTiltKinematics(*cfg.calibrated_e_M_c) : robots::PanTiltKinematics();
   robots::SimulatedPanTiltParams up = cfg.unit;
   {
     const Vector2d p0 = path.position(0.0);
@@ -308,11 +384,8 @@ PanTiltRunMetrics runPanTilt(const PanTiltScenarioConfig& cfg, std::uint64_t see
 
   // Camera on the unit.
   sim::SimCamera sc;
-  sc.camera.name = "ptu_camera";
-  sc.camera.width = cfg.image_width;
-  sc.camera.height = cfg.image_height;
-  sc.camera.intrinsics.initPersProjWithoutDistortion(cfg.fx, cfg.fy, 0.5 * (cfg.image_width - 1.0),
-                                                     0.5 * (cfg.image_height - 1.0));
+  sc.camera = panTiltTrueCamera(cfg);
+  core::Camera model_cam = panTiltModelCamera(cfg);  // pose set per frame
   sc.clock.rate = cfg.fps;
   sc.effects.noise.sigma = cfg.sensor_noise;
   sc.effects.noise.pool_size = 1u << 20;
@@ -331,12 +404,13 @@ PanTiltRunMetrics runPanTilt(const PanTiltScenarioConfig& cfg, std::uint64_t see
   std::unique_ptr<control::PanTiltController> ctrl;
   control::PredictivePanTiltController* ours = nullptr;
   if (kind == PanTiltControllerKind::Predictive) {
-    auto p = std::make_unique<control::PredictivePanTiltController>(cfg.control, up.limits, up.latency, f_M_screen);
+    auto p = std::make_unique<control::PredictivePanTiltController>(cfg.control, up.limits, up.latency, f_M_screen,
+                                                                     kin_model);
     ours = p.get();
     ctrl = std::move(p);
   } else {
     ctrl = std::make_unique<control::BaselinePanTiltController>(cfg.control.servo, up.limits, up.latency,
-                                                                cfg.control.limits);
+                                                                cfg.control.limits, kin_model);
   }
 
   PanTiltRunMetrics m;
@@ -376,10 +450,13 @@ PanTiltRunMetrics runPanTilt(const PanTiltScenarioConfig& cfg, std::uint64_t see
     obs.stamp = frame->stamp;
     Vector2d meas_px = Vector2d::Constant(std::nan(""));
     const auto det = detector.detect(frame->image, frame->stamp);
+    // The camera as the controllers know it at the capture stamp: calibrated intrinsics, calibrated
+    // mount, encoder reading at the stamp.
+    model_cam.c_M_w = kin_model.c_M_f(unit.read(frame->stamp).q);
     if (det.ok()) {
-      // Back-project onto the screen plane (z_screen = 0) through the capture-time camera.
-      const Vector3d ray_f = cam.rayThroughPixel_w(det.value().pixel);
-      const Vector3d c_f = cam.center_w();
+      // Back-project onto the screen plane (z_screen = 0) through that camera.
+      const Vector3d ray_f = model_cam.rayThroughPixel_w(det.value().pixel);
+      const Vector3d c_f = model_cam.center_w();
       const Eigen::Isometry3d screen_M_f = f_M_screen.inverse();
       const Vector3d o_s = screen_M_f * c_f;
       const Vector3d d_s = screen_M_f.linear() * ray_f;
@@ -387,12 +464,12 @@ PanTiltRunMetrics runPanTilt(const PanTiltScenarioConfig& cfg, std::uint64_t see
         const double lambda = -o_s.z() / d_s.z();
         const Vector3d hit = o_s + lambda * d_s;
         const Vector2d measured = hit.head<2>() + n;
-        const Vector3d meas_c = cam.toCamera(f_M_screen * Vector3d(measured.x(), measured.y(), 0.0));
+        const Vector3d meas_c = model_cam.toCamera(f_M_screen * Vector3d(measured.x(), measured.y(), 0.0));
         obs.detected = meas_c.z() > 0.0;
         obs.plane = measured;
         obs.plane_cov = R;
         obs.feature = Vector2d(meas_c.x() / meas_c.z(), meas_c.y() / meas_c.z());
-        meas_px = cam.normalizedToPixel(obs.feature);
+        meas_px = model_cam.normalizedToPixel(obs.feature);
         if (tc >= cfg.metrics_start) det_px.add((det.value().pixel - truth_px).squaredNorm());
       }
     }
@@ -452,7 +529,7 @@ PanTiltRunMetrics runPanTilt(const PanTiltScenarioConfig& cfg, std::uint64_t see
     }
 
     Vector2d pred_px = Vector2d::Constant(std::nan(""));
-    if (out.has_prediction) pred_px = cam.normalizedToPixel(out.predicted_feature);
+    if (out.has_prediction) pred_px = model_cam.normalizedToPixel(out.predicted_feature);
     if (csv != nullptr) {
       csv->row({tc, truth.x(), truth.y(), obs.detected ? 1.0 : 0.0, obs.detected ? obs.plane.x() : std::nan(""),
                 obs.detected ? obs.plane.y() : std::nan(""), filt.x(), filt.y(), truth_px.x(), truth_px.y(),
@@ -484,6 +561,7 @@ PanTiltRunMetrics runPanTilt(const PanTiltScenarioConfig& cfg, std::uint64_t see
   if (ours != nullptr) {
     m.rmse_filtered_cm = 100.0 * Vector2d(fx_.rms(), fy_.rms());
     m.reacquisitions = ours->reacquisitions();
+    m.filter_jumps = ours->filter().jumps();
   }
   m.detection_pixel_rmse_px = det_px.rms();
   m.rate_violations = unit.rateViolations();
@@ -494,6 +572,97 @@ PanTiltRunMetrics runPanTilt(const PanTiltScenarioConfig& cfg, std::uint64_t see
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - wall0).count();
   m.wall_ms_per_frame = m.frames ? wall / static_cast<double>(m.frames) : 0.0;
   return m;
+}
+
+nlohmann::json PanTiltReplayMetrics::toJson() const {
+  return {{"measurements", measurements},
+          {"jumps", jumps},
+          {"rmse_measured_cm", {rmse_measured_cm.x(), rmse_measured_cm.y()}},
+          {"rmse_filtered_cm", {rmse_filtered_cm.x(), rmse_filtered_cm.y()}},
+          {"horizon_s", horizon_s},
+          {"rmse_predicted_cm", {rmse_predicted_cm.x(), rmse_predicted_cm.y()}},
+          {"predicted_error_px", predicted_error_px}};
+}
+
+PanTiltReplayMetrics replayPanTiltFilter(const PanTiltScenarioConfig& cfg, std::uint64_t seed,
+                                         const std::string& frames_csv) {
+  cfg.validate();
+  core::Rng path_rng = core::makeRng(core::deriveSeed(seed, 1));  // the run's path stream
+  sim::ScreenPathParams pp = cfg.path;
+  pp.duration = cfg.duration + 10.0;
+  const sim::ScreenPath path(pp, path_rng);
+  double amplitude_span = cfg.duration;  // (as runPanTilt)
+  if (pp.shape == sim::PathShape::Rectangle) amplitude_span = 2.0 * (pp.width + pp.height) / pp.speed;
+  if (pp.shape == sim::PathShape::Circle) amplitude_span = 2.0 * core::kPi * pp.radius / pp.speed;
+  const Vector2d sigma = cfg.noise_fraction * pathAmplitude(path, amplitude_span);
+  Eigen::Matrix2d R = sigma.cwiseProduct(sigma).asDiagonal();
+  if (R.determinant() <= 0.0) R += 1e-8 * Eigen::Matrix2d::Identity();
+
+  std::ifstream in(frames_csv);
+  if (!in) throw core::InvalidInput(frames_csv + ": cannot read (predictive_frames.csv of pan_tilt_tracking --log)");
+  std::string line;
+  std::getline(in, line);
+  std::vector<std::string> header;
+  {
+    std::stringstream ss(line);
+    std::string f;
+    while (std::getline(ss, f, ',')) header.push_back(f);
+  }
+  const auto col = [&](const std::string& name) {
+    const auto it = std::find(header.begin(), header.end(), name);
+    if (it == header.end()) throw core::InvalidInput(frames_csv + ": no column '" + name + "'");
+    return static_cast<std::size_t>(it - header.begin());
+  };
+  const std::size_t ct = col("t"), cd = col("detected"), cx = col("meas_x"), cy = col("meas_y");
+
+  control::PredictivePanTiltController ctrl(cfg.control, cfg.unit.limits, cfg.unit.latency, screenPose(cfg));
+  const double occ0 = cfg.occlusion_start >= 0.0 ? cfg.occlusion_start : 1e300;
+  const double occ1 = cfg.occlusion_start >= 0.0 ? cfg.occlusion_start + cfg.occlusion_duration : 1e300;
+  PanTiltReplayMetrics out;
+  out.horizon_s = cfg.processing_delay + cfg.unit.latency + cfg.control.lead;
+  Accumulator mx, my, fx_, fy_, px_, py_;
+  std::size_t row = 1;
+  while (std::getline(in, line)) {
+    ++row;
+    if (line.empty()) continue;
+    std::vector<double> v;
+    std::stringstream ss(line);
+    std::string f;
+    while (std::getline(ss, f, ',')) v.push_back(f.empty() || f == "nan" ? std::nan("") : std::strtod(f.c_str(), nullptr));
+    if (v.size() != header.size()) throw core::InvalidInput(frames_csv + ":" + std::to_string(row) + ": wrong number of columns");
+    const double t = v[ct];
+    if (t >= cfg.duration) break;
+    control::TargetObservation obs;
+    obs.stamp = t;
+    obs.detected = v[cd] > 0.5;
+    if (obs.detected) {
+      obs.plane = Vector2d(v[cx], v[cy]);
+      obs.plane_cov = R;
+      ++out.measurements;
+    }
+    ctrl.observe(obs);
+    if (!(t >= cfg.metrics_start && !(t >= occ0 && t < occ1 + 2.0))) continue;
+    const Vector2d truth = path.position(t);
+    if (obs.detected) {
+      mx.add(std::pow(obs.plane.x() - truth.x(), 2));
+      my.add(std::pow(obs.plane.y() - truth.y(), 2));
+      if (ctrl.lastUpdate().accepted) {
+        fx_.add(std::pow(ctrl.filteredPlane().x() - truth.x(), 2));
+        fy_.add(std::pow(ctrl.filteredPlane().y() - truth.y(), 2));
+      }
+    }
+    if (ctrl.filter().initialized()) {
+      const Vector2d e = ctrl.filter().at(t + out.horizon_s).p - path.position(t + out.horizon_s);
+      px_.add(e.x() * e.x());
+      py_.add(e.y() * e.y());
+    }
+  }
+  out.jumps = ctrl.filter().jumps();
+  out.rmse_measured_cm = 100.0 * Vector2d(mx.rms(), my.rms());
+  out.rmse_filtered_cm = 100.0 * Vector2d(fx_.rms(), fy_.rms());
+  out.rmse_predicted_cm = 100.0 * Vector2d(px_.rms(), py_.rms());
+  out.predicted_error_px = std::hypot(px_.rms(), py_.rms()) * cfg.fx / cfg.screen_distance;
+  return out;
 }
 
 PanTiltComparison runPanTiltComparison(const PanTiltScenarioConfig& config, std::uint64_t seed,
@@ -527,7 +696,9 @@ nlohmann::json PanTiltComparison::toJson(const PanTiltScenarioConfig& cfg) const
   j["camera"] = {{"width", cfg.image_width}, {"height", cfg.image_height}, {"fx", cfg.fx}, {"fy", cfg.fy}, {"fps", cfg.fps}};
   j["path_speed_m_s"] = cfg.path.speed;
   j["filter_model"] = control::toString(cfg.control.filter.model);
-  j["servo_gain"] = cfg.control.servo.gain;
+  j["servo_gain"] = cfg.control.servo.gain;  // the baseline's (and ours unless predictive_gain is set)
+  j["predictive_gain"] = cfg.control.gain > 0.0 ? cfg.control.gain : cfg.control.servo.gain;
+  j["rig"] = cfg.rig_folder;
   j["noise_definition"] =
       "per axis, white Gaussian noise with std = measurement_noise_fraction x (max - min)/2 of the true path "
       "along that axis, added to the measured target position on the screen plane";

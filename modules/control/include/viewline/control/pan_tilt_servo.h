@@ -29,6 +29,9 @@
 //
 // so that ṡ = J q̇ + ṡ_T = −λ (ŝ − s*): the error decays at rate λ instead of
 // settling at the lag ṡ_T / λ of law (1). J⁺ is vpServo's own pseudo-inverse.
+// λ of (2) is PredictiveConfig::gain when set (the baseline keeps servo.gain): law
+// (2) acts on the predicted error at the effect time, so a higher λ follows the
+// filter's corrections faster without the delay that limits law (1)'s gain.
 //
 // Both laws' outputs go through robots::limitVelocityCommand (rate limit, and
 // joint limits with braking from the predicted state at the effect time), so no
@@ -110,6 +113,9 @@ struct TargetFilterConfig {
   double ct_q_omega = 1e-3;              ///< CT/IMM: turn-rate random-walk density (rad²/s³)
   double maneuver_q = 0.5;               ///< IMM manoeuvre mode: CV acceleration density (m²/s³)
   Eigen::Vector3d imm_sojourn{5.0, 5.0, 0.2};  ///< IMM mean sojourn times (s) of the cv, ct, manoeuvre modes
+  double jump_window = 0.0;              ///< s searched back for a velocity jump (GLR; 0: no jump detection)
+  double jump_threshold = 20.0;          ///< GLR statistic (χ², 2 dof) that declares a jump
+  int jump_min_samples = 4;              ///< measurements after a candidate jump time before it is tested
   double gate_probability = 0.9999;      ///< chi-square (2 dof) gate on the NIS
   int reinit_after = 3;                  ///< consecutive gated-out measurements that re-initialise
   void validate() const;
@@ -127,6 +133,10 @@ struct TargetFilterConfig {
 ///           density maneuver_q; mean sojourn times imm_sojourn, jumps uniform to the other modes.
 ///           (CT alone is the one-mode IMM, i.e. a plain EKF.)
 /// Measurement: the position, y = [I 0] x + e, cov e = R.
+/// Jump detection (jump_window > 0, any model): a generalised likelihood-ratio test for a step in
+/// velocity at one of the measurement times of the last jump_window seconds (a corner of a
+/// polyline at constant speed); on detection the filter restarts from its estimate at that time
+/// with the velocity prior re-opened and processes the later measurements again (detectJump()).
 class PlanarTargetFilter {
 public:
   explicit PlanarTargetFilter(const TargetFilterConfig& config = {});
@@ -134,6 +144,7 @@ public:
   struct Update {
     bool accepted = false;
     bool reinitialized = false;
+    bool jump = false;  ///< a velocity jump was detected and the recent measurements processed again
     double nis = 0.0;
   };
   bool initialized() const { return initialized_; }
@@ -153,8 +164,23 @@ public:
   int stateDim() const;
   /// IMM mode probabilities (cv, ct, maneuver); empty for the other models.
   Eigen::VectorXd modeProbabilities() const;
+  /// Velocity jumps detected since construction.
+  std::size_t jumps() const { return jumps_; }
 
 private:
+  struct Snapshot {
+    core::Timestamp t = 0.0;
+    Eigen::Vector2d z = Eigen::Vector2d::Zero();
+    Eigen::Matrix2d R = Eigen::Matrix2d::Identity();
+    estimation::StateEstimate state;       ///< x(t|t) after this measurement
+    std::optional<estimation::Imm> imm;
+  };
+  Update step(core::Timestamp t, const Eigen::Vector2d& z, const Eigen::Matrix2d& R);
+  Snapshot snapshot(core::Timestamp t, const Eigen::Vector2d& z, const Eigen::Matrix2d& R) const;
+  Eigen::Vector2d extrapolatePosition(const Eigen::VectorXd& x, double tau) const;
+  bool detectJump();
+  std::vector<Snapshot> history_;  ///< accepted measurements of the last jump_window s (since the last jump)
+  std::size_t jumps_ = 0;
   bool usesImm() const { return config_.model == TargetModel::CoordinatedTurn || config_.model == TargetModel::Imm; }
   TargetFilterConfig config_;
   std::optional<estimation::Imm> imm_;
@@ -211,8 +237,11 @@ public:
 /// Law (1) on the raw measured feature; zero velocity when the target is not detected.
 class BaselinePanTiltController : public PanTiltController {
 public:
+  /// `kinematics`: the unit's model as the controller knows it (camera mount from the hand-eye
+  /// calibration; vpPtu46's nominal mount by default).
   BaselinePanTiltController(const PointServoConfig& servo, const robots::PanTiltLimits& limits, double latency,
-                            const LimitConfig& limit_config = {});
+                            const LimitConfig& limit_config = {},
+                            const robots::PanTiltKinematics& kinematics = robots::PanTiltKinematics());
   std::string name() const override { return "visp_baseline"; }
   void observe(const TargetObservation& observation) override { last_ = observation; }
   ControlOutput command(const ControlInput& input) override;
@@ -229,6 +258,7 @@ private:
 struct PredictiveConfig {
   PointServoConfig servo;
   TargetFilterConfig filter;
+  double gain = 0.0;              ///< λ (1/s) of law (2); 0: servo.gain (the baseline's)
   double lead = 0.0;              ///< s predicted beyond the command latency (e.g. half a period)
   bool feed_forward = true;       ///< the −J⁺ ṡ_T term of (2)
   double coast_time = 1.5;        ///< s of following the prediction without measurements
@@ -243,9 +273,11 @@ struct PredictiveConfig {
 /// Law (2): prediction, feed-forward, latency compensation, search and reacquisition.
 class PredictivePanTiltController : public PanTiltController {
 public:
-  /// f_M_plane: pose of the target plane (x, y in the plane) in the unit's base frame.
+  /// f_M_plane: pose of the target plane (x, y in the plane) in the unit's base frame;
+  /// `kinematics`: the unit's model as the controller knows it (see BaselinePanTiltController).
   PredictivePanTiltController(const PredictiveConfig& config, const robots::PanTiltLimits& limits, double latency,
-                              const Eigen::Isometry3d& f_M_plane);
+                              const Eigen::Isometry3d& f_M_plane,
+                              const robots::PanTiltKinematics& kinematics = robots::PanTiltKinematics());
   std::string name() const override { return "predictive"; }
   void observe(const TargetObservation& observation) override;
   ControlOutput command(const ControlInput& input) override;

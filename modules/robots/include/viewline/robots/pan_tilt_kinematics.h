@@ -20,6 +20,13 @@
 // Newton steps on the point's normalised image coordinates (the camera centre
 // is offset from the axes by L and h, so the direction alone is off by ~3°
 // at 1.3 m).
+//
+// Camera mount (issue 9): vpPtu46 carries a nominal camera mount e_M_c (translation
+// (h, −L, 0), rotation 90° about z). A real camera is mounted with errors, so the
+// model can be built with another e_M_c (the true one in the simulator, the
+// hand-eye calibration in the estimators): f_M_c(q) = f_M_e(q) e_M_c, with
+// f_M_e(q) = f_M_c_nominal(q) c_M_e_nominal (vpPtu46's chain without its mount),
+// and cVe the twist of c_M_e = e_M_c⁻¹. eJe does not depend on the mount.
 
 #include <Eigen/Geometry>
 #include <visp3/core/vpHomogeneousMatrix.h>
@@ -31,6 +38,16 @@ namespace viewline::robots {
 
 class PanTiltKinematics {
 public:
+  /// vpPtu46's nominal camera mount.
+  PanTiltKinematics();
+  /// The camera mounted at e_M_c on the end effector (maps camera to end-effector coordinates).
+  explicit PanTiltKinematics(const Eigen::Isometry3d& e_M_c);
+
+  /// The camera mount in use (the nominal one for the default constructor).
+  const Eigen::Isometry3d& e_M_c() const { return e_M_c_; }
+  /// vpPtu46's nominal camera mount.
+  static Eigen::Isometry3d nominalEyeInHand();
+
   /// Pose of the camera in the base frame (maps camera coordinates to base coordinates).
   vpHomogeneousMatrix f_M_c(const Eigen::Vector2d& q) const;
   /// Pose of the base in the camera frame, as Eigen (c_M_f).
@@ -47,6 +64,9 @@ public:
 
 private:
   vpPtu46 ptu_;
+  Eigen::Isometry3d e_M_c_;
+  vpHomogeneousMatrix c_M_e_nominal_, e_M_c_vp_;
+  vpVelocityTwistMatrix cVe_;
 };
 
 }  // namespace viewline::robots
