@@ -93,7 +93,7 @@ ConfigNode ConfigNode::loadFile(const std::string& path) {
   return ConfigNode(shared, root, "");
 }
 
-ConfigNode ConfigNode::fromString(const std::string& text, const std::string& name) {
+ConfigNode ConfigNode::fromString(const std::string& text, const std::string& name, const std::string& base_dir) {
   YAML::Node root;
   try {
     root = YAML::Load(text);
@@ -106,6 +106,7 @@ ConfigNode ConfigNode::fromString(const std::string& text, const std::string& na
   checkKeys(root, name);
   auto shared = std::make_shared<Shared>();
   shared->file = name;
+  shared->dir = base_dir;
   return ConfigNode(shared, root, "");
 }
 

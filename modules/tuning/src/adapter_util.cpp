@@ -167,4 +167,8 @@ std::unique_ptr<ScenarioAdapter> makeAdapter(AdapterInfo info, AdapterLoader loa
   return std::make_unique<InfoAdapter>(std::move(info), std::move(load));
 }
 
+io::ConfigNode scenarioConfig(const std::string& yaml, const std::string& name) {
+  return io::ConfigNode::fromString(yaml, name, std::filesystem::path(name).parent_path().string());
+}
+
 }  // namespace viewline::tuning::detail

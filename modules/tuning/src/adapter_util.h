@@ -20,6 +20,7 @@
 
 #include "viewline/core/camera.h"
 #include "viewline/core/error.h"
+#include "viewline/io/config.h"
 #include "viewline/tracking/tracker.h"
 #include "viewline/tuning/scenario.h"
 
@@ -117,5 +118,9 @@ struct AdapterInfo {
 using AdapterLoader =
     std::function<std::unique_ptr<ScenarioInstance>(const std::string& yaml, const std::string& name, const AdapterOptions&)>;
 std::unique_ptr<ScenarioAdapter> makeAdapter(AdapterInfo info, AdapterLoader load);
+
+/// The scenario tree for the scenario's own loader: `name` is the config file's path, so its
+/// relative paths (`rig: ../calib/rigs/<rig>`) resolve against the file's folder, as in the app.
+io::ConfigNode scenarioConfig(const std::string& yaml, const std::string& name);
 
 }  // namespace viewline::tuning::detail

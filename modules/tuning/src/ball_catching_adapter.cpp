@@ -268,7 +268,7 @@ void registerBallCatchingAdapter(AdapterRegistry& registry) {
                   {"nees_fused", "8", {}, "the NEES sample of a throw is taken after this many fused images"}};
   registry.add(detail::makeAdapter(std::move(info), [](const std::string& yaml, const std::string& name,
                                                        const AdapterOptions& options) {
-    scenarios::BallCatchingConfig cfg = scenarios::loadBallCatchingConfig(io::ConfigNode::fromString(yaml, name));
+    scenarios::BallCatchingConfig cfg = scenarios::loadBallCatchingConfig(detail::scenarioConfig(yaml, name));
     CatchOptions o;
     const double throws = optionNumber(options, "throws");
     if (!(throws >= 1.0 && throws <= 1e5)) throw core::InvalidInput("adapter option 'throws': expected 1 to 1e5");

@@ -200,7 +200,7 @@ void registerMobileCaptureAdapter(AdapterRegistry& registry) {
                   {"settle_s", "2", {}, "s a track must have been valid before its NEES samples count"}};
   registry.add(detail::makeAdapter(std::move(info), [](const std::string& yaml, const std::string& name,
                                                        const AdapterOptions& options) {
-    scenarios::MobileCaptureConfig cfg = scenarios::loadMobileCaptureConfig(io::ConfigNode::fromString(yaml, name));
+    scenarios::MobileCaptureConfig cfg = scenarios::loadMobileCaptureConfig(detail::scenarioConfig(yaml, name));
     MobileOptions o;
     o.max_time = optionNumber(options, "max_time");
     o.nees_spacing = optionNumber(options, "nees_spacing_s");

@@ -353,7 +353,7 @@ void registerPanTiltAdapter(AdapterRegistry& registry) {
                   {"log_seed", "1", {}, "seed of a pan_tilt_tracking --log run (its path amplitude gives R)"}};
   registry.add(detail::makeAdapter(std::move(info), [](const std::string& yaml, const std::string& name,
                                                        const AdapterOptions& options) {
-    scenarios::PanTiltScenarioConfig cfg = scenarios::loadPanTiltScenarioConfig(io::ConfigNode::fromString(yaml, name));
+    scenarios::PanTiltScenarioConfig cfg = scenarios::loadPanTiltScenarioConfig(detail::scenarioConfig(yaml, name));
     PanTiltOptions o;
     o.duration = optionNumber(options, "duration");
     if (!(o.duration >= 0.0)) throw core::InvalidInput("adapter option 'duration': expected >= 0");

@@ -51,6 +51,16 @@ YAML::Node parseYaml(const std::string& text, const std::string& path) {
   }
 }
 
+// `kv` plus the config's relative paths (rig folders, ...) re-expressed for a copy of the config
+// written into `out_dir`, so that the copy loads from there too (keys already in `kv` win).
+void addRelocatedPaths(std::vector<std::pair<std::string, YAML::Node>>& kv, const std::string& text,
+                       const std::string& config_path, const std::string& out_dir) {
+  for (auto& r : relocatedPaths(parseYaml(text, config_path), fs::path(config_path).parent_path().string(), out_dir)) {
+    const bool swept = std::any_of(kv.begin(), kv.end(), [&](const auto& e) { return e.first == r.first; });
+    if (!swept) kv.push_back(std::move(r));
+  }
+}
+
 nlohmann::json interval(const core::Interval& i) { return {num(i.lo), num(i.hi)}; }
 
 nlohmann::json consistencyJson(const Consistency& c, double confidence) {
@@ -257,6 +267,7 @@ AutotuneOutcome doAutotune(const ScenarioInstance& base, const std::string& orig
   for (std::size_t i = 0; i < params.size(); ++i)
     header += params[i].name + " " + params[i].symbol + ": start " + fmt(start[i]) + " -> tuned " +
               fmt(o.result.tuned[i]) + " " + params[i].unit + (params[i].config_key.empty() ? " (not written: no config key)" : "") + "\n";
+  addRelocatedPaths(kv, original_text, source_name, out_dir);
   o.config_file = (fs::path(out_dir) / "autotuned_config.yaml").string();
   io::writeTextFileAtomic(o.config_file, rewriteYamlText(original_text, kv, header));
   o.json["autotuned_config"] = o.config_file;
@@ -401,6 +412,7 @@ nlohmann::json runSweepSession(const AdapterRegistry& registry, const std::strin
     best_metric = b.metrics.at(spec.metric).mean;
     std::vector<std::pair<std::string, YAML::Node>> kv;
     for (std::size_t k = 0; k < spec.parameters.size(); ++k) kv.emplace_back(spec.parameters[k].key, b.setting.values[k]);
+    addRelocatedPaths(kv, text, config_path, opt.out_dir);
     best_config = (fs::path(opt.out_dir) / "best_config.yaml").string();
     const std::string header = "viewline_tune: best setting of " + sweep_file + " (" + spec.metric + " " +
                                (spec.minimize ? "minimised" : "maximised") + ": " + fmt(best_metric, 6) + " over " +

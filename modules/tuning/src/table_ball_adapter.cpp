@@ -345,7 +345,7 @@ void registerTableBallAdapter(AdapterRegistry& registry) {
                   {"nees_spacing_s", "0.5", {}, "s between NEES samples (nearly independent)"}};
   registry.add(detail::makeAdapter(std::move(info), [](const std::string& yaml, const std::string& name,
                                                        const AdapterOptions& options) {
-    scenarios::TableBallConfig cfg = scenarios::tableBallConfigFromYaml(io::ConfigNode::fromString(yaml, name));
+    scenarios::TableBallConfig cfg = scenarios::tableBallConfigFromYaml(detail::scenarioConfig(yaml, name));
     TableBallOptions o;
     o.duration = optionNumber(options, "duration");
     o.burn_in = static_cast<int>(optionNumber(options, "burn_in"));

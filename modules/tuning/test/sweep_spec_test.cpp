@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <filesystem>
+
 #include "toy_scenario.h"
 #include "viewline/core/error.h"
 #include "viewline/tuning/sweep_spec.h"
@@ -96,4 +98,24 @@ TEST(YamlEdit, RewriteKeepsCommentsAndReplacesInPlace) {
   EXPECT_EQ(n["cams"][0]["f"].as<int>(), 1);
   EXPECT_THROW(parseDottedKey("a..b"), core::InvalidInput);
   EXPECT_THROW(parseDottedKey("a[x]"), core::InvalidInput);
+}
+
+TEST(YamlEdit, RelativePathsAreRelocatedForACopyWrittenElsewhere) {
+  namespace fs = std::filesystem;
+  const fs::path root = fs::temp_directory_path() / "viewline_relocated_paths_test";
+  fs::remove_all(root);
+  fs::create_directories(root / "config");
+  fs::create_directories(root / "calib/rigs/r");
+  fs::create_directories(root / "out/session");
+  const YAML::Node tree = YAML::Load(
+      "rig: ../calib/rigs/r\nname: pan.tilt\nmode: stage\nlist: [../calib, absent/dir]\nabs: /tmp\n");
+  const auto moved = relocatedPaths(tree, (root / "config").string(), (root / "out/session").string());
+  ASSERT_EQ(moved.size(), 2u);  // 'rig' and 'list[0]'; plain words, missing and absolute paths stay
+  EXPECT_EQ(moved[0].first, "rig");
+  EXPECT_EQ(moved[0].second.as<std::string>(), "../../calib/rigs/r");
+  EXPECT_EQ(moved[1].first, "list[0]");
+  EXPECT_EQ(moved[1].second.as<std::string>(), "../../calib");
+  // Written into the same folder as the config: nothing to change.
+  EXPECT_TRUE(relocatedPaths(tree, (root / "config").string(), (root / "config").string()).empty());
+  fs::remove_all(root);
 }

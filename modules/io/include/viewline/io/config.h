@@ -34,8 +34,11 @@ public:
   /// Parses a YAML file; throws InvalidInput naming the file (and line for syntax errors,
   /// duplicate keys) when it cannot be read or parsed. The root must be a map.
   static ConfigNode loadFile(const std::string& path);
-  /// Parses YAML text; `name` stands for the file name in messages.
-  static ConfigNode fromString(const std::string& text, const std::string& name = "<string>");
+  /// Parses YAML text; `name` stands for the file name in messages. Relative paths (getPath) are
+  /// resolved against `base_dir` (empty: returned as written), as loadFile resolves them against
+  /// the file's folder.
+  static ConfigNode fromString(const std::string& text, const std::string& name = "<string>",
+                               const std::string& base_dir = "");
 
   /// True when the map has this key (does not mark it as read).
   bool has(const std::string& key) const;

@@ -46,3 +46,18 @@ std::string rewriteYamlText(const std::string& original_text,
                             const std::string& header);
 
 }  // namespace viewline::tuning
+
+namespace viewline::tuning {
+
+/// The string scalars of a scenario tree that name a file or folder relative to the config's own
+/// folder (scenario loaders resolve relative paths such as `rig: ../calib/rigs/pan_tilt` against
+/// the directory of the config file, io::ConfigNode::getPath), re-expressed relative to
+/// `to_dir`, as (dotted key, new value) pairs for rewriteYamlText(). A config written into
+/// another folder (the session's best_config.yaml, autotuned_config.yaml) then still finds them.
+/// A scalar counts as a path when it is relative, contains '/' or '.', and exists relative to
+/// `from_dir`; absolute paths and other scalars are left alone. Where no relative form exists
+/// the absolute path is used.
+std::vector<std::pair<std::string, YAML::Node>> relocatedPaths(const YAML::Node& root, const std::string& from_dir,
+                                                                 const std::string& to_dir);
+
+}  // namespace viewline::tuning
