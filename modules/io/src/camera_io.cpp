@@ -1,6 +1,8 @@
 #include "viewline/io/camera_io.h"
 
 #include <filesystem>
+#include <iostream>
+#include <mutex>
 #include <opencv2/core.hpp>
 #include <visp3/core/vpException.h>
 #include <visp3/core/vpXmlParserCamera.h>
@@ -16,6 +18,27 @@ vpCameraParameters::vpCameraParametersProjType toVisp(Projection p) {
   return p == Projection::WithDistortion ? vpCameraParameters::perspectiveProjWithDistortion
                                          : vpCameraParameters::perspectiveProjWithoutDistortion;
 }
+
+// vpXmlParserCamera::parse (ViSP 3.5) writes `Found camera with name: "..."` to std::cout for every
+// camera in the file, unconditionally: a rig load in each of a sweep's runs filled the terminal.
+// std::cout's buffer is swapped for the parse only; the lock serialises concurrent loads (the
+// swap is process-wide, so another thread's std::cout output in that instant would be dropped:
+// our library code prints progress to std::cerr).
+class QuietStdout {
+public:
+  QuietStdout() : lock_(mutex()), previous_(std::cout.rdbuf(nullptr)) {}
+  ~QuietStdout() { std::cout.rdbuf(previous_); std::cout.clear(); }
+  QuietStdout(const QuietStdout&) = delete;
+  QuietStdout& operator=(const QuietStdout&) = delete;
+
+private:
+  static std::mutex& mutex() {
+    static std::mutex m;
+    return m;
+  }
+  std::lock_guard<std::mutex> lock_;
+  std::streambuf* previous_;
+};
 
 std::string extensionOf(const std::string& path) {
   std::string e = fs::path(path).extension().string();
@@ -41,6 +64,7 @@ CameraXml loadVispCameraXml(const std::string& path, const std::string& camera_n
   vpCameraParameters cam;
   int status = vpXmlParserCamera::SEQUENCE_ERROR;
   try {
+    const QuietStdout quiet;
     status = parser.parse(cam, path, camera_name, toVisp(projection), width, height);
   } catch (const vpException& e) {
     throw core::InvalidInput(path + ": cannot parse the ViSP camera XML: " + e.getStringMessage());
