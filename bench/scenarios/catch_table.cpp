@@ -16,6 +16,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "viewline/core/error.h"
@@ -63,6 +64,10 @@ int main(int argc, char** argv) {
     using Cfg = scenarios::BallCatchingConfig;
     std::vector<Variant> variants = {
         {"cameras", "1 camera (right)", [](Cfg& c) { c.camera_count = 1; }},
+        {"cameras", "1 camera (behind)", [](Cfg& c) {
+           std::swap(c.cameras[0], c.cameras[1]);
+           c.camera_count = 1;
+         }},
         {"cameras", "4 cameras (right, behind, left, high)", [](Cfg& c) { c.camera_count = 4; }},
         {"rate", "25 Hz", [](Cfg& c) { c.rate_override_hz = 25.0; }},
         {"rate", "100 Hz", [](Cfg& c) { c.rate_override_hz = 100.0; }},
@@ -82,7 +87,7 @@ int main(int argc, char** argv) {
         {"model", "planner ballistic (no drag)", [](Cfg& c) { c.planner.model.kind = planning::FlightModel::Ballistic; }},
     };
     const std::map<std::string, std::string> titles = {
-        {"cameras", "Camera count (first N of right, behind, left, high; 50 Hz)"},
+        {"cameras", "Camera count (first N of right, behind, left, high, or behind alone; 50 Hz)"},
         {"rate", "Frame rate (every camera)"},
         {"noise", "Pixel noise (sensor noise in grey levels; extra Gaussian noise on each detection, told to the tracker)"},
         {"limits", "Robot limits (per Cartesian axis; the oracle uses the same limits)"},

@@ -384,6 +384,10 @@ BallCatchingConfig loadBallCatchingConfig(const io::ConfigNode& root) {
     g.offsets_z = r.getOr<std::vector<double>>("offsets_z", g.offsets_z);
     if (!(g.marker_radius > 0.0)) r.fail("marker_radius", "a positive radius, m");
     g.min_points = r.getOr<int>("min_points", g.min_points);
+    g.gate_px = r.getOr<double>("gate_px", g.gate_px);
+    g.max_rms_px = r.getOr<double>("max_rms_px", g.max_rms_px);
+    g.max_shift_m = r.getOr<double>("max_shift_m", g.max_shift_m);
+    g.max_rotation_rad = r.getAngleOr("max_rotation_deg", g.max_rotation_rad);
     if (g.min_points < 6) r.fail("min_points", "at least 6 (a camera pose from its marker points)");
   }
   if (root.has("render")) {
@@ -687,7 +691,7 @@ RegistrationResult registerCamerasToRobot(BallCatchingConfig& cfg, const sim::Sc
           const auto expected = est[ci].project(marker);
           if (!expected || !est[ci].inImage(*expected, 0.0)) continue;
           const auto det = detectors[ci].detect(f->image, f->stamp, *expected);
-          if (!det.ok()) continue;
+          if (!det.ok() || (det.value().pixel - *expected).norm() > rg.gate_px) continue;  // noise blobs
           const Eigen::Vector2d x = est[ci].pixelToNormalized(det.value().pixel);
           obj[ci].emplace_back(marker.x(), marker.y(), marker.z());
           img[ci].emplace_back(x.x(), x.y());
@@ -715,10 +719,34 @@ RegistrationResult registerCamerasToRobot(BallCatchingConfig& cfg, const sim::Sc
       for (std::size_t k = 0; k < p.size(); ++k) ss += std::pow(cv::norm(p[k] - img[ci][k]), 2);
       return ss;
     };
-    ss_before += reproj(rvec, tvec);
+    const cv::Vec3d rvec0 = rvec, tvec0 = tvec;
     cv::solvePnP(obj[ci], img[ci], K, cv::noArray(), rvec, tvec, true, cv::SOLVEPNP_ITERATIVE);
-    ss_after += reproj(rvec, tvec);
-    npts += static_cast<int>(obj[ci].size());
+    // One pass of outlier removal (residual > 3 x the median, at least 0.5 px), then solve again
+    // from the calibrated pose.
+    {
+      std::vector<cv::Point2d> p;
+      cv::projectPoints(obj[ci], rvec, tvec, K, cv::noArray(), p);
+      std::vector<double> r;
+      for (std::size_t k = 0; k < p.size(); ++k) r.push_back(cv::norm(p[k] - img[ci][k]));
+      std::vector<double> sorted = r;
+      std::nth_element(sorted.begin(), sorted.begin() + static_cast<long>(sorted.size() / 2), sorted.end());
+      const double limit = std::max(3.0 * sorted[sorted.size() / 2], 0.5 / est[ci].focalPx());
+      std::vector<cv::Point3d> o2;
+      std::vector<cv::Point2d> i2;
+      for (std::size_t k = 0; k < r.size(); ++k)
+        if (r[k] <= limit) {
+          o2.push_back(obj[ci][k]);
+          i2.push_back(img[ci][k]);
+        }
+      if (static_cast<int>(o2.size()) < rg.min_points) continue;
+      obj[ci] = o2;
+      img[ci] = i2;
+      out.points_per_camera.back() = static_cast<int>(o2.size());
+      rvec = rvec0;
+      tvec = tvec0;
+      cv::solvePnP(obj[ci], img[ci], K, cv::noArray(), rvec, tvec, true, cv::SOLVEPNP_ITERATIVE);
+    }
+    const double after = reproj(rvec, tvec);
     cv::Mat R;
     cv::Rodrigues(rvec, R);
     Eigen::Matrix3d Re;
@@ -726,8 +754,20 @@ RegistrationResult registerCamerasToRobot(BallCatchingConfig& cfg, const sim::Sc
     Eigen::Isometry3d Mn = Eigen::Isometry3d::Identity();
     Mn.linear() = Re;
     Mn.translation() = Eigen::Vector3d(tvec[0], tvec[1], tvec[2]);
-    out.centre_shift_mm.push_back(1e3 * (Mn.inverse().translation() - M.inverse().translation()).norm());
-    out.rotation_deg.push_back(core::rad2deg(core::rotationAngle(Mn.linear(), M.linear())));
+    const double shift = (Mn.inverse().translation() - M.inverse().translation()).norm();
+    const double rot = core::rotationAngle(Mn.linear(), M.linear());
+    const double rms_px = est[ci].focalPx() * std::sqrt(after / static_cast<double>(obj[ci].size()));
+    // Plausibility: a registration that does not fit its points, or moves the camera far more than
+    // a calibration error, is refused (the camera keeps its calibrated pose).
+    if (rms_px > rg.max_rms_px || shift > rg.max_shift_m || rot > rg.max_rotation_rad) {
+      ++out.cameras_refused;
+      continue;
+    }
+    ss_before += reproj(rvec0, tvec0);
+    ss_after += after;
+    npts += static_cast<int>(obj[ci].size());
+    out.centre_shift_mm.push_back(1e3 * shift);
+    out.rotation_deg.push_back(core::rad2deg(rot));
     core::Camera cam = est[ci];
     cam.c_M_w = Mn;
     cfg.cameras[ci].calibrated_camera = cam;
@@ -896,6 +936,7 @@ nlohmann::json summaryJson(const CatchSummary& s, const BallCatchingConfig& cfg)
     j["registration"] = {{"poses", s.registration->poses},
                          {"points_per_camera", s.registration->points_per_camera},
                          {"cameras_registered", s.registration->cameras_registered},
+                         {"cameras_refused", s.registration->cameras_refused},
                          {"reprojection_px_before", s.registration->reprojection_px_before},
                          {"reprojection_px_after", s.registration->reprojection_px_after},
                          {"centre_shift_mm", s.registration->centre_shift_mm},

@@ -110,7 +110,10 @@ struct ThrowDistribution {
 /// calibrated camera expects it), and each camera's pose c_M_w is re-estimated by PnP (Levenberg-
 /// Marquardt from the calibrated pose, calibrated intrinsics) from the known marker positions
 /// (robot kinematics: set point + offset) and their detections. Nothing of the truth is used but
-/// the robot's own set points. Cameras with fewer than min_points detections keep their pose.
+/// the robot's own set points. Detections beyond gate_px of the expected pixel are dropped, then
+/// residuals above 3x the median after a first solve; cameras with fewer than min_points detections,
+/// or whose registration fits badly (max_rms_px) or moves them implausibly far (max_shift_m,
+/// max_rotation_deg), keep their calibrated pose.
 struct CatchRegistration {
   bool enabled = false;  ///< off unless the config's registration.enabled says so
   Eigen::Vector3d marker_offset = Eigen::Vector3d(0.15, 0.0, 0.175);  ///< m, from the hole centre (world axes)
@@ -119,10 +122,14 @@ struct CatchRegistration {
   vision::ColorRange marker_hsv{35, 85, 80, 255, 30, 255};
   std::vector<double> offsets_x{-0.08, 0.08}, offsets_y{-0.4, 0.0, 0.4}, offsets_z{-0.3, 0.0, 0.3};  ///< m, from home
   int min_points = 6;
+  double gate_px = 10.0;          ///< detections farther than this from the expected pixel are dropped
+  double max_rms_px = 0.5;        ///< refuse a camera's registration above this reprojection RMS,
+  double max_shift_m = 0.05;      ///< or moving its centre more than this,
+  double max_rotation_rad = 0.0087;  ///< or rotating it more than this (0.5°)
 };
 
 struct RegistrationResult {
-  int poses = 0, cameras_registered = 0;
+  int poses = 0, cameras_registered = 0, cameras_refused = 0;
   std::vector<int> points_per_camera;               ///< marker detections per configured camera
   double reprojection_px_before = 0.0;              ///< RMS over the registered cameras, calibrated pose
   double reprojection_px_after = 0.0;               ///< same, registered pose
