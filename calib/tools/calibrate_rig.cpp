@@ -17,11 +17,17 @@
 //     w_M_anchor:                     # optional: the anchor's (surveyed) pose in the world, when the
 //       translation: [..]             # world origin is not on the anchor (default: identity, world =
 //       rotation: [[..], [..], [..]]  # anchor frame); {translation, rotation | theta_u_deg}
+//     views: [0, 3, 7]                # board: several surveyed placements instead of `view` +
+//     w_M_anchors: [{..}, {..}, {..}] # `w_M_anchor` (one pose each, same order): the world is then
+//                                     # the least-squares rigid fit (Umeyama) of the boards' outer
+//                                     # corners, estimated vs surveyed, which averages out the error
+//                                     # of a single board's pose
 #include <CLI/CLI.hpp>
 #include <filesystem>
 #include <iostream>
 
 #include "tool_common.h"
+#include "viewline/calib/synthetic.h"  // boardOutline
 #include "viewline/io/rig.h"
 
 int main(int argc, char** argv) {
@@ -81,6 +87,20 @@ int main(int argc, char** argv) {
     }
     const Eigen::Isometry3d w_M_anchor = world.has("w_M_anchor") ? io::readPose(world.child("w_M_anchor")) : Eigen::Isometry3d::Identity();
     if (anchor == "camera" && world.has("w_M_anchor")) world.fail("w_M_anchor", "no anchor pose with anchor: camera (the world is that camera's frame)");
+    std::vector<std::size_t> anchor_views;
+    std::vector<Eigen::Isometry3d> w_M_anchors;
+    if (world.has("views")) {
+      if (anchor != "board") world.fail("views", "several anchor views only with anchor: board");
+      if (world.has("view") || world.has("w_M_anchor")) world.fail("views", "either view + w_M_anchor or views + w_M_anchors");
+      for (int v : world.get<std::vector<int>>("views")) {
+        if (v < 0 || static_cast<std::size_t>(v) >= images.front().size())
+          world.fail("views", "instant indices below the number of images");
+        anchor_views.push_back(static_cast<std::size_t>(v));
+      }
+      for (const auto& n : world.childList("w_M_anchors")) w_M_anchors.push_back(io::readPose(n));
+      if (anchor_views.size() < 2 || w_M_anchors.size() != anchor_views.size())
+        world.fail("w_M_anchors", "one surveyed pose per entry of views (at least two)");
+    }
     cfg.finish();
 
     const std::size_t nk = images.front().size();
@@ -106,7 +126,31 @@ int main(int argc, char** argv) {
     const calib::RigResult r = calib::calibrateRig(obs, ref);
     // World frame: w_M_ref.
     Eigen::Isometry3d ref_M_w = Eigen::Isometry3d::Identity();
-    if (anchor == "board") {
+    if (anchor == "board" && !anchor_views.empty()) {
+      // Outer corners of every anchor board, in the reference camera (estimated) and in the world
+      // (surveyed): the rigid transform world -> reference that fits them best.
+      const Eigen::Isometry3d a_M_b = frame == "ground" ? calib::groundFromBoard(board.type).inverse() : Eigen::Isometry3d::Identity();
+      const auto outline = calib::boardOutline(board);
+      Eigen::Matrix3Xd in_w(3, 0), in_ref(3, 0);
+      for (std::size_t a = 0; a < anchor_views.size(); ++a) {
+        const std::size_t v = anchor_views[a];
+        bool seen = false;
+        for (std::size_t i = 0; i < cameras.size(); ++i) seen = seen || obs.views[v][i].has_value();
+        if (!seen) throw core::InvalidInput("world.views: no camera sees the board at instant " + std::to_string(v));
+        for (const auto& o : outline) {
+          in_w.conservativeResize(3, in_w.cols() + 1);
+          in_ref.conservativeResize(3, in_ref.cols() + 1);
+          in_w.col(in_w.cols() - 1) = w_M_anchors[a] * (a_M_b * o);
+          in_ref.col(in_ref.cols() - 1) = r.ref_M_board[v] * o;
+        }
+      }
+      ref_M_w.matrix() = Eigen::umeyama(in_w, in_ref, false);
+      double rms = 0.0;
+      for (Eigen::Index c = 0; c < in_w.cols(); ++c) rms += (ref_M_w * in_w.col(c) - in_ref.col(c)).squaredNorm();
+      std::cout << "world from " << anchor_views.size() << " surveyed boards: corner fit RMS "
+                << 1e3 * std::sqrt(rms / static_cast<double>(in_w.cols())) << " mm; with a free scale: "
+                << Eigen::umeyama(in_w, in_ref, true).topLeftCorner<3, 3>().determinant() << "^(1/3) (1 = no scale error)\n";
+    } else if (anchor == "board") {
       bool seen = false;
       for (std::size_t i = 0; i < cameras.size(); ++i) seen = seen || obs.views[view][i].has_value();
       if (!seen) throw core::InvalidInput("world.view " + std::to_string(view) + ": no camera sees the board at that instant");

@@ -7,6 +7,14 @@
 //               rig_calibration.yaml, the calibrate-rig config; its world anchor is the board of
 //               instant 0 at its (surveyed) world pose, so the calibrated rig is in the truth's world.
 //               Needs --intrinsics-dir: where calibrate-camera wrote <camera>.xml and <camera>.yaml.
+//               With --reference CAM (rigs whose cameras cannot all see one board, e.g. cameras on
+//               opposite sides of the scene): each instant is seen fully by CAM and by one partner
+//               camera, the partners taken in turn, so every camera shares views with CAM (what
+//               calibrate-rig needs; the config names CAM as its reference). Every camera's image
+//               is still rendered at every instant: the others see the board obliquely, partly or
+//               not at all, and calibrate-rig uses whatever the detector finds in them.
+//               --surveyed N: the boards of the first N instants are anchors at surveyed world poses
+//               (default 1); calibrate-rig then fits the world to all of them.
 //   ground      <camera>_ground_NN.png: the board lying on the floor at --floor-origin (camera still).
 //   hand-eye    <camera>_ptu_NN.png and robot_poses.yaml (r_M_e per image, the PTU's forward
 //               kinematics): the board fixed in the PTU base frame, the camera on the PTU (truth's
@@ -29,8 +37,8 @@ namespace fs = std::filesystem;
 int main(int argc, char** argv) {
   CLI::App app{"Renders calibration-board images through the true rig of a truth file (simulator renderer,\n"
                "ViSP kud distortion, blur, sensor noise)."};
-  std::string truth_file, board_file, mode = "intrinsics", camera, out_dir, intrinsics_dir;
-  int views = 15;
+  std::string truth_file, board_file, mode = "intrinsics", camera, out_dir, intrinsics_dir, reference;
+  int views = 15, surveyed = 1;
   std::uint64_t seed = 1;
   std::vector<double> target, floor_origin{0.0, 0.0}, board_in_front{0.75, 0.0765, 0.068};
   double radius = 0.4, max_obliquity_deg = 65.0, pan_range_deg = 20.0, tilt_range_deg = 15.0;
@@ -45,6 +53,10 @@ int main(int argc, char** argv) {
   app.add_option("--intrinsics-dir", intrinsics_dir, "rig: directory of the calibrated <camera>.xml/.yaml");
   app.add_option("--target", target, "rig: centre of the shared views, world x y z (default: the point closest to the optical axes)")
       ->expected(3);
+  app.add_option("--reference", reference,
+                 "rig: every instant seen fully by this camera and one partner in turn (default: by every camera)");
+  app.add_option("--surveyed", surveyed, "rig: the first N instants' boards anchor the world at surveyed poses")
+      ->check(CLI::PositiveNumber);
   app.add_option("--radius", radius, "rig: board centres within +-radius of the target per axis, m");
   app.add_option("--max-obliquity", max_obliquity_deg, "rig: largest angle between board normal and line of sight, deg");
   app.add_option("--floor-origin", floor_origin, "ground: board origin on the floor, world x y (m)")->expected(2);
@@ -91,7 +103,23 @@ int main(int argc, char** argv) {
       o.radius = radius;
       o.max_obliquity_rad = core::deg2rad(max_obliquity_deg);
       std::cout << "shared views around [" << o.center_w.transpose() << "] m\n";
-      const auto ps = calib::sampleRigPoses(truth.cameras, board, views, rng, o);
+      std::vector<Eigen::Isometry3d> ps;
+      if (reference.empty()) {
+        ps = calib::sampleRigPoses(truth.cameras, board, views, rng, o);
+      } else {
+        const core::Camera& ref = truth.camera(reference);
+        std::vector<const core::Camera*> partners;
+        for (const auto& cam : truth.cameras)
+          if (cam.name != reference) partners.push_back(&cam);
+        for (int k = 0; k < views; ++k) {
+          const std::vector<core::Camera> pair{ref, *partners[static_cast<std::size_t>(k) % partners.size()]};
+          calib::RigViewOptions op = o;
+          if (target.size() != 3) op.center_w = calib::commonViewPoint(pair);
+          ps.push_back(calib::sampleRigPoses(pair, board, 1, rng, op).front());
+          std::cout << "instant " << k << ": " << pair[0].name << " + " << pair[1].name << " around ["
+                    << op.center_w.transpose() << "] m\n";
+        }
+      }
       std::ostringstream cfg;
       cfg << std::setprecision(10) << "# calibrate-rig config written by render-board-views (seed " << seed << ")\n"
           << "board: " << fs::absolute(board_file).string() << "\ncameras:\n";
@@ -105,8 +133,19 @@ int main(int argc, char** argv) {
           ++written;
         }
       }
-      // World anchor: the board of instant 0, whose world pose was surveyed (here: the truth).
-      cfg << "world:\n  anchor: board\n  view: 0\n  frame: board\n  w_M_anchor:\n" << calib::tools::poseYaml(ps.front(), 4);
+      // World anchor: the board of instant 0 (or of the first --surveyed instants), whose world pose
+      // was surveyed (here: the truth).
+      if (surveyed > views) throw core::InvalidInput("--surveyed: more than --views");
+      cfg << "world:\n  anchor: board\n  frame: board\n";
+      if (!reference.empty()) cfg << "  camera: " << reference << "\n";
+      if (surveyed == 1) {
+        cfg << "  view: 0\n  w_M_anchor:\n" << calib::tools::poseYaml(ps.front(), 4);
+      } else {
+        cfg << "  views: [";
+        for (int k = 0; k < surveyed; ++k) cfg << (k ? ", " : "") << k;
+        cfg << "]\n  w_M_anchors:\n";
+        for (int k = 0; k < surveyed; ++k) cfg << "    -\n" << calib::tools::poseYaml(ps[static_cast<std::size_t>(k)], 6);
+      }
       io::writeTextFileAtomic(out_dir + "/rig_calibration.yaml", cfg.str());
       std::cout << "wrote " << out_dir << "/rig_calibration.yaml\n";
       poses << "w_M_o:\n";

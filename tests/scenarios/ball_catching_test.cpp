@@ -2,6 +2,7 @@
 // colour-blob detector -> viewline tracker -> interception planner -> simulated robot).
 #include <gtest/gtest.h>
 
+#include "viewline/core/error.h"
 #include "viewline/io/config.h"
 #include "viewline/scenarios/ball_catching.h"
 
@@ -36,6 +37,12 @@ TEST(BallCatchingScenario, ShortSeededSessionCatchesAndRespectsTheLimits) {
     }
   }
   EXPECT_EQ(with_target, 6);
+  // Camera-to-robot registration: the marker's reprojection error with the registered poses is a
+  // fraction of the calibrated rig's (~2 px), for both cameras of the session.
+  ASSERT_TRUE(s.registration.has_value());
+  EXPECT_GE(s.registration->cameras_registered, 2);
+  EXPECT_LT(s.registration->reprojection_px_after, 0.5);
+  EXPECT_LT(s.registration->reprojection_px_after, 0.5 * s.registration->reprojection_px_before);
   EXPECT_GE(s.reachable_throws, 1);
   EXPECT_GE(s.caught_reachable, 1);
   // Same seeds, one thread: identical results (throws are independent of the scheduling).
@@ -71,6 +78,44 @@ TEST(BallCatchingScenario, ShippedDartScenarioRuns) {
     EXPECT_TRUE(r.had_target);
     EXPECT_LT(r.prediction_error, 0.02);
   }
+}
+
+TEST(BallCatchingScenario, RigRendersWithTheTruthAndEstimatesWithTheCalibration) {
+  const auto cfg = shipped("config/ball_catching.yaml");
+  ASSERT_FALSE(cfg.rig.empty());
+  for (const auto& c : cfg.cameras) {
+    ASSERT_TRUE(c.true_camera && c.calibrated_camera) << c.name;
+    const core::Camera t = c.renderCamera(), e = c.estimatorCamera();
+    EXPECT_EQ(t.name, c.name);
+    EXPECT_EQ(e.width, t.width);
+    // Calibrated from rendered board images: close to the truth, but not the truth itself.
+    const double dc = (e.center_w() - t.center_w()).norm();
+    EXPECT_GT(dc, 1e-5) << c.name << ": the estimator must not get the render camera";
+    EXPECT_LT(dc, 0.05) << c.name;
+    EXPECT_NE(e.intrinsics.get_px(), t.intrinsics.get_px()) << c.name;
+  }
+  // A camera geometry key next to rig: is an error naming file:line:key; so is an unknown camera.
+  const std::string rig = "rig: calib/rigs/catching\nrobot: {kind: stage}\n";  // ctest runs from the source root
+  try {
+    scenarios::loadBallCatchingConfig(
+        io::ConfigNode::fromString(rig + "cameras:\n  - {name: right, position: [0, 0, 0]}\n", "r.yaml"));
+    ADD_FAILURE() << "geometry with rig: accepted";
+  } catch (const core::InvalidInput& e) {
+    EXPECT_NE(std::string(e.what()).find("r.yaml:"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("position"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(scenarios::loadBallCatchingConfig(
+                   io::ConfigNode::fromString(rig + "cameras:\n  - {name: nobody}\n", "r.yaml")),
+               core::InvalidInput);
+  // Inline cameras (no rig): the estimator uses the render camera.
+  const auto inline_cfg = scenarios::loadBallCatchingConfig(io::ConfigNode::fromString(
+      "robot: {kind: stage}\ncameras:\n  - {name: a, kud: 0.02, position: [4.6, -2.9, 2.1], look_at: [2.4, 0, 1.3]}\n",
+      "i.yaml"));
+  ASSERT_EQ(inline_cfg.cameras.size(), 1u);
+  EXPECT_TRUE(inline_cfg.rig.empty());
+  const core::Camera t = inline_cfg.cameras[0].renderCamera(), e = inline_cfg.cameras[0].estimatorCamera();
+  EXPECT_TRUE(t.c_M_w.isApprox(e.c_M_w));
+  EXPECT_DOUBLE_EQ(t.intrinsics.get_kud(), e.intrinsics.get_kud());
 }
 
 TEST(BallCatchingScenario, UnknownConfigKeyIsAnError) {

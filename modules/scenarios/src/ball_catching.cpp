@@ -8,11 +8,14 @@
 #include <memory>
 #include <mutex>
 #include <thread>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core/eigen.hpp>
 
 #include "viewline/core/checks.h"
 #include "viewline/core/error.h"
 #include "viewline/core/frames.h"
 #include "viewline/core/random.h"
+#include "viewline/scenarios/simulated_rig.h"
 #include "viewline/sim/rig.h"
 
 namespace viewline::scenarios {
@@ -59,6 +62,15 @@ core::Camera makeCamera(const CatchCameraConfig& c) {
   return cam;
 }
 
+}  // namespace
+
+core::Camera CatchCameraConfig::renderCamera() const { return true_camera ? *true_camera : makeCamera(*this); }
+core::Camera CatchCameraConfig::estimatorCamera() const {
+  return calibrated_camera ? *calibrated_camera : makeCamera(*this);
+}
+
+namespace {
+
 Eigen::Matrix3d boxRotation(const Eigen::Vector3d& n) {
   Eigen::Matrix3d R;
   R.col(2) = n;
@@ -78,6 +90,36 @@ double percentile(std::vector<double> v, double q) {
   return i + 1 < v.size() ? v[i] * (1 - f) + v[i + 1] * f : v[i];
 }
 
+// The box with its hole centred on `hole`, and the registration marker on its top.
+void appendBox(const BallCatchingConfig& cfg, const Eigen::Matrix3d& R, const Eigen::Vector3d& hole,
+               std::vector<sim::Primitive>& out) {
+  const Eigen::Vector3d& n = cfg.box_normal;
+  Eigen::Isometry3d M = Eigen::Isometry3d::Identity();
+  M.linear() = R;
+  M.translation() = hole - n * (0.5 * cfg.box_size);
+  out.push_back(sim::makeBox("box", M, Eigen::Vector3d::Constant(cfg.box_size), Eigen::Vector3d(0.7, 0.72, 0.7)));
+  M.translation() = hole + n * 1e-3;
+  out.push_back(sim::makeDisc("hole", M, cfg.hole_radius, Eigen::Vector3d(0.04, 0.04, 0.04)));
+  if (cfg.registration.enabled)
+    out.push_back(sim::makeSphere("marker", hole + cfg.registration.marker_offset, cfg.registration.marker_radius,
+                                  cfg.registration.marker_albedo_bgr));
+}
+
+// The room and the box held still with its hole at `hole` (registration).
+class StaticBoxWorld : public sim::World {
+public:
+  StaticBoxWorld(const sim::Scene& room, const BallCatchingConfig& cfg, const Eigen::Vector3d& hole)
+      : room_(room), cfg_(cfg), hole_(hole), R_(boxRotation(cfg.box_normal)) {}
+  const sim::Scene& staticScene() const override { return room_; }
+  void dynamicObjects(double, std::vector<sim::Primitive>& out) const override { appendBox(cfg_, R_, hole_, out); }
+
+private:
+  const sim::Scene& room_;
+  const BallCatchingConfig& cfg_;
+  Eigen::Vector3d hole_;
+  Eigen::Matrix3d R_;
+};
+
 // The world of one throw: the room, the ball on its flight, the box at the robot's hole position.
 class CatchWorld : public sim::World {
 public:
@@ -94,16 +136,7 @@ public:
         out.push_back(sim::makeSphere("ball", s.p, cfg_.throws.body.reference_radius, cfg_.ball_albedo_bgr));
       }
     }
-    if (cfg_.render_box) {
-      const Eigen::Vector3d hole = robot_.read(t).p;
-      const Eigen::Vector3d& n = cfg_.box_normal;
-      Eigen::Isometry3d M = Eigen::Isometry3d::Identity();
-      M.linear() = R_;
-      M.translation() = hole - n * (0.5 * cfg_.box_size);
-      out.push_back(sim::makeBox("box", M, Eigen::Vector3d::Constant(cfg_.box_size), Eigen::Vector3d(0.7, 0.72, 0.7)));
-      M.translation() = hole + n * 1e-3;
-      out.push_back(sim::makeDisc("hole", M, cfg_.hole_radius, Eigen::Vector3d(0.04, 0.04, 0.04)));
-    }
+    if (cfg_.render_box) appendBox(cfg_, R_, robot_.read(t).p, out);
   }
 
 private:
@@ -178,6 +211,8 @@ void BallCatchingConfig::validate() const {
   if (!(control_period > 0.0)) throw InvalidInput("robot.control_period_s: expected > 0");
   if (!(processing_latency >= 0.0)) throw InvalidInput("processing_latency_s: expected >= 0");
   if (!(sigma_px_floor > 0.0)) throw InvalidInput("detector.sigma_px_floor: expected > 0");
+  if (!(pixel_noise_px >= 0.0 && std::isfinite(pixel_noise_px)))
+    throw InvalidInput("detector.pixel_noise_px: expected a finite value >= 0");
   if (threads < 1) throw InvalidInput("threads: expected >= 1");
   robot.validate();
   tracker.validate();
@@ -202,17 +237,36 @@ BallCatchingConfig loadBallCatchingConfig(const io::ConfigNode& root) {
   c.processing_latency = root.getOr<double>("processing_latency_s", c.processing_latency);
   c.camera_count = root.getOr<unsigned>("camera_count", 0u);
   c.rate_override_hz = root.getOr<double>("rate_override_hz", 0.0);
+  std::optional<SimulatedRig> rig;
+  if (root.has("rig")) {
+    rig = loadSimulatedRig(root, "rig");
+    c.rig = rig->folder;
+  }
   for (const auto& n : root.childList("cameras")) {
     CatchCameraConfig k;
     k.name = n.get<std::string>("name");
-    k.width = n.getOr<unsigned>("width", k.width);
-    k.height = n.getOr<unsigned>("height", k.height);
-    k.hfov_rad = n.getAngleOr("hfov_deg", k.hfov_rad);
-    k.cx = n.getOr<double>("cx", -1.0);
-    k.cy = n.getOr<double>("cy", -1.0);
-    k.kud = n.getOr<double>("kud", 0.0);
-    k.position = n.get<Eigen::Vector3d>("position");
-    k.look_at = n.get<Eigen::Vector3d>("look_at");
+    if (rig) {
+      // Geometry comes from the rig: the truth renders, the calibration estimates.
+      for (const char* key : {"width", "height", "hfov_deg", "cx", "cy", "kud", "position", "look_at"})
+        if (n.has(key)) n.fail(key, "no camera geometry with rig: (it comes from " + rig->folder + "/truth.yaml and rig.yaml)");
+      try {
+        k.true_camera = rig->trueCamera(k.name);
+        k.calibrated_camera = rig->calibratedCamera(k.name);
+      } catch (const InvalidInput& e) {
+        n.fail("name", std::string("a camera of the rig: ") + e.what());
+      }
+      k.width = k.true_camera->width;
+      k.height = k.true_camera->height;
+    } else {
+      k.width = n.getOr<unsigned>("width", k.width);
+      k.height = n.getOr<unsigned>("height", k.height);
+      k.hfov_rad = n.getAngleOr("hfov_deg", k.hfov_rad);
+      k.cx = n.getOr<double>("cx", -1.0);
+      k.cy = n.getOr<double>("cy", -1.0);
+      k.kud = n.getOr<double>("kud", 0.0);
+      k.position = n.get<Eigen::Vector3d>("position");
+      k.look_at = n.get<Eigen::Vector3d>("look_at");
+    }
     k.rate_hz = n.getOr<double>("rate_hz", k.rate_hz);
     k.drift = n.getOr<double>("clock_drift", k.drift);
     k.exposure_s = n.getOr<double>("exposure_s", k.exposure_s);
@@ -277,6 +331,7 @@ BallCatchingConfig loadBallCatchingConfig(const io::ConfigNode& root) {
     c.detector.open_kernel_px = d.getOr<int>("open_kernel_px", c.detector.open_kernel_px);
     c.detector.close_kernel_px = d.getOr<int>("close_kernel_px", c.detector.close_kernel_px);
     c.sigma_px_floor = d.getOr<double>("sigma_px_floor", c.sigma_px_floor);
+    c.pixel_noise_px = d.getOr<double>("pixel_noise_px", c.pixel_noise_px);
   }
   if (root.has("tracker")) {
     const auto t = root.child("tracker");
@@ -311,6 +366,29 @@ BallCatchingConfig loadBallCatchingConfig(const io::ConfigNode& root) {
     c.planner.home_delay = p.getOr<double>("home_delay_s", c.planner.home_delay);
     c.planner.min_lead = p.getOr<double>("min_lead_s", c.planner.min_lead);
     c.planner.target_prior_std = p.getOr<double>("target_prior_std_m", c.planner.target_prior_std);
+  }
+  if (root.has("registration")) {
+    const auto r = root.child("registration");
+    CatchRegistration& g = c.registration;
+    g.enabled = r.getOr<bool>("enabled", g.enabled);
+    g.marker_offset = r.getOr<Eigen::Vector3d>("marker_offset", g.marker_offset);
+    g.marker_radius = r.getOr<double>("marker_radius", g.marker_radius);
+    g.marker_albedo_bgr = r.getOr<Eigen::Vector3d>("marker_albedo_bgr", g.marker_albedo_bgr);
+    if (r.has("marker_hsv")) {
+      const auto v = r.get<std::vector<int>>("marker_hsv");
+      if (v.size() != 6) r.fail("marker_hsv", "[hue_lo, hue_hi, s_lo, s_hi, v_lo, v_hi]");
+      g.marker_hsv = {v[0], v[1], v[2], v[3], v[4], v[5]};
+    }
+    g.offsets_x = r.getOr<std::vector<double>>("offsets_x", g.offsets_x);
+    g.offsets_y = r.getOr<std::vector<double>>("offsets_y", g.offsets_y);
+    g.offsets_z = r.getOr<std::vector<double>>("offsets_z", g.offsets_z);
+    if (!(g.marker_radius > 0.0)) r.fail("marker_radius", "a positive radius, m");
+    g.min_points = r.getOr<int>("min_points", g.min_points);
+    g.gate_px = r.getOr<double>("gate_px", g.gate_px);
+    g.max_rms_px = r.getOr<double>("max_rms_px", g.max_rms_px);
+    g.max_shift_m = r.getOr<double>("max_shift_m", g.max_shift_m);
+    g.max_rotation_rad = r.getAngleOr("max_rotation_deg", g.max_rotation_rad);
+    if (g.min_points < 6) r.fail("min_points", "at least 6 (a camera pose from its marker points)");
   }
   if (root.has("render")) {
     const auto r = root.child("render");
@@ -391,7 +469,7 @@ ThrowResult runThrow(const BallCatchingConfig& cfg, const sim::Scene& room, int 
   for (std::size_t i = 0; i < ncam; ++i) {
     const CatchCameraConfig& c = cfg.cameras[i];
     sim::SimCamera sc;
-    sc.camera = makeCamera(c);
+    sc.camera = c.renderCamera();
     sc.clock.rate = cfg.rate_override_hz > 0.0 ? cfg.rate_override_hz : c.rate_hz;
     sc.clock.phase = core::uniform(rng, 0.0, 1.0 / sc.clock.rate);
     sc.clock.drift = c.drift;
@@ -401,7 +479,7 @@ ThrowResult runThrow(const BallCatchingConfig& cfg, const sim::Scene& room, int 
     sc.effects.faults.drop_probability = c.drop_probability;
     sc.effects.faults.trigger_jitter = c.trigger_jitter_s;
     sc.effects.faults.stamp_jitter = c.stamp_jitter_s;
-    est_cams.push_back(sc.camera);  // the estimator's rig: same intrinsics and poses (see config)
+    est_cams.push_back(c.estimatorCamera());  // calibrated (rig:) or the render camera (inline cameras)
     sims.push_back(std::move(sc));
   }
   sim::CameraRig rig(sims, rng, cfg.render);
@@ -419,6 +497,7 @@ ThrowResult runThrow(const BallCatchingConfig& cfg, const sim::Scene& room, int 
     estimation::StateEstimate est;
   };
   std::deque<Pending> pending;
+  core::Rng noise_rng = core::makeRng(core::deriveSeed(seed, 0xD37));  // pixel_noise_px only
   std::optional<Eigen::Vector3d> lead_prediction;
   double t_tick = 0.0;
   std::uint64_t next_id = 1;
@@ -472,9 +551,12 @@ ThrowResult runThrow(const BallCatchingConfig& cfg, const sim::Scene& room, int 
     if (det.ok()) {
       ++res.detections;
       if (res.t_first_detection < 0.0) res.t_first_detection = frame->capture_time;
-      const double sigma = std::max(cfg.sigma_px_floor, std::sqrt(0.5 * det.value().pixel_covariance.trace()));
+      const double sigma_det = std::max(cfg.sigma_px_floor, std::sqrt(0.5 * det.value().pixel_covariance.trace()));
+      const double sigma = std::hypot(sigma_det, cfg.pixel_noise_px);
       det_px = det.value().pixel;
-      tracking::ImageMeasurement m{next_id++, ci, frame->stamp, det.value().pixel, sigma};
+      if (cfg.pixel_noise_px > 0.0)
+        *det_px += cfg.pixel_noise_px * Eigen::Vector2d(core::gaussian(noise_rng), core::gaussian(noise_rng));
+      tracking::ImageMeasurement m{next_id++, ci, frame->stamp, *det_px, sigma};
       const tracking::Refusal r = tracker.submit(m);
       bool fused = false;
       if (r == tracking::Refusal::None) {
@@ -499,7 +581,7 @@ ThrowResult runThrow(const BallCatchingConfig& cfg, const sim::Scene& room, int 
       CatchFrame f;
       f.throw_index = index;
       f.camera = ci;
-      f.camera_model = &frame->camera;
+      f.camera_model = &est_cams[ci];  // what the estimator believes (the calibrated camera with rig:)
       f.t = frame->capture_time;
       f.image = &frame->image;
       f.detection = det_px;
@@ -563,6 +645,144 @@ ThrowResult runThrow(const BallCatchingConfig& cfg, const sim::Scene& room, int 
 }
 
 // ------------------------------------------------------------------------------------------------
+// Camera-to-robot registration
+
+RegistrationResult registerCamerasToRobot(BallCatchingConfig& cfg, const sim::Scene& room, std::uint64_t seed) {
+  const CatchRegistration& rg = cfg.registration;
+  core::Rng rng = core::makeRng(seed);
+  std::vector<sim::SimCamera> sims;
+  std::vector<core::Camera> est;
+  std::vector<vision::BallDetector> detectors;
+  vision::BallDetectorConfig dc = cfg.detector;
+  dc.hsv = rg.marker_hsv;
+  dc.fallback_full_frame = false;
+  for (const auto& c : cfg.cameras) {  // every configured camera, whatever camera_count
+    sim::SimCamera sc;
+    sc.camera = c.renderCamera();
+    sc.clock.rate = c.rate_hz;
+    sc.effects.noise.sigma = c.noise_sigma;
+    sims.push_back(std::move(sc));
+    est.push_back(c.estimatorCamera());
+    detectors.emplace_back(dc, est.back());
+  }
+  sim::CameraRig rig(sims, rng, cfg.render);
+  RegistrationResult out;
+  // Per camera: known marker positions (robot world) and their detected, undistorted normalised
+  // image points (calibrated intrinsics).
+  std::vector<std::vector<cv::Point3d>> obj(sims.size());
+  std::vector<std::vector<cv::Point2d>> img(sims.size());
+  for (double dx : rg.offsets_x)
+    for (double dy : rg.offsets_y)
+      for (double dz : rg.offsets_z) {
+        const Eigen::Vector3d hole = cfg.robot.home + Eigen::Vector3d(dx, dy, dz);
+        const Eigen::Vector3d marker = hole + rg.marker_offset;
+        ++out.poses;
+        StaticBoxWorld world(room, cfg, hole);
+        rig.reset(0.0);
+        std::vector<bool> seen(sims.size(), false);
+        for (std::size_t got = 0; got < sims.size();) {
+          auto f = rig.captureNext(world);
+          if (!f || seen[f->camera_index]) continue;
+          const std::size_t ci = f->camera_index;
+          seen[ci] = true;
+          ++got;
+          // Search only around where the calibrated camera expects the marker (the robot knows
+          // where it holds it): other green things in the room are never taken for it.
+          const auto expected = est[ci].project(marker);
+          if (!expected || !est[ci].inImage(*expected, 0.0)) continue;
+          const auto det = detectors[ci].detect(f->image, f->stamp, *expected);
+          if (!det.ok() || (det.value().pixel - *expected).norm() > rg.gate_px) continue;  // noise blobs
+          const Eigen::Vector2d x = est[ci].pixelToNormalized(det.value().pixel);
+          obj[ci].emplace_back(marker.x(), marker.y(), marker.z());
+          img[ci].emplace_back(x.x(), x.y());
+        }
+      }
+  // Each camera's pose re-estimated from its own points (PnP, Levenberg-Marquardt from the
+  // calibrated pose): the per-camera pose errors of the board calibration differ, so one rigid
+  // transform for the whole rig cannot remove them. Cameras with fewer than min_points keep their
+  // calibrated pose.
+  const cv::Matx33d K = cv::Matx33d::eye();
+  double ss_before = 0.0, ss_after = 0.0;
+  int npts = 0;
+  for (std::size_t ci = 0; ci < sims.size(); ++ci) {
+    out.points_per_camera.push_back(static_cast<int>(obj[ci].size()));
+    if (static_cast<int>(obj[ci].size()) < rg.min_points) continue;
+    const Eigen::Isometry3d& M = est[ci].c_M_w;
+    cv::Mat R0;
+    cv::eigen2cv(Eigen::Matrix3d(M.linear()), R0);
+    cv::Vec3d rvec, tvec(M.translation().x(), M.translation().y(), M.translation().z());
+    cv::Rodrigues(R0, rvec);
+    auto reproj = [&](const cv::Vec3d& rv, const cv::Vec3d& tv) {
+      std::vector<cv::Point2d> p;
+      cv::projectPoints(obj[ci], rv, tv, K, cv::noArray(), p);
+      double ss = 0.0;
+      for (std::size_t k = 0; k < p.size(); ++k) ss += std::pow(cv::norm(p[k] - img[ci][k]), 2);
+      return ss;
+    };
+    const cv::Vec3d rvec0 = rvec, tvec0 = tvec;
+    cv::solvePnP(obj[ci], img[ci], K, cv::noArray(), rvec, tvec, true, cv::SOLVEPNP_ITERATIVE);
+    // One pass of outlier removal (residual > 3 x the median, at least 0.5 px), then solve again
+    // from the calibrated pose.
+    {
+      std::vector<cv::Point2d> p;
+      cv::projectPoints(obj[ci], rvec, tvec, K, cv::noArray(), p);
+      std::vector<double> r;
+      for (std::size_t k = 0; k < p.size(); ++k) r.push_back(cv::norm(p[k] - img[ci][k]));
+      std::vector<double> sorted = r;
+      std::nth_element(sorted.begin(), sorted.begin() + static_cast<long>(sorted.size() / 2), sorted.end());
+      const double limit = std::max(3.0 * sorted[sorted.size() / 2], 0.5 / est[ci].focalPx());
+      std::vector<cv::Point3d> o2;
+      std::vector<cv::Point2d> i2;
+      for (std::size_t k = 0; k < r.size(); ++k)
+        if (r[k] <= limit) {
+          o2.push_back(obj[ci][k]);
+          i2.push_back(img[ci][k]);
+        }
+      if (static_cast<int>(o2.size()) < rg.min_points) continue;
+      obj[ci] = o2;
+      img[ci] = i2;
+      out.points_per_camera.back() = static_cast<int>(o2.size());
+      rvec = rvec0;
+      tvec = tvec0;
+      cv::solvePnP(obj[ci], img[ci], K, cv::noArray(), rvec, tvec, true, cv::SOLVEPNP_ITERATIVE);
+    }
+    const double after = reproj(rvec, tvec);
+    cv::Mat R;
+    cv::Rodrigues(rvec, R);
+    Eigen::Matrix3d Re;
+    cv::cv2eigen(R, Re);
+    Eigen::Isometry3d Mn = Eigen::Isometry3d::Identity();
+    Mn.linear() = Re;
+    Mn.translation() = Eigen::Vector3d(tvec[0], tvec[1], tvec[2]);
+    const double shift = (Mn.inverse().translation() - M.inverse().translation()).norm();
+    const double rot = core::rotationAngle(Mn.linear(), M.linear());
+    const double rms_px = est[ci].focalPx() * std::sqrt(after / static_cast<double>(obj[ci].size()));
+    // Plausibility: a registration that does not fit its points, or moves the camera far more than
+    // a calibration error, is refused (the camera keeps its calibrated pose).
+    if (rms_px > rg.max_rms_px || shift > rg.max_shift_m || rot > rg.max_rotation_rad) {
+      ++out.cameras_refused;
+      continue;
+    }
+    ss_before += reproj(rvec0, tvec0);
+    ss_after += after;
+    npts += static_cast<int>(obj[ci].size());
+    out.centre_shift_mm.push_back(1e3 * shift);
+    out.rotation_deg.push_back(core::rad2deg(rot));
+    core::Camera cam = est[ci];
+    cam.c_M_w = Mn;
+    cfg.cameras[ci].calibrated_camera = cam;
+    ++out.cameras_registered;
+  }
+  if (out.cameras_registered == 0)
+    throw core::NumericalError("registration: no camera saw the marker at " + std::to_string(rg.min_points) +
+                               " poses (check registration.marker_hsv and the offsets)");
+  const double f = est.front().focalPx();
+  out.reprojection_px_before = f * std::sqrt(ss_before / std::max(1, npts));
+  out.reprojection_px_after = f * std::sqrt(ss_after / std::max(1, npts));
+  return out;
+}
+
+// ------------------------------------------------------------------------------------------------
 // Batch
 
 CatchSummary runBallCatching(const BallCatchingConfig& cfg, int throws, std::uint64_t seed, const CatchHooks& hooks) {
@@ -573,6 +793,8 @@ CatchSummary runBallCatching(const BallCatchingConfig& cfg, int throws, std::uin
   const sim::Scene room = sim::makeRoom(cfg.room, room_rng);
   CatchSummary s;
   s.seed = seed;
+  BallCatchingConfig registered = cfg;  // estimator cameras in the robot's world
+  if (cfg.registration.enabled) s.registration = registerCamerasToRobot(registered, room, core::deriveSeed(seed, 0x4E6));
   s.throws = throws;
   s.results.resize(static_cast<std::size_t>(throws));
   const bool serial = hooks.log || hooks.on_frame || cfg.threads <= 1;
@@ -585,7 +807,7 @@ CatchSummary runBallCatching(const BallCatchingConfig& cfg, int throws, std::uin
       if (i >= throws) return;
       try {
         s.results[static_cast<std::size_t>(i)] =
-            runThrow(cfg, room, i, core::deriveSeed(seed, static_cast<std::uint64_t>(i)), &hooks);
+            runThrow(registered, room, i, core::deriveSeed(seed, static_cast<std::uint64_t>(i)), &hooks);
       } catch (...) {
         std::lock_guard<std::mutex> lock(mu);
         if (!error) error = std::current_exception();
@@ -695,6 +917,8 @@ nlohmann::json summaryJson(const CatchSummary& s, const BallCatchingConfig& cfg)
   j["cameras"] = ncam;
   j["rate_hz"] = cfg.rate_override_hz > 0.0 ? cfg.rate_override_hz : cfg.cameras.front().rate_hz;
   j["pixel_noise_grey"] = cfg.cameras.front().noise_sigma;
+  j["detection_noise_px"] = cfg.pixel_noise_px;
+  j["rig"] = cfg.rig.empty() ? nlohmann::json("inline cameras (estimator = render cameras)") : nlohmann::json(cfg.rig);
   j["planner_model"] = planning::toString(cfg.planner.model.kind);
   j["hole_radius_m"] = cfg.hole_radius;
   j["ball_radius_m"] = cfg.throws.body.reference_radius;
@@ -708,6 +932,17 @@ nlohmann::json summaryJson(const CatchSummary& s, const BallCatchingConfig& cfg)
                              {"aim_radius_m", cfg.throws.aim_radius},
                              {"mean_horizontal_speed_mps", {cfg.throws.speed_min, cfg.throws.speed_max}},
                              {"spin", "none"}};
+  if (s.registration)
+    j["registration"] = {{"poses", s.registration->poses},
+                         {"points_per_camera", s.registration->points_per_camera},
+                         {"cameras_registered", s.registration->cameras_registered},
+                         {"cameras_refused", s.registration->cameras_refused},
+                         {"reprojection_px_before", s.registration->reprojection_px_before},
+                         {"reprojection_px_after", s.registration->reprojection_px_after},
+                         {"centre_shift_mm", s.registration->centre_shift_mm},
+                         {"rotation_deg", s.registration->rotation_deg}};
+  else
+    j["registration"] = "off";
   j["reachability_start"] = "first capture with the ball inside a camera image (truth), robot at home at rest";
   j["wall_time_s"] = s.wall_s;
   j["ms_per_frame_per_thread"] = s.ms_per_frame;

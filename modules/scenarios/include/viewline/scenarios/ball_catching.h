@@ -54,6 +54,7 @@
 #include <string>
 #include <vector>
 
+#include "viewline/core/camera.h"
 #include "viewline/io/config.h"
 #include "viewline/io/log.h"
 #include "viewline/planning/catch_planner.h"
@@ -82,6 +83,13 @@ struct CatchCameraConfig {
   double drop_probability = 0.0;
   double trigger_jitter_s = 0.0002;
   double stamp_jitter_s = 0.0;
+  /// With a `rig:` (scenarios::loadSimulatedRig): the TRUE camera the simulator renders with
+  /// (truth.yaml) and the CALIBRATED one the detector and tracker use (rig.yaml); the geometry
+  /// fields above are then unused (width/height are copied from the truth). Without a rig both are
+  /// built from the fields above: a perfectly calibrated rig.
+  std::optional<core::Camera> true_camera, calibrated_camera;
+  core::Camera renderCamera() const;     ///< true_camera, or the one built from the fields
+  core::Camera estimatorCamera() const;  ///< calibrated_camera, or the one built from the fields
 };
 
 struct ThrowDistribution {
@@ -93,8 +101,44 @@ struct ThrowDistribution {
   sim::DragBody body = sim::DragBody::ball5cm();  ///< 5 cm ball, 57 g, Cd 0.5, ρ 1.2 (k ≈ 0.0103 /m)
 };
 
+/// Camera-to-robot registration, once per session before the throws (config `registration:`).
+/// The catcher needs the ball in the ROBOT's frame to a few mm (5 mm clearance), but a rig
+/// calibrated from board views carries ~1 px / 5-10 mm of pose error per camera (docs/results.md).
+/// So, as a real catcher would (eye-to-hand): a green marker sphere sits on the box top at a known
+/// offset from the hole; the robot holds the box still at a grid of set points around home, every
+/// configured camera renders it, the detector finds the marker (searching only around where the
+/// calibrated camera expects it), and each camera's pose c_M_w is re-estimated by PnP (Levenberg-
+/// Marquardt from the calibrated pose, calibrated intrinsics) from the known marker positions
+/// (robot kinematics: set point + offset) and their detections. Nothing of the truth is used but
+/// the robot's own set points. Detections beyond gate_px of the expected pixel are dropped, then
+/// residuals above 3x the median after a first solve; cameras with fewer than min_points detections,
+/// or whose registration fits badly (max_rms_px) or moves them implausibly far (max_shift_m,
+/// max_rotation_deg), keep their calibrated pose.
+struct CatchRegistration {
+  bool enabled = false;  ///< off unless the config's registration.enabled says so
+  Eigen::Vector3d marker_offset = Eigen::Vector3d(0.15, 0.0, 0.175);  ///< m, from the hole centre (world axes)
+  double marker_radius = 0.025;
+  Eigen::Vector3d marker_albedo_bgr = Eigen::Vector3d(0.15, 0.75, 0.15);  ///< green
+  vision::ColorRange marker_hsv{35, 85, 80, 255, 30, 255};
+  std::vector<double> offsets_x{-0.08, 0.08}, offsets_y{-0.4, 0.0, 0.4}, offsets_z{-0.3, 0.0, 0.3};  ///< m, from home
+  int min_points = 6;
+  double gate_px = 10.0;          ///< detections farther than this from the expected pixel are dropped
+  double max_rms_px = 0.5;        ///< refuse a camera's registration above this reprojection RMS,
+  double max_shift_m = 0.05;      ///< or moving its centre more than this,
+  double max_rotation_rad = 0.0087;  ///< or rotating it more than this (0.5°)
+};
+
+struct RegistrationResult {
+  int poses = 0, cameras_registered = 0, cameras_refused = 0;
+  std::vector<int> points_per_camera;               ///< marker detections per configured camera
+  double reprojection_px_before = 0.0;              ///< RMS over the registered cameras, calibrated pose
+  double reprojection_px_after = 0.0;               ///< same, registered pose
+  std::vector<double> centre_shift_mm, rotation_deg;  ///< per registered camera: registered vs calibrated
+};
+
 struct BallCatchingConfig {
   std::string name = "ball_catching";
+  std::string rig;                   ///< rig folder as resolved ("" : inline cameras)
   std::vector<CatchCameraConfig> cameras;
   std::size_t camera_count = 0;      ///< use the first N cameras (0: all)
   double rate_override_hz = 0.0;     ///< > 0: every camera at this rate
@@ -115,8 +159,13 @@ struct BallCatchingConfig {
   double prediction_lead_s = 0.2;    ///< the early-prediction metric uses the last prediction this long before the crossing
   vision::BallDetectorConfig detector;
   double sigma_px_floor = 0.3;       ///< px, floor of the measurement std given to the tracker
+  /// px per axis: white Gaussian noise added to every detected pixel (pixel-noise table; 0: none).
+  /// The tracker is told: its σ is the detector's σ and this one added in quadrature. Drawn from
+  /// its own stream (deriveSeed(throw seed, 0xD37)), so the rest of a throw is unchanged.
+  double pixel_noise_px = 0.0;
   tracking::TrackerConfig tracker;
   planning::CatchPlannerConfig planner;  ///< model, thresholds (home/normal/limits/latency copied from robot/box)
+  CatchRegistration registration;
   sim::RenderSettings render;
   sim::RoomParams room;
   int threads = 2;                   ///< throws run in parallel (independent seeds: same results)
@@ -176,6 +225,7 @@ struct CatchSummary {
   std::size_t limit_violations = 0, refused_setpoints = 0;
   int frames = 0, detections = 0;
   double detection_rate = 0.0;
+  std::optional<RegistrationResult> registration;
   double launch_speed_min = 0.0, launch_speed_max = 0.0, launch_speed_mean = 0.0;
   double elevation_deg_min = 0.0, elevation_deg_max = 0.0;
   double flight_time_min = 0.0, flight_time_max = 0.0;
@@ -202,12 +252,18 @@ struct CatchHooks {
   std::function<void(int done, int total)> progress;
 };
 
+/// The registration above: renders the marker at the grid poses through every configured camera
+/// (true cameras, sensor noise), detects it and replaces each camera's calibrated_camera by the
+/// registered one. Throws core::NumericalError when no camera has min_points detections.
+RegistrationResult registerCamerasToRobot(BallCatchingConfig& cfg, const sim::Scene& room, std::uint64_t seed);
+
 /// One throw with its own seed.
 ThrowResult runThrow(const BallCatchingConfig& cfg, const sim::Scene& room, int index, std::uint64_t seed,
                      const CatchHooks* hooks = nullptr);
 
 /// `throws` throws (throw i uses deriveSeed(seed, i)), in parallel over cfg.threads unless hooks
-/// need one thread; the results do not depend on the thread count.
+/// need one thread; the results do not depend on the thread count. With registration.enabled the
+/// session first registers the cameras to the robot (seed deriveSeed(seed, 0x4E6)).
 CatchSummary runBallCatching(const BallCatchingConfig& cfg, int throws, std::uint64_t seed,
                              const CatchHooks& hooks = {});
 
