@@ -279,6 +279,24 @@ Eigen::Vector2d ScreenPath::velocity(double t) const {
   return d.norm() > 0.0 ? Eigen::Vector2d(params_.speed * d.normalized()) : Eigen::Vector2d::Zero();
 }
 
+std::vector<double> ScreenPath::cornerTimes(double t_end) const {
+  std::vector<double> out;
+  if (params_.shape == PathShape::Circle || cumulative_.size() < 3) return out;
+  const double total = cumulative_.back();
+  const bool closed = params_.shape == PathShape::Rectangle;
+  const double s_end = params_.speed * t_end;
+  for (double lap = 0.0; lap <= s_end; lap += total) {
+    // Interior vertices of the open polyline; every vertex of the closed one (its start included after lap 0).
+    for (std::size_t i = 1; i < cumulative_.size(); ++i) {
+      if (!closed && i + 1 == cumulative_.size()) break;
+      const double s = lap + cumulative_[i];
+      if (s > 0.0 && s <= s_end) out.push_back(s / params_.speed);
+    }
+    if (!closed) break;
+  }
+  return out;
+}
+
 // ----------------------------------------------------------------------------------------------
 
 Eigen::Vector2d GroundTarget::nominal(GroundProfile profile, double k) {

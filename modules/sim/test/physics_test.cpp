@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <vector>
 
 #include "viewline/core/error.h"
 #include "viewline/core/frames.h"
@@ -175,6 +176,29 @@ TEST(ScreenPath, AllShapesMoveAtConstantSpeed) {
   EXPECT_LT((r.position(0.0) - Eigen::Vector2d(-0.5, -0.25)).norm(), 1e-12);
   EXPECT_LT((r.position(1.0) - Eigen::Vector2d(0.5, -0.25)).norm(), 1e-12);
   EXPECT_LT((r.position(3.0) - r.position(0.0)).norm(), 1e-12);  // perimeter 3 m: closed loop
+  // Corners at the vertices: 1, 1.5, 2.5, 3 (back at the start), 4, ... s.
+  const std::vector<double> corners = r.cornerTimes(4.2);
+  ASSERT_EQ(corners.size(), 5u);
+  const double expected[] = {1.0, 1.5, 2.5, 3.0, 4.0};
+  for (std::size_t i = 0; i < 5; ++i) EXPECT_NEAR(corners[i], expected[i], 1e-12);
+  for (double c : corners) {  // the direction changes there
+    const Eigen::Vector2d before = r.velocity(c - 1e-3), after = r.velocity(c + 1e-3);
+    EXPECT_GT((before - after).norm(), 0.5);
+  }
+  ScreenPathParams random;
+  random.shape = PathShape::Random;
+  random.speed = 0.15;
+  random.duration = 30.0;
+  const ScreenPath rp(random, rng);
+  const std::vector<double> rc = rp.cornerTimes(30.0);
+  ASSERT_GE(rc.size(), 3u);
+  for (std::size_t i = 0; i < rc.size(); ++i) {
+    EXPECT_GT(rc[i], i ? rc[i - 1] : 0.0);
+    EXPECT_GT((rp.velocity(rc[i] - 1e-3) - rp.velocity(rc[i] + 1e-3)).norm(), 1e-4);
+  }
+  ScreenPathParams circle;
+  circle.shape = PathShape::Circle;
+  EXPECT_TRUE(ScreenPath(circle, rng).cornerTimes(100.0).empty());
   ScreenPathParams bad;
   bad.speed = 0.0;
   EXPECT_THROW(ScreenPath(bad, rng), core::InvalidInput);

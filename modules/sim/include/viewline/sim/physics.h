@@ -176,6 +176,8 @@ public:
   ScreenPath(const ScreenPathParams& params, core::Rng& rng);
   Eigen::Vector2d position(double t) const;
   Eigen::Vector2d velocity(double t) const;
+  /// Times in (0, t_end] at which the target passes a vertex of the polyline (its corners); empty for the circle.
+  std::vector<double> cornerTimes(double t_end) const;
   const ScreenPathParams& params() const { return params_; }
 
 private:
