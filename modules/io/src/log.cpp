@@ -80,7 +80,7 @@ LogDirectory::LogDirectory(const std::string& dir) : dir_(dir) {
     throw core::InvalidInput(dir_ + ": cannot create the log directory" + (ec ? ": " + ec.message() : ""));
 }
 
-CsvWriter& LogDirectory::stream(const std::string& name, const std::vector<std::string>& header) {
+CsvWriter& LogDirectory::stream(const std::string& name, const std::vector<std::string>& header, int precision) {
   if (!enabled()) return null_;
   if (name.empty() || name.find('/') != std::string::npos)
     throw core::InvalidInput("log stream name '" + name + "': expected a plain file stem");
@@ -91,7 +91,7 @@ CsvWriter& LogDirectory::stream(const std::string& name, const std::vector<std::
     return *it->second;
   }
   const std::string path = (std::filesystem::path(dir_) / (name + ".csv")).string();
-  auto w = std::make_unique<CsvWriter>(path, header);
+  auto w = std::make_unique<CsvWriter>(path, header, precision);
   CsvWriter& ref = *w;
   streams_.emplace(name, std::move(w));
   return ref;

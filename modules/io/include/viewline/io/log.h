@@ -48,8 +48,9 @@ public:
   bool enabled() const { return !dir_.empty(); }
   const std::string& dir() const { return dir_; }
   /// The writer of `<dir>/<name>.csv`, created on first use. Asking again with a different
-  /// header throws. When disabled, a shared no-op writer.
-  CsvWriter& stream(const std::string& name, const std::vector<std::string>& header);
+  /// header throws. When disabled, a shared no-op writer. `precision`: significant digits (17: every
+  /// double reads back exactly, for logs that are replayed).
+  CsvWriter& stream(const std::string& name, const std::vector<std::string>& header, int precision = 12);
   void flush();
 
 private:
