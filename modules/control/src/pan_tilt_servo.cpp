@@ -101,6 +101,19 @@ void TargetFilterConfig::validate() const {
   if (!(jump_window >= 0.0) || !std::isfinite(jump_window)) throw core::InvalidInput("filter.jump_window must be >= 0");
   core::requirePositive(jump_threshold, "filter.jump_threshold");
   if (jump_min_samples < 2) throw core::InvalidInput("filter.jump_min_samples must be >= 2");
+  if (!(constant_speed_sigma >= 0.0) || !std::isfinite(constant_speed_sigma))
+    throw core::InvalidInput("filter.constant_speed_sigma must be >= 0");
+  if (constant_speed && (model != TargetModel::ConstantVelocity || !(jump_window > 0.0)))
+    throw core::InvalidInput("filter.constant_speed needs model constant_velocity and jump detection "
+                             "(filter.jump_window > 0): the speed is learnt from the legs between detected jumps");
+  if (!(jump_rate >= 0.0) || !std::isfinite(jump_rate)) throw core::InvalidInput("filter.jump_rate must be >= 0");
+  core::requirePositive(jump_prior_sigma, "filter.jump_prior_sigma");
+  if (!(jump_corner_sigma >= 0.0) || !std::isfinite(jump_corner_sigma))
+    throw core::InvalidInput("filter.jump_corner_sigma must be >= 0");
+  if (jump_rate > 0.0 && !(jump_window > 0.0))
+    throw core::InvalidInput("filter.jump_rate needs jump detection (filter.jump_window > 0)");
+  if (jump_rate > 0.0 && (model == TargetModel::CoordinatedTurn || model == TargetModel::Imm))
+    throw core::InvalidInput("filter.jump_rate (the soft jump mixture) is for the linear models cv, ca and singer");
 }
 
 namespace {
@@ -120,6 +133,107 @@ estimation::NonlinearTransition cvWithOmega(double q, double q_omega, double dt)
 }
 
 }  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// A constant-speed leg (see the class comment): measurements z_i = c + s τ_i u(θ) + e_i, τ_i = t_i − t_c,
+// e_i ~ N(0, R_i), θ uniform, and β = (c, s) ~ N(β₀, P₀) with β₀ = (ĉ, ŝ), P₀ = diag(P_c, σ_s²). Given θ
+// the model is linear in β (H_i = [I  τ_i u]), so β is marginalised in closed form from the sufficient
+// statistics A = Σ R_i⁻¹, B_z = Σ R_i⁻¹ z_i, B_τ = Σ τ_i R_i⁻¹, C_τz = Σ τ_i R_i⁻¹ z_i, C_ττ = Σ τ_i² R_i⁻¹,
+// zz = Σ z_iᵀ R_i⁻¹ z_i:
+//   Λ(θ) = P₀⁻¹ + [[A, B_τ u], [uᵀ B_τ, uᵀ C_ττ u]],  η(θ) = P₀⁻¹ β₀ + (B_z, uᵀ C_τz),
+//   β | θ ~ N(Λ⁻¹ η, Λ⁻¹),  log p(z | θ) = −½ (zz + β₀ᵀ P₀⁻¹ β₀ − ηᵀ Λ⁻¹ η) − ½ log det Λ  (+ const).
+// The speed is thus re-estimated on every leg around the learnt ŝ (it absorbs a scale error of the
+// measurements), and only θ needs a grid.
+struct PlanarTargetFilter::Leg {
+  double t_c = 0.0;
+  Eigen::Vector3d beta0 = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d P0_inv = Eigen::Matrix3d::Identity();
+  Eigen::Matrix2d A = Eigen::Matrix2d::Zero(), Bt = Eigen::Matrix2d::Zero(), Ctt = Eigen::Matrix2d::Zero();
+  Eigen::Vector2d Bz = Eigen::Vector2d::Zero(), Ctz = Eigen::Vector2d::Zero();
+  double zz = 0.0;
+
+  void add(double t, const Eigen::Vector2d& z, const Eigen::Matrix2d& R) {
+    const Eigen::Matrix2d Ri = R.inverse();
+    const double tau = t - t_c;
+    A += Ri;
+    Bz += Ri * z;
+    Bt += tau * Ri;
+    Ctz += tau * (Ri * z);
+    Ctt += tau * tau * Ri;
+    zz += z.dot(Ri * z);
+  }
+
+  /// The posterior moments of (p, v) at time t (p = c + s (t − t_c) u, v = s u).
+  estimation::StateEstimate moments(double t) const {
+    const Eigen::Vector3d P0_b0 = P0_inv * beta0;
+    const double b0_term = beta0.dot(P0_b0);
+    struct Point {
+      double th = 0.0, ll = 0.0;
+      Eigen::Vector3d m = Eigen::Vector3d::Zero();
+      Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+    };
+    const auto evaluate = [&](double th) {
+      Point pt;
+      pt.th = th;
+      const Eigen::Vector2d u(std::cos(th), std::sin(th));
+      Eigen::Matrix3d L = P0_inv;
+      L.topLeftCorner<2, 2>() += A;
+      const Eigen::Vector2d Btu = Bt * u;
+      L.block<2, 1>(0, 2) += Btu;
+      L.block<1, 2>(2, 0) += Btu.transpose();
+      L(2, 2) += u.dot(Ctt * u);
+      Eigen::Vector3d eta = P0_b0;
+      eta.head<2>() += Bz;
+      eta(2) += u.dot(Ctz);
+      const Eigen::LLT<Eigen::Matrix3d> llt(L);
+      pt.m = llt.solve(eta);
+      pt.cov = llt.solve(Eigen::Matrix3d::Identity());
+      const double logdet = 2.0 * Eigen::Matrix3d(llt.matrixL()).diagonal().array().log().sum();
+      pt.ll = -0.5 * (zz + b0_term - eta.dot(pt.m)) - 0.5 * logdet;
+      return pt;
+    };
+    // Grid over θ: 180 points on the circle, then refined (±2 steps of the previous grid, 81 points)
+    // while one point holds more than 30 % of the mass, so a narrow posterior is still resolved.
+    double lo = -core::kPi, step = 2.0 * core::kPi / 180.0;
+    int count = 180;
+    std::vector<Point> grid;
+    for (int level = 0; level < 6; ++level) {
+      grid.clear();
+      for (int k = 0; k < count; ++k) grid.push_back(evaluate(lo + step * k));
+      const auto best = std::max_element(grid.begin(), grid.end(), [](const Point& a, const Point& b) { return a.ll < b.ll; });
+      double total = 0.0;
+      for (const Point& pt : grid) total += std::exp(pt.ll - best->ll);
+      if (1.0 / total < 0.3) break;
+      lo = best->th - 2.0 * step;
+      step = 4.0 * step / 80.0;
+      count = 81;
+    }
+    double top = -1e300;
+    for (const Point& pt : grid) top = std::max(top, pt.ll);
+    const double tau = t - t_c;
+    Eigen::Vector4d mean = Eigen::Vector4d::Zero();
+    Eigen::Matrix4d second = Eigen::Matrix4d::Zero();
+    double wsum = 0.0;
+    for (const Point& pt : grid) {
+      const double w = std::exp(pt.ll - top);
+      if (w < 1e-12) continue;
+      const Eigen::Vector2d u(std::cos(pt.th), std::sin(pt.th));
+      Eigen::Matrix<double, 4, 3> J = Eigen::Matrix<double, 4, 3>::Zero();  // (p, v) = J β
+      J.topLeftCorner<2, 2>() = Eigen::Matrix2d::Identity();
+      J.block<2, 1>(0, 2) = tau * u;
+      J.block<2, 1>(2, 2) = u;
+      const Eigen::Vector4d x = J * pt.m;
+      wsum += w;
+      mean += w * x;
+      second += w * (x * x.transpose() + J * pt.cov * J.transpose());
+    }
+    mean /= wsum;
+    Eigen::Matrix4d P = second / wsum - mean * mean.transpose();
+    P = 0.5 * (P + P.transpose()).eval();
+    P.diagonal().array() += 1e-12;
+    return estimation::StateEstimate(Eigen::VectorXd(mean), Eigen::MatrixXd(P), t);
+  }
+};
 
 int PlanarTargetFilter::stateDim() const {
   switch (config_.model) {
@@ -191,14 +305,19 @@ void PlanarTargetFilter::reset(core::Timestamp t, const Eigen::Vector2d& z, cons
   if (imm_) imm_->reset(x, P, t);
   initialized_ = true;
   rejected_in_a_row_ = 0;
+  output_.reset();
+  leg_.reset();
   history_.clear();
   if (config_.jump_window > 0.0) history_.push_back(snapshot(t, z, R));
 }
 
 PlanarTargetFilter::Update PlanarTargetFilter::update(core::Timestamp t, const Eigen::Vector2d& z,
                                                       const Eigen::Matrix2d& R) {
+  output_.reset();
   Update out = step(t, z, R);
-  if (config_.jump_window <= 0.0 || out.reinitialized || !out.accepted) return out;
+  // Gated-out measurements are kept for the jump test too: after a sharp corner the first
+  // measurements of the new leg are the ones the gate rejects, and they are the evidence of the jump.
+  if (config_.jump_window <= 0.0 || out.reinitialized) return out;
   history_.push_back(snapshot(t, z, R));
   while (history_.size() > 1 && history_.front().t < t - config_.jump_window) history_.erase(history_.begin());
   out.jump = detectJump();
@@ -250,12 +369,17 @@ bool PlanarTargetFilter::detectJump() {
   // estimate (it uses measurements up to t_k only).
   const int n = static_cast<int>(history_.size());
   const int m = config_.jump_min_samples;
-  if (n < 2 * m + 1) return false;
+  const bool soft = config_.jump_rate > 0.0;
+  output_.reset();
+  // Hard test: m <= j < n - m. Soft mixture: every j with m measurements before and 2 after.
+  if (n < (soft ? m + 3 : 2 * m + 1)) return false;
   double best = config_.jump_threshold;
   int best_j = -1;
   std::vector<double> tau(static_cast<std::size_t>(n));
   std::vector<Eigen::Vector2d> r(static_cast<std::size_t>(n));
-  for (int j = m; j + m < n; ++j) {
+  std::vector<std::pair<double, int>> log_odds;  // soft: log(π_j BF_j), j
+  const double prior_precision = soft ? 1.0 / (config_.jump_prior_sigma * config_.jump_prior_sigma) : 0.0;
+  for (int j = m; j + (soft ? 2 : m) < n; ++j) {
     const Snapshot& sj = history_[static_cast<std::size_t>(j)];
     for (int i = 0; i < n; ++i) {
       const Snapshot& si = history_[static_cast<std::size_t>(i)];
@@ -268,7 +392,7 @@ bool PlanarTargetFilter::detectJump() {
     if (xj.size() == 5) sigma_gamma = 0.5 * xj.segment<2>(2).norm() * std::sqrt(std::max(sj.state.P()(4, 4), 0.0));
     const bool curved = sigma_gamma > 0.0;  // (CV/CA: no γ column)
     const double gamma_weight = curved ? 1.0 / (sigma_gamma * sigma_gamma) : 1.0;
-    double l = 0.0;
+    double l = 0.0, log_bf = 0.0;
     for (int a = 0; a < 2; ++a) {
       // Penalised least squares (γ with its prior, α, β and Δv free) under H0 and H1:
       // min ‖r − X θ‖²_W + θᵀ Λ θ = rᵀ W r − (Xᵀ W r)ᵀ (Xᵀ W X + Λ)⁻¹ Xᵀ W r.
@@ -283,21 +407,80 @@ bool PlanarTargetFilter::detectJump() {
       }
       M(2, 2) += gamma_weight;
       const Eigen::Vector3d g0 = g.head<3>();
-      const double fit0 = g0.dot(M.topLeftCorner<3, 3>().ldlt().solve(g0));
+      const auto ldlt0 = M.topLeftCorner<3, 3>().ldlt();
+      const double fit0 = g0.dot(ldlt0.solve(g0));
       const double fit1 = g.dot(M.ldlt().solve(g));
       l += fit1 - fit0;
+      if (soft) {
+        // Bayes factor with Δv_a ~ N(0, jump_prior_sigma²) (α, β flat under both hypotheses):
+        // log BF_a = ½ (fit1' − fit0) − ½ log(det M1' / det M0) − ½ log σ_Δ², M1' = M1 + diag(0, 0, 0, 1/σ_Δ²).
+        Eigen::Matrix4d M1 = M;
+        M1(3, 3) += prior_precision;
+        const auto ldlt1 = M1.ldlt();
+        const double fit1p = g.dot(ldlt1.solve(g));
+        const double logdet1 = ldlt1.vectorD().array().log().sum(), logdet0 = ldlt0.vectorD().array().log().sum();
+        log_bf += 0.5 * (fit1p - fit0) - 0.5 * (logdet1 - logdet0) + 0.5 * std::log(prior_precision);
+      }
     }
-    if (l > best) {
+    if (j + m < n && l > best) {
       best = l;
       best_j = j;
     }
+    if (soft) {
+      // Prior probability of a jump at t_j (and nowhere else in the window): rate × the interval it stands for.
+      const double dt_j = sj.t - history_[static_cast<std::size_t>(j - 1)].t;
+      log_odds.emplace_back(std::log(std::max(config_.jump_rate * dt_j, 1e-300)) + log_bf, j);
+    }
   }
-  if (best_j < 0) return false;
-  // Back to x(j|j) with the motion prior re-opened, then the later measurements again.
-  std::vector<Snapshot> later(history_.begin() + best_j + 1, history_.end());
-  history_.erase(history_.begin(), history_.begin() + best_j);
-  history_.resize(1);
-  Snapshot& sj = history_.front();
+  if (best_j < 0) {
+    if (soft) softMixture(log_odds);
+    return false;
+  }
+  if (config_.constant_speed) learnSpeed(static_cast<std::size_t>(best_j));
+  applyJump(best_j);
+  ++jumps_;
+  return true;
+}
+
+void PlanarTargetFilter::softMixture(std::vector<std::pair<double, int>>& log_odds) {
+  // Posterior over "no jump in the window" (prior odds 1) and "a jump at t_j" (odds π_j BF_j): the
+  // estimate is the mixture of the filter's own x(k|k) and of the filters restarted at the likely
+  // jump times (the same restart as a detected jump, alternative()), moments matched. Hypotheses below
+  // 1 % of the posterior are dropped (at most 4 are kept), so the cost stays a few re-runs per step.
+  if (log_odds.empty()) return;
+  std::sort(log_odds.begin(), log_odds.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+  const double top = std::max(0.0, log_odds.front().first);
+  double total = std::exp(-top);
+  for (const auto& [lo, j] : log_odds) total += std::exp(lo - top);
+  std::vector<std::pair<double, Eigen::VectorXd>> parts;
+  std::vector<Eigen::MatrixXd> covs;
+  const double w0 = std::exp(-top) / total;
+  parts.emplace_back(w0, state_.x());
+  covs.push_back(state_.P());
+  for (std::size_t k = 0; k < log_odds.size() && k < 4; ++k) {
+    const double w = std::exp(log_odds[k].first - top) / total;
+    if (w < 0.01) break;
+    const estimation::StateEstimate alt = alternative(log_odds[k].second);
+    parts.emplace_back(w, alt.x());
+    covs.push_back(alt.P());
+  }
+  if (parts.size() == 1) return;
+  double wsum = 0.0;
+  Eigen::VectorXd mean = Eigen::VectorXd::Zero(state_.x().size());
+  for (const auto& [w, x] : parts) {
+    wsum += w;
+    mean += w * x;
+  }
+  mean /= wsum;
+  Eigen::MatrixXd P = Eigen::MatrixXd::Zero(mean.size(), mean.size());
+  for (std::size_t k = 0; k < parts.size(); ++k) {
+    const Eigen::VectorXd d = parts[k].second - mean;
+    P += parts[k].first / wsum * (covs[k] + d * d.transpose());
+  }
+  output_ = estimation::StateEstimate(mean, P, state_.t());
+}
+
+estimation::StateEstimate PlanarTargetFilter::reopened(const Snapshot& sj) const {
   Eigen::VectorXd x = sj.state.x();
   Eigen::MatrixXd P = sj.state.P();
   const int dim = static_cast<int>(x.size());
@@ -310,20 +493,125 @@ bool PlanarTargetFilter::detectJump() {
     P(4, 4) = std::pow(config_.init_omega_sigma, 2);
   }
   if (dim == 6) P.block(4, 4, 2, 2) = std::pow(config_.init_acceleration_sigma, 2) * Eigen::Matrix2d::Identity();
-  state_ = estimation::StateEstimate(x, P, sj.t);
+  return estimation::StateEstimate(x, P, sj.t);
+}
+
+estimation::StateEstimate PlanarTargetFilter::alternative(int j) const {
+  // The state now if the jump had been at t_j: as applyJump, without the gate and without touching
+  // the filter (a leg only accumulates its statistics; a linear model re-runs its Kalman steps).
+  const Snapshot& sj = history_[static_cast<std::size_t>(j)];
+  const std::size_t n = history_.size();
+  if (config_.constant_speed && speed_info_ > 0.0) {
+    Leg leg = makeLeg(sj.t, sj.state.x().head<2>(), sj.state.P().block(0, 0, 2, 2));
+    for (std::size_t i = static_cast<std::size_t>(j) + 1; i < n; ++i) leg.add(history_[i].t, history_[i].z, history_[i].R);
+    return leg.moments(history_.back().t);
+  }
+  estimation::StateEstimate s = reopened(sj);
+  estimation::LinearMeasurement m;
+  m.C = Eigen::MatrixXd::Zero(2, stateDim());
+  m.C.block(0, 0, 2, 2) = Eigen::Matrix2d::Identity();
+  for (std::size_t i = static_cast<std::size_t>(j) + 1; i < n; ++i) {
+    const double dt = history_[i].t - s.t();
+    if (dt > 1e-9) estimation::predict(s, estimation::discretize(model_, dt));
+    m.y = history_[i].z;
+    m.R = history_[i].R;
+    estimation::update(s, m);
+  }
+  return s;
+}
+
+void PlanarTargetFilter::applyJump(int best_j) {
+  // Back to x(j|j) with the motion prior re-opened, then the later measurements again.
+  std::vector<Snapshot> later(history_.begin() + best_j + 1, history_.end());
+  history_.erase(history_.begin(), history_.begin() + best_j);
+  history_.resize(1);
+  Snapshot& sj = history_.front();
+  state_ = reopened(sj);
+  leg_.reset();
+  if (config_.constant_speed && speed_info_ > 0.0)
+    leg_ = std::make_shared<const Leg>(makeLeg(sj.t, state_.x().head<2>(), state_.P().block(0, 0, 2, 2)));
   if (imm_) {
     imm_ = *sj.imm;
-    imm_->reset(x, P, sj.t, sj.imm->probabilities());
+    imm_->reset(state_.x(), state_.P(), sj.t, sj.imm->probabilities());
   }
   sj = snapshot(sj.t, sj.z, sj.R);
   rejected_in_a_row_ = 0;
-  ++jumps_;
   for (const Snapshot& s : later) {
     const Update u = step(s.t, s.z, s.R);
     if (u.reinitialized) history_.clear();
-    if (u.accepted) history_.push_back(snapshot(s.t, s.z, s.R));
+    history_.push_back(snapshot(s.t, s.z, s.R));
   }
-  return true;
+}
+
+PlanarTargetFilter::Leg PlanarTargetFilter::makeLeg(core::Timestamp t_c, const Eigen::Vector2d& c,
+                                                    const Eigen::Matrix2d& P_c) const {
+  Leg leg;
+  leg.t_c = t_c;
+  leg.beta0 << c, speedEstimate();
+  Eigen::Matrix3d P0 = Eigen::Matrix3d::Zero();
+  P0.topLeftCorner<2, 2>() = P_c + std::pow(config_.jump_corner_sigma, 2) * Eigen::Matrix2d::Identity();
+  P0(2, 2) = speedVariance() + config_.constant_speed_sigma * config_.constant_speed_sigma;
+  leg.P0_inv = P0.inverse();
+  return leg;
+}
+
+void PlanarTargetFilter::startLeg(core::Timestamp t_c) {
+  if (!initialized_) throw core::Error("PlanarTargetFilter::startLeg: filter not initialised");
+  if (!config_.constant_speed || !(speed_info_ > 0.0))
+    throw core::Error("PlanarTargetFilter::startLeg: needs constant_speed and a known speed (setSpeed or a finished leg)");
+  if (t_c < state_.t()) throw core::InvalidInput("PlanarTargetFilter::startLeg: t_c is before the last measurement");
+  const Kinematics k = at(t_c);
+  leg_ = std::make_shared<const Leg>(makeLeg(t_c, k.p, k.P_pos));
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(4);
+  x.head<2>() = k.p;
+  Eigen::MatrixXd P = Eigen::MatrixXd::Zero(4, 4);
+  P.block(0, 0, 2, 2) = k.P_pos;
+  P.block(2, 2, 2, 2) = std::pow(config_.init_velocity_sigma, 2) * Eigen::Matrix2d::Identity();
+  state_ = estimation::StateEstimate(x, P, t_c);
+  output_.reset();
+  history_.clear();
+}
+
+void PlanarTargetFilter::setSpeed(double speed, double variance) {
+  core::requirePositive(speed, "PlanarTargetFilter::setSpeed: speed");
+  core::requirePositive(variance, "PlanarTargetFilter::setSpeed: variance");
+  speed_sum_ = speed / variance;
+  speed_info_ = 1.0 / variance;
+}
+
+void PlanarTargetFilter::learnSpeed(std::size_t end) {
+  // Weighted least-squares line z = a + b t per axis through history_[0..end] (the segment that
+  // ended at the detected jump, or its last jump_window s): var b = 1 / Σ w (t − t̄)², t̄ the weighted
+  // mean time. s_k = |b|, var s_k = b̂ᵀ diag(var b) b̂ (b̂ = b / |b|). Segments under 0.5 s or with
+  // fewer than 2 jump_min_samples measurements are skipped (their slope is mostly noise).
+  if (end + 1 < static_cast<std::size_t>(2 * config_.jump_min_samples)) return;
+  if (history_[end].t - history_.front().t < 0.5) return;
+  Eigen::Vector2d b, var_b;
+  for (int a = 0; a < 2; ++a) {
+    double sw = 0.0, swt = 0.0, swz = 0.0;
+    for (std::size_t i = 0; i <= end; ++i) {
+      const double w = 1.0 / history_[i].R(a, a);
+      sw += w;
+      swt += w * history_[i].t;
+      swz += w * history_[i].z(a);
+    }
+    const double tm = swt / sw, zm = swz / sw;
+    double stt = 0.0, stz = 0.0;
+    for (std::size_t i = 0; i <= end; ++i) {
+      const double w = 1.0 / history_[i].R(a, a);
+      stt += w * (history_[i].t - tm) * (history_[i].t - tm);
+      stz += w * (history_[i].t - tm) * (history_[i].z(a) - zm);
+    }
+    b(a) = stz / stt;
+    var_b(a) = 1.0 / stt;
+  }
+  const double s = b.norm();
+  if (!(s > 0.0)) return;
+  const Eigen::Vector2d u = b / s;
+  const double var_s = u.cwiseProduct(u).dot(var_b);
+  if (!(var_s > 0.0) || var_s > 0.25 * s * s) return;  // a segment whose speed is not resolved
+  speed_sum_ += s / var_s;
+  speed_info_ += 1.0 / var_s;
 }
 
 PlanarTargetFilter::Update PlanarTargetFilter::step(core::Timestamp t, const Eigen::Vector2d& z,
@@ -357,6 +645,32 @@ PlanarTargetFilter::Update PlanarTargetFilter::step(core::Timestamp t, const Eig
     out.accepted = true;
     return out;
   }
+  if (leg_) {
+    // Constant-speed leg: gate on the leg's predicted moments, then add the measurement to the leg. Every
+    // component of the posterior moves on a straight line, so the moments at t are exactly those at the
+    // last measurement carried by p += τ v (no process noise).
+    Eigen::MatrixXd Phi = Eigen::MatrixXd::Identity(4, 4);
+    Phi(0, 2) = Phi(1, 3) = dt;
+    const estimation::StateEstimate pred(Phi * state_.x(), Phi * state_.P() * Phi.transpose(), t);
+    const Eigen::Matrix2d S = pred.P().block(0, 0, 2, 2) + R;
+    const Eigen::Vector2d d = z - pred.x().head<2>();
+    out.nis = d.dot(S.ldlt().solve(d));
+    if (out.nis > gate_) {
+      state_ = pred;
+      if (++rejected_in_a_row_ >= config_.reinit_after) {
+        reset(t, z, R);
+        out.accepted = out.reinitialized = true;
+      }
+      return out;
+    }
+    rejected_in_a_row_ = 0;
+    auto leg = std::make_shared<Leg>(*leg_);
+    leg->add(t, z, R);
+    leg_ = leg;
+    state_ = leg_->moments(t);
+    out.accepted = true;
+    return out;
+  }
   if (dt > 1e-9) estimation::predict(state_, estimation::discretize(model_, dt));
   const Eigen::MatrixXd S = estimation::innovationCovariance(state_, m.C, m.R);
   const Eigen::Vector2d d = z - state_.x().head<2>();
@@ -377,9 +691,10 @@ PlanarTargetFilter::Update PlanarTargetFilter::step(core::Timestamp t, const Eig
 PlanarTargetFilter::Kinematics PlanarTargetFilter::at(core::Timestamp t) const {
   if (!initialized_) throw core::Error("PlanarTargetFilter::at: filter not initialised");
   Kinematics k;
-  const double dt = t - state_.t();
-  Eigen::VectorXd x = state_.x();
-  Eigen::MatrixXd P = state_.P();
+  const estimation::StateEstimate& est = estimate();
+  const double dt = t - est.t();
+  Eigen::VectorXd x = est.x();
+  Eigen::MatrixXd P = est.P();
   if (imm_) {
     estimation::Imm ahead = *imm_;
     if (dt > 1e-9) ahead.predict(t);
@@ -486,7 +801,7 @@ void PredictivePanTiltController::observe(const TargetObservation& obs) {
   }
   if (last_update_.accepted) {
     last_accepted_ = obs.stamp;
-    filtered_ = filter_.state().x().head<2>();
+    filtered_ = filter_.estimate().x().head<2>();
     searching_ = false;
   }
 }

@@ -116,6 +116,11 @@ struct TargetFilterConfig {
   double jump_window = 0.0;              ///< s searched back for a velocity jump (GLR; 0: no jump detection)
   double jump_threshold = 20.0;          ///< GLR statistic (χ², 2 dof) that declares a jump
   int jump_min_samples = 4;              ///< measurements after a candidate jump time before it is tested
+  bool constant_speed = false;           ///< constant-speed legs after each jump (cv; see PlanarTargetFilter)
+  double constant_speed_sigma = 0.002;   ///< m/s, std of a leg's speed about the learnt ŝ (beside var ŝ)
+  double jump_corner_sigma = 0.0;        ///< m, added to the corner's position std when a leg starts
+  double jump_rate = 0.0;                ///< 1/s, prior rate of jumps; > 0: soft jump mixture (see below)
+  double jump_prior_sigma = 0.15;        ///< m/s, prior std of a velocity jump per axis (soft mixture)
   double gate_probability = 0.9999;      ///< chi-square (2 dof) gate on the NIS
   int reinit_after = 3;                  ///< consecutive gated-out measurements that re-initialise
   void validate() const;
@@ -137,6 +142,20 @@ struct TargetFilterConfig {
 /// velocity at one of the measurement times of the last jump_window seconds (a corner of a
 /// polyline at constant speed); on detection the filter restarts from its estimate at that time
 /// with the velocity prior re-opened and processes the later measurements again (detectJump()).
+/// Constant-speed legs (constant_speed, cv, with jump detection): the target moves along straight legs
+/// at one unknown speed s (a polyline at constant speed). At each detected jump the leg that ended gives
+/// a speed measurement s_k = |b|, b the slope of a weighted least-squares line through its measurements
+/// (var s_k = b̂ᵀ cov(b) b̂), and ŝ is their inverse-variance mean. Once ŝ is known, each jump starts a
+/// leg p(t) = c + s (t − t_c) u(θ) from the corner c ~ N(x(j|j) position, its covariance + σ_c² I,
+/// σ_c = jump_corner_sigma) at the jump time t_c, with s ~ N(ŝ, var ŝ + constant_speed_sigma²) and θ
+/// uniform: (c, s) is marginalised in closed form, the posterior of θ is evaluated on a grid (refined
+/// around the mode as it narrows), and the filter's state is the posterior's moments of (p, v). After a
+/// corner only the direction is learnt (one unknown instead of a 2-D velocity), without linearising.
+/// Soft jump mixture (jump_rate > 0; cv, ca, singer): between detected jumps the output is not the
+/// filter's x(k|k) alone but the posterior mixture of "no jump in the window" and "a jump at t_j"
+/// for the window's measurement times, with prior probability jump_rate × (t_j − t_{j−1}) and Bayes
+/// factor from the same fits as the test, the jump having the prior Δv ~ N(0, jump_prior_sigma² I);
+/// so the estimate starts to turn before the test is sure of a corner (estimate(), at()).
 class PlanarTargetFilter {
 public:
   explicit PlanarTargetFilter(const TargetFilterConfig& config = {});
@@ -160,12 +179,23 @@ public:
   /// only by rounding (it is then evaluated at the state's time).
   Kinematics at(core::Timestamp t) const;
   const estimation::StateEstimate& state() const { return state_; }
+  /// The output estimate at the last measurement: the soft jump mixture when it applies, else state().
+  const estimation::StateEstimate& estimate() const { return output_ ? *output_ : state_; }
   const TargetFilterConfig& config() const { return config_; }
   int stateDim() const;
   /// IMM mode probabilities (cv, ct, maneuver); empty for the other models.
   Eigen::VectorXd modeProbabilities() const;
   /// Velocity jumps detected since construction.
   std::size_t jumps() const { return jumps_; }
+  /// Starts a constant-speed leg at t_c (>= the last measurement time) from the estimate there: a
+  /// jump known from outside (e.g. the corner times of a known path, for a bound). Needs constant_speed
+  /// and a known speed.
+  void startLeg(core::Timestamp t_c);
+  /// Sets ŝ and its variance (instead of learning them from the legs).
+  void setSpeed(double speed, double variance);
+  /// The learnt speed ŝ (m/s) and its variance; 0 / infinity before the first segment has ended.
+  double speedEstimate() const { return speed_info_ > 0.0 ? speed_sum_ / speed_info_ : 0.0; }
+  double speedVariance() const { return speed_info_ > 0.0 ? 1.0 / speed_info_ : 1e300; }
 
 private:
   struct Snapshot {
@@ -179,6 +209,16 @@ private:
   Snapshot snapshot(core::Timestamp t, const Eigen::Vector2d& z, const Eigen::Matrix2d& R) const;
   Eigen::Vector2d extrapolatePosition(const Eigen::VectorXd& x, double tau) const;
   bool detectJump();
+  void applyJump(int j);  ///< restart from history_[j] with the motion prior re-opened, re-process the rest
+  void softMixture(std::vector<std::pair<double, int>>& log_odds);
+  struct Leg;
+  Leg makeLeg(core::Timestamp t_c, const Eigen::Vector2d& c, const Eigen::Matrix2d& P_c) const;
+  estimation::StateEstimate reopened(const Snapshot& sj) const;  ///< x(j|j) with the motion prior re-opened
+  estimation::StateEstimate alternative(int j) const;            ///< the state now after a jump at history_[j]
+  std::shared_ptr<const Leg> leg_;  ///< the current constant-speed leg (immutable: copies share it until it changes)
+  std::optional<estimation::StateEstimate> output_;  ///< the soft mixture, when it differs from state_
+  void learnSpeed(std::size_t end);  ///< s_k of the segment history_[0..end]
+  double speed_sum_ = 0.0, speed_info_ = 0.0;  ///< Σ s_k / var s_k, Σ 1 / var s_k
   std::vector<Snapshot> history_;  ///< accepted measurements of the last jump_window s (since the last jump)
   std::size_t jumps_ = 0;
   bool usesImm() const { return config_.model == TargetModel::CoordinatedTurn || config_.model == TargetModel::Imm; }
