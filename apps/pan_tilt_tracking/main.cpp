@@ -5,6 +5,8 @@
 //
 //   pan_tilt_tracking --config config/pan_tilt_circle.yaml --duration 60 --seed 1 --headless --summary out.json
 //   pan_tilt_tracking --config <variant>.yaml --seed 1 --replay <log>/predictive_frames.csv   (filter only)
+//   pan_tilt_tracking --config <path>.yaml --seed 1 --replay <log>/predictive_frames.csv --oracle-corners
+//       (a bound: the filter told the true corner times and speed; rectangle and random paths)
 
 #include <CLI/CLI.hpp>
 #include <cmath>
@@ -26,7 +28,7 @@ int main(int argc, char** argv) {
   std::string config_path, log_dir, summary_path, replay_path;
   std::uint64_t seed = 1;
   double duration = -1.0;
-  bool headless = false, display = false, no_baseline = false;
+  bool headless = false, display = false, no_baseline = false, oracle_corners = false;
   app.add_option("--config", config_path, "scenario YAML (config/pan_tilt_*.yaml)")->required();
   app.add_option("--seed", seed, "random seed (path, sensor noise, [T] measurement noise)");
   app.add_option("--duration", duration, "simulated seconds (overrides run.duration)");
@@ -38,7 +40,14 @@ int main(int argc, char** argv) {
   app.add_option("--replay", replay_path,
                  "filter only: re-run this config's target filter on the measurements of a --log run "
                  "(<log>/predictive_frames.csv, same --seed and --duration) instead of simulating");
+  app.add_flag("--oracle-corners", oracle_corners,
+               "with --replay (rectangle, random): instead of the config's filter, a bound: constant-speed legs "
+               "told the path's true corner times and speed");
   CLI11_PARSE(app, argc, argv);
+  if (oracle_corners && replay_path.empty()) {
+    std::cerr << "--oracle-corners needs --replay\n";
+    return 2;
+  }
   if (headless && display) {
     std::cerr << "--headless and --display are exclusive\n";
     return 2;
@@ -52,11 +61,15 @@ int main(int argc, char** argv) {
     if (no_baseline) cfg.run_baseline = false;
     cfg.validate();
     if (!replay_path.empty()) {
-      const scenarios::PanTiltReplayMetrics r = scenarios::replayPanTiltFilter(cfg, seed, replay_path);
+      const scenarios::PanTiltReplayMetrics r = scenarios::replayPanTiltFilter(cfg, seed, replay_path, oracle_corners);
       if (!summary_path.empty()) io::writeJsonFile(summary_path, r.toJson());
-      std::printf("replay of %s (seed %llu, filter %s): %zu measurements, %zu velocity jumps detected\n",
-                  replay_path.c_str(), static_cast<unsigned long long>(seed), control::toString(cfg.control.filter.model),
-                  r.measurements, r.jumps);
+      if (oracle_corners)
+        std::printf("replay of %s (seed %llu, oracle: constant-speed legs at the %zu true corners): %zu measurements\n",
+                    replay_path.c_str(), static_cast<unsigned long long>(seed), r.jumps, r.measurements);
+      else
+        std::printf("replay of %s (seed %llu, filter %s): %zu measurements, %zu velocity jumps detected\n",
+                    replay_path.c_str(), static_cast<unsigned long long>(seed),
+                    control::toString(cfg.control.filter.model), r.measurements, r.jumps);
       std::printf("  rmse measured (cm)          x %.4f  y %.4f\n", r.rmse_measured_cm.x(), r.rmse_measured_cm.y());
       std::printf("  rmse filtered (cm)          x %.4f  y %.4f\n", r.rmse_filtered_cm.x(), r.rmse_filtered_cm.y());
       std::printf("  rmse predicted %.4f s ahead (cm)  x %.4f  y %.4f  (%.2f px)\n", r.horizon_s, r.rmse_predicted_cm.x(),

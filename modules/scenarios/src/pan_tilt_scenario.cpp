@@ -1,6 +1,7 @@
 #include "viewline/scenarios/pan_tilt_scenario.h"
 
 #include <algorithm>
+#include <optional>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -187,6 +188,12 @@ PanTiltScenarioConfig loadPanTiltScenarioConfig(const io::ConfigNode& root) {
     c.control.filter.jump_window = f.getOr<double>("jump_window", c.control.filter.jump_window);
     c.control.filter.jump_threshold = f.getOr<double>("jump_threshold", c.control.filter.jump_threshold);
     c.control.filter.jump_min_samples = f.getOr<int>("jump_min_samples", c.control.filter.jump_min_samples);
+    c.control.filter.constant_speed_sigma =
+        f.getOr<double>("constant_speed_sigma", c.control.filter.constant_speed_sigma);
+    c.control.filter.constant_speed = f.getOr<bool>("constant_speed", c.control.filter.constant_speed);
+    c.control.filter.jump_corner_sigma = f.getOr<double>("jump_corner_sigma", c.control.filter.jump_corner_sigma);
+    c.control.filter.jump_rate = f.getOr<double>("jump_rate", c.control.filter.jump_rate);
+    c.control.filter.jump_prior_sigma = f.getOr<double>("jump_prior_sigma", c.control.filter.jump_prior_sigma);
     c.control.filter.imm_sojourn = f.getOr<Eigen::Vector3d>("imm_sojourn", c.control.filter.imm_sojourn);
   }
   {
@@ -427,7 +434,8 @@ PanTiltRunMetrics runPanTilt(const PanTiltScenarioConfig& cfg, std::uint64_t see
     csv = &log->stream(prefix + "_frames",
                        {"t", "truth_x", "truth_y", "detected", "meas_x", "meas_y", "filt_x", "filt_y", "truth_u",
                         "truth_v", "meas_u", "meas_v", "pred_u", "pred_v", "error_px", "pan", "tilt", "pan_rate",
-                        "tilt_rate", "cmd_pan", "cmd_tilt", "mode"});
+                        "tilt_rate", "cmd_pan", "cmd_tilt", "mode"},
+                       17);  // exact doubles: replayPanTiltFilter re-runs the filter on these measurements
   }
 
   const auto n_frames = static_cast<std::size_t>(std::floor(cfg.duration * cfg.fps));
@@ -585,7 +593,7 @@ nlohmann::json PanTiltReplayMetrics::toJson() const {
 }
 
 PanTiltReplayMetrics replayPanTiltFilter(const PanTiltScenarioConfig& cfg, std::uint64_t seed,
-                                         const std::string& frames_csv) {
+                                         const std::string& frames_csv, bool oracle_corners) {
   cfg.validate();
   core::Rng path_rng = core::makeRng(core::deriveSeed(seed, 1));  // the run's path stream
   sim::ScreenPathParams pp = cfg.path;
@@ -616,6 +624,29 @@ PanTiltReplayMetrics replayPanTiltFilter(const PanTiltScenarioConfig& cfg, std::
   const std::size_t ct = col("t"), cd = col("detected"), cx = col("meas_x"), cy = col("meas_y");
 
   control::PredictivePanTiltController ctrl(cfg.control, cfg.unit.limits, cfg.unit.latency, screenPose(cfg));
+  // Oracle (a bound, not a controller): constant-speed legs started at the path's true corner times with
+  // the true speed; jump detection off. Only the leg directions, the corners' positions and the speed's
+  // leg-to-leg variation (none) remain to be estimated from the measurements.
+  std::optional<control::PlanarTargetFilter> oracle;
+  std::vector<double> corners;
+  std::size_t next_corner = 0;
+  if (oracle_corners) {
+    if (pp.shape == sim::PathShape::Circle) throw core::InvalidInput("--oracle-corners: the circle has no corners");
+    control::TargetFilterConfig fc;
+    fc.model = control::TargetModel::ConstantVelocity;
+    fc.q = 1e-5;  // the first leg (before the first corner), a plain CV filter
+    fc.init_velocity_sigma = cfg.control.filter.init_velocity_sigma;
+    fc.gate_probability = cfg.control.filter.gate_probability;
+    fc.reinit_after = cfg.control.filter.reinit_after;
+    fc.jump_window = 1.0;
+    fc.jump_threshold = 1e300;  // never fires
+    fc.constant_speed = true;
+    fc.constant_speed_sigma = 0.0;
+    oracle.emplace(fc);
+    corners = path.cornerTimes(cfg.duration);
+  }
+  const auto filterReady = [&]() { return oracle ? oracle->initialized() : ctrl.filter().initialized(); };
+  const auto filterAt = [&](double t) { return oracle ? oracle->at(t) : ctrl.filter().at(t); };
   const double occ0 = cfg.occlusion_start >= 0.0 ? cfg.occlusion_start : 1e300;
   const double occ1 = cfg.occlusion_start >= 0.0 ? cfg.occlusion_start + cfg.occlusion_duration : 1e300;
   PanTiltReplayMetrics out;
@@ -640,24 +671,42 @@ PanTiltReplayMetrics replayPanTiltFilter(const PanTiltScenarioConfig& cfg, std::
       obs.plane_cov = R;
       ++out.measurements;
     }
-    ctrl.observe(obs);
+    bool accepted = false;
+    Vector2d filtered = Vector2d::Zero();
+    if (oracle) {
+      while (next_corner < corners.size() && corners[next_corner] <= t) {
+        if (oracle->initialized() && corners[next_corner] >= oracle->state().t()) {
+          oracle->setSpeed(pp.speed, 1e-12);
+          oracle->startLeg(corners[next_corner]);
+        }
+        ++next_corner;
+      }
+      if (obs.detected) {
+        accepted = oracle->update(t, obs.plane, R).accepted;
+        filtered = oracle->estimate().x().head<2>();
+      }
+    } else {
+      ctrl.observe(obs);
+      accepted = ctrl.lastUpdate().accepted;
+      filtered = ctrl.filteredPlane();
+    }
     if (!(t >= cfg.metrics_start && !(t >= occ0 && t < occ1 + 2.0))) continue;
     const Vector2d truth = path.position(t);
     if (obs.detected) {
       mx.add(std::pow(obs.plane.x() - truth.x(), 2));
       my.add(std::pow(obs.plane.y() - truth.y(), 2));
-      if (ctrl.lastUpdate().accepted) {
-        fx_.add(std::pow(ctrl.filteredPlane().x() - truth.x(), 2));
-        fy_.add(std::pow(ctrl.filteredPlane().y() - truth.y(), 2));
+      if (accepted) {
+        fx_.add(std::pow(filtered.x() - truth.x(), 2));
+        fy_.add(std::pow(filtered.y() - truth.y(), 2));
       }
     }
-    if (ctrl.filter().initialized()) {
-      const Vector2d e = ctrl.filter().at(t + out.horizon_s).p - path.position(t + out.horizon_s);
+    if (filterReady()) {
+      const Vector2d e = filterAt(t + out.horizon_s).p - path.position(t + out.horizon_s);
       px_.add(e.x() * e.x());
       py_.add(e.y() * e.y());
     }
   }
-  out.jumps = ctrl.filter().jumps();
+  out.jumps = oracle ? corners.size() : ctrl.filter().jumps();
   out.rmse_measured_cm = 100.0 * Vector2d(mx.rms(), my.rms());
   out.rmse_filtered_cm = 100.0 * Vector2d(fx_.rms(), fy_.rms());
   out.rmse_predicted_cm = 100.0 * Vector2d(px_.rms(), py_.rms());

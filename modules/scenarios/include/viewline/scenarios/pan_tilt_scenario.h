@@ -190,8 +190,11 @@ struct PanTiltReplayMetrics {
   double predicted_error_px = 0.0;  ///< its RMS norm × fx / screen distance (px near the image centre)
   nlohmann::json toJson() const;
 };
+/// oracle_corners (rectangle and random paths): instead of the config's filter, a bound: a constant-speed
+/// leg filter told the path's true corner times and speed (control::PlanarTargetFilter::startLeg); `jumps`
+/// is then the number of corners. No causal filter that must detect the corners can expect to beat it.
 PanTiltReplayMetrics replayPanTiltFilter(const PanTiltScenarioConfig& config, std::uint64_t seed,
-                                         const std::string& frames_csv);
+                                         const std::string& frames_csv, bool oracle_corners = false);
 
 /// [T] Table 1 (RMSE in cm, (x, y)): noisy measurement and Kalman filter; nothing for the random path.
 struct TTable1Row {
