@@ -163,6 +163,34 @@ struct PlanarTargetFilter::Leg {
     zz += z.dot(Ri * z);
   }
 
+  /// log p(measurements | leg) up to the terms every candidate corner time shares (Σ log det 2πR_i, and
+  /// −½ log det P₀ when P₀ is the same): log of the mean over θ of p(z | θ), on a 360-point grid.
+  double logEvidence() const {
+    const Eigen::Vector3d P0_b0 = P0_inv * beta0;
+    const double b0_term = beta0.dot(P0_b0);
+    std::vector<double> ll(360);
+    for (int k = 0; k < 360; ++k) {
+      const double th = -core::kPi + 2.0 * core::kPi * k / 360.0;
+      const Eigen::Vector2d u(std::cos(th), std::sin(th));
+      Eigen::Matrix3d L = P0_inv;
+      L.topLeftCorner<2, 2>() += A;
+      const Eigen::Vector2d Btu = Bt * u;
+      L.block<2, 1>(0, 2) += Btu;
+      L.block<1, 2>(2, 0) += Btu.transpose();
+      L(2, 2) += u.dot(Ctt * u);
+      Eigen::Vector3d eta = P0_b0;
+      eta.head<2>() += Bz;
+      eta(2) += u.dot(Ctz);
+      const Eigen::LLT<Eigen::Matrix3d> llt(L);
+      const double logdet = 2.0 * Eigen::Matrix3d(llt.matrixL()).diagonal().array().log().sum();
+      ll[static_cast<std::size_t>(k)] = -0.5 * (zz + b0_term - eta.dot(llt.solve(eta))) - 0.5 * logdet;
+    }
+    const double top = *std::max_element(ll.begin(), ll.end());
+    double sum = 0.0;
+    for (double v : ll) sum += std::exp(v - top);
+    return top + std::log(sum / 360.0);
+  }
+
   /// The posterior moments of (p, v) at time t (p = c + s (t − t_c) u, v = s u).
   estimation::StateEstimate moments(double t) const {
     const Eigen::Vector3d P0_b0 = P0_inv * beta0;
@@ -437,6 +465,7 @@ bool PlanarTargetFilter::detectJump() {
     return false;
   }
   if (config_.constant_speed) learnSpeed(static_cast<std::size_t>(best_j));
+  if (config_.constant_speed && speed_info_ > 0.0) best_j = refineCornerTime(best_j);
   applyJump(best_j);
   ++jumps_;
   return true;
@@ -518,6 +547,39 @@ estimation::StateEstimate PlanarTargetFilter::alternative(int j) const {
     estimation::update(s, m);
   }
   return s;
+}
+
+int PlanarTargetFilter::refineCornerTime(int j) const {
+  // The test's t_j is only the best kink of a free velocity step; a leg that starts a few samples
+  // early or late bends towards the old direction. Among the candidates t_j' within ±6 measurements,
+  // take the one of highest evidence for "straight on from x(i0|i0) until t_j', then a constant-speed
+  // leg from there": the same measurements i0+1 .. n−1 are explained by both parts for every j'.
+  const int n = static_cast<int>(history_.size());
+  const int i0 = std::max(0, j - 6);
+  const Snapshot& s0 = history_[static_cast<std::size_t>(i0)];
+  const Eigen::Matrix2d P_pos = s0.state.P().block(0, 0, 2, 2);
+  int best = j;
+  double best_e = -1e300;
+  for (int jj = std::max(i0 + 1, j - 6); jj <= std::min(n - 3, j + 6); ++jj) {
+    double e = 0.0;
+    for (int i = i0 + 1; i <= jj; ++i) {
+      const Snapshot& si = history_[static_cast<std::size_t>(i)];
+      const Eigen::Vector2d r = si.z - extrapolatePosition(s0.state.x(), si.t - s0.t);
+      e -= 0.5 * r.dot(si.R.ldlt().solve(r));
+    }
+    const Snapshot& sj = history_[static_cast<std::size_t>(jj)];
+    Leg leg = makeLeg(sj.t, extrapolatePosition(s0.state.x(), sj.t - s0.t), P_pos);
+    for (int i = jj + 1; i < n; ++i) {
+      const Snapshot& si = history_[static_cast<std::size_t>(i)];
+      leg.add(si.t, si.z, si.R);
+    }
+    e += leg.logEvidence();
+    if (e > best_e) {
+      best_e = e;
+      best = jj;
+    }
+  }
+  return best;
 }
 
 void PlanarTargetFilter::applyJump(int best_j) {

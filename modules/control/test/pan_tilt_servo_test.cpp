@@ -243,10 +243,10 @@ TEST(PlanarTargetFilter, SoftJumpsAndConstantSpeedLegsOnASquare) {
   }
   std::cout << "square, RMS (mm): hard " << 1e3 * r_hard << ", soft " << 1e3 * r_soft << ", legs + soft "
             << 1e3 * r_legs << ", oracle corners " << 1e3 * r_oracle << "\n";
-  // measured (mm): hard 20.34, soft 18.79, legs + soft 17.36, oracle 12.47
+  // measured (mm): hard 20.34, soft 18.79, legs + soft 16.45, oracle 12.47
   EXPECT_LT(r_soft, r_hard);
   EXPECT_LT(r_legs, r_soft);
-  EXPECT_LT(r_legs, 0.9 * r_hard);
+  EXPECT_LT(r_legs, 0.85 * r_hard);
   EXPECT_LT(r_oracle, r_legs);  // knowing the corners is a bound
 
   control::TargetFilterConfig bad = legs;

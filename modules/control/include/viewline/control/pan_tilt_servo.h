@@ -151,6 +151,8 @@ struct TargetFilterConfig {
 /// uniform: (c, s) is marginalised in closed form, the posterior of θ is evaluated on a grid (refined
 /// around the mode as it narrows), and the filter's state is the posterior's moments of (p, v). After a
 /// corner only the direction is learnt (one unknown instead of a 2-D velocity), without linearising.
+/// The leg's start is re-chosen within ±6 measurements of the test's t_j by evidence (straight on
+/// until t_j', then the leg): a leg started a few samples off bends towards the old direction.
 /// Soft jump mixture (jump_rate > 0; cv, ca, singer): between detected jumps the output is not the
 /// filter's x(k|k) alone but the posterior mixture of "no jump in the window" and "a jump at t_j"
 /// for the window's measurement times, with prior probability jump_rate × (t_j − t_{j−1}) and Bayes
@@ -215,6 +217,7 @@ private:
   Leg makeLeg(core::Timestamp t_c, const Eigen::Vector2d& c, const Eigen::Matrix2d& P_c) const;
   estimation::StateEstimate reopened(const Snapshot& sj) const;  ///< x(j|j) with the motion prior re-opened
   estimation::StateEstimate alternative(int j) const;            ///< the state now after a jump at history_[j]
+  int refineCornerTime(int j) const;  ///< the constant-speed leg's most likely start near history_[j]
   std::shared_ptr<const Leg> leg_;  ///< the current constant-speed leg (immutable: copies share it until it changes)
   std::optional<estimation::StateEstimate> output_;  ///< the soft mixture, when it differs from state_
   void learnSpeed(std::size_t end);  ///< s_k of the segment history_[0..end]
