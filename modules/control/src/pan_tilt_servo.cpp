@@ -163,28 +163,32 @@ struct PlanarTargetFilter::Leg {
     zz += z.dot(Ri * z);
   }
 
+  /// log p(z | θ) (up to a constant), and the posterior mean and covariance of β = (c, s) given θ.
+  double logLikelihood(double th, Eigen::Vector3d* m = nullptr, Eigen::Matrix3d* cov = nullptr) const {
+    const Eigen::Vector2d u(std::cos(th), std::sin(th));
+    Eigen::Matrix3d L = P0_inv;
+    L.topLeftCorner<2, 2>() += A;
+    const Eigen::Vector2d Btu = Bt * u;
+    L.block<2, 1>(0, 2) += Btu;
+    L.block<1, 2>(2, 0) += Btu.transpose();
+    L(2, 2) += u.dot(Ctt * u);
+    const Eigen::Vector3d P0_b0 = P0_inv * beta0;
+    Eigen::Vector3d eta = P0_b0;
+    eta.head<2>() += Bz;
+    eta(2) += u.dot(Ctz);
+    const Eigen::LLT<Eigen::Matrix3d> llt(L);
+    const Eigen::Vector3d mean = llt.solve(eta);
+    if (m != nullptr) *m = mean;
+    if (cov != nullptr) *cov = llt.solve(Eigen::Matrix3d::Identity());
+    const double logdet = 2.0 * Eigen::Matrix3d(llt.matrixL()).diagonal().array().log().sum();
+    return -0.5 * (zz + beta0.dot(P0_b0) - eta.dot(mean)) - 0.5 * logdet;
+  }
+
   /// log p(measurements | leg) up to the terms every candidate corner time shares (Σ log det 2πR_i, and
   /// −½ log det P₀ when P₀ is the same): log of the mean over θ of p(z | θ), on a 360-point grid.
   double logEvidence() const {
-    const Eigen::Vector3d P0_b0 = P0_inv * beta0;
-    const double b0_term = beta0.dot(P0_b0);
     std::vector<double> ll(360);
-    for (int k = 0; k < 360; ++k) {
-      const double th = -core::kPi + 2.0 * core::kPi * k / 360.0;
-      const Eigen::Vector2d u(std::cos(th), std::sin(th));
-      Eigen::Matrix3d L = P0_inv;
-      L.topLeftCorner<2, 2>() += A;
-      const Eigen::Vector2d Btu = Bt * u;
-      L.block<2, 1>(0, 2) += Btu;
-      L.block<1, 2>(2, 0) += Btu.transpose();
-      L(2, 2) += u.dot(Ctt * u);
-      Eigen::Vector3d eta = P0_b0;
-      eta.head<2>() += Bz;
-      eta(2) += u.dot(Ctz);
-      const Eigen::LLT<Eigen::Matrix3d> llt(L);
-      const double logdet = 2.0 * Eigen::Matrix3d(llt.matrixL()).diagonal().array().log().sum();
-      ll[static_cast<std::size_t>(k)] = -0.5 * (zz + b0_term - eta.dot(llt.solve(eta))) - 0.5 * logdet;
-    }
+    for (int k = 0; k < 360; ++k) ll[static_cast<std::size_t>(k)] = logLikelihood(-core::kPi + 2.0 * core::kPi * k / 360.0);
     const double top = *std::max_element(ll.begin(), ll.end());
     double sum = 0.0;
     for (double v : ll) sum += std::exp(v - top);
@@ -193,8 +197,6 @@ struct PlanarTargetFilter::Leg {
 
   /// The posterior moments of (p, v) at time t (p = c + s (t − t_c) u, v = s u).
   estimation::StateEstimate moments(double t) const {
-    const Eigen::Vector3d P0_b0 = P0_inv * beta0;
-    const double b0_term = beta0.dot(P0_b0);
     struct Point {
       double th = 0.0, ll = 0.0;
       Eigen::Vector3d m = Eigen::Vector3d::Zero();
@@ -203,21 +205,7 @@ struct PlanarTargetFilter::Leg {
     const auto evaluate = [&](double th) {
       Point pt;
       pt.th = th;
-      const Eigen::Vector2d u(std::cos(th), std::sin(th));
-      Eigen::Matrix3d L = P0_inv;
-      L.topLeftCorner<2, 2>() += A;
-      const Eigen::Vector2d Btu = Bt * u;
-      L.block<2, 1>(0, 2) += Btu;
-      L.block<1, 2>(2, 0) += Btu.transpose();
-      L(2, 2) += u.dot(Ctt * u);
-      Eigen::Vector3d eta = P0_b0;
-      eta.head<2>() += Bz;
-      eta(2) += u.dot(Ctz);
-      const Eigen::LLT<Eigen::Matrix3d> llt(L);
-      pt.m = llt.solve(eta);
-      pt.cov = llt.solve(Eigen::Matrix3d::Identity());
-      const double logdet = 2.0 * Eigen::Matrix3d(llt.matrixL()).diagonal().array().log().sum();
-      pt.ll = -0.5 * (zz + b0_term - eta.dot(pt.m)) - 0.5 * logdet;
+      pt.ll = logLikelihood(th, &pt.m, &pt.cov);
       return pt;
     };
     // Grid over θ: 180 points on the circle, then refined (±2 steps of the previous grid, 81 points)
