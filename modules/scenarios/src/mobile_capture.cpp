@@ -398,8 +398,13 @@ public:
     estimation::ekfPredict(est_, model_.transition(t - est_.t()));
   }
 
+  /// NIS of the last measurement against the predicted track (2 dof), fused or gated out; NaN when the
+  /// last update had no track to test it against (start or restart).
+  double lastNis() const { return last_nis_; }
+
   /// Measurement (x, y) with covariance R at time t. Returns true when it was fused.
   bool update(double t, const Vector2d& y, const Eigen::Matrix2d& R) {
+    last_nis_ = std::numeric_limits<double>::quiet_NaN();
     if (!valid_) {
       if (first_ && t - first_t_ <= 0.5 && t > first_t_) {
         const Vector2d d = y - *first_;
@@ -434,6 +439,7 @@ public:
     const Eigen::Matrix2d S = R + est_.P().topLeftCorner<2, 2>();
     const Vector2d d = y - est_.x().head<2>();
     const double nis = d.dot(S.ldlt().solve(d));
+    last_nis_ = nis;
     if (nis > gate_) {
       if (++rejected_ >= 5) {  // the track is wrong, not the measurements: start again
         valid_ = false;
@@ -476,6 +482,7 @@ public:
 private:
   estimation::UnicycleModel model_;
   double init_speed_sigma_, init_turn_sigma_, gate_;
+  double last_nis_ = std::numeric_limits<double>::quiet_NaN();
   estimation::UnicycleTrajectoryPredictor predictor_;
   estimation::StateEstimate est_;
   bool valid_ = false;
@@ -649,6 +656,7 @@ MobileCaptureRun runMobileCapture(const MobileCaptureConfig& cfg, std::uint64_t 
       if (blackout) image.setTo(cv::Scalar(0, 0, 0));
       const auto det = detector.detect(image, t, predicted_px);
       bool detected = false, fused = false;
+      double nis = std::numeric_limits<double>::quiet_NaN();
       Vector2d pixel = Vector2d::Zero();
       if (det.ok()) {
         pixel = det.value().blob_center;
@@ -671,6 +679,7 @@ MobileCaptureRun runMobileCapture(const MobileCaptureConfig& cfg, std::uint64_t 
           }
           const Eigen::Matrix2d R = *cov + cfg.floor_sigma * cfg.floor_sigma * Eigen::Matrix2d::Identity();
           fused = filter.update(t, *exact, R);
+          nis = filter.lastNis();
           if (log_meas) {
             const double nan = std::numeric_limits<double>::quiet_NaN();
             log_meas->row({t, pixel.x(), pixel.y(), exact->x(), exact->y(), a ? a->x() : nan, a ? a->y() : nan,
@@ -706,6 +715,8 @@ MobileCaptureRun runMobileCapture(const MobileCaptureConfig& cfg, std::uint64_t 
         f.robot = pose;
         f.joints = robot.q;
         f.object_true = obj;
+        f.fused = fused;
+        f.nis = nis;
         f.estimate_valid = filter.valid();
         if (filter.valid()) f.estimate = filter.state().x();
         f.prediction = prediction;

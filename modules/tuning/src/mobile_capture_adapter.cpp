@@ -10,14 +10,14 @@
 // folder. NEES: the full covariance is not exposed, but each marginal is exact — for a consistent
 // filter e_i² / P_ii ~ χ²(1) — so every `nees_spacing_s` seconds (nearly independent samples) the
 // adapter takes one 1-dof sample, cycling through the components x, y, θ (wrapped), v, ω, once the
-// track has been valid for `settle_s`. NIS: not available — neither the innovations nor the
-// prior covariance leave the scenario (needed hook, for the scenario's owner: the gate's NIS and
-// fused flag in MobileCaptureFrame or a "nis" column in the measurements log).
+// track has been valid for `settle_s`. NIS: the gate's d' S⁻¹ d of every measurement tested
+// against the track (MobileCaptureFrame::nis, 2 dof, fused or gated out), once the track has been
+// valid for `settle_s`.
 //
-// Noise auto-tuning is not offered: the innovations are not exposed (above), and the head points
-// the camera at the filter's own prediction, so which frames see the object depends on the filter
-// being tuned (the measurements cannot be replayed honestly). Sweeps of filter.q_v, filter.q_w,
-// filter.gate_probability, the planner and control keys work.
+// Noise auto-tuning is not offered: the head points the camera at the filter's own prediction, so
+// which frames see the object depends on the filter being tuned (the measurements cannot be
+// replayed honestly). Sweeps of filter.q_v, filter.q_w, filter.gate_probability, the planner and
+// control keys work, with NEES and NIS beside the metrics.
 
 #include <cmath>
 #include <map>
@@ -48,9 +48,9 @@ public:
   }
 
   std::string autotuneUnsupported() const override {
-    return "the mobile-capture EKF does not expose its innovations or prior covariance, and the head aims the "
-           "camera at the filter's own prediction, so the measurements depend on the filter being tuned and cannot "
-           "be replayed honestly; sweep filter.q_v / filter.q_w instead";
+    return "the head aims the camera at the mobile-capture EKF's own prediction, so the measurements depend on the "
+           "filter being tuned and cannot be replayed honestly; sweep filter.q_v / filter.q_w instead (NEES and NIS "
+           "are reported per setting)";
   }
 
   RunResult run(std::uint64_t seed, const RunOptions& ro) const override {
@@ -68,7 +68,8 @@ public:
     Curve err{"position error", {}, {}}, obj{"object", {}, {}}, robot{"robot", {}, {}}, est{"estimate", {}, {}};
     double sq = 0.0;
     std::size_t n = 0;
-    double next_prediction = 5.0;
+    double next_prediction = 5.0, valid_since = -1.0;
+    Consistency nis;
     scenarios::MobileCaptureRun res;
     {
       io::LogDirectory log(tmp.dir());
@@ -76,6 +77,15 @@ public:
       hooks.log = &log;
       hooks.on_frame = [&](const scenarios::MobileCaptureFrame& f) {
         if (view) view->show(f);
+        if (!f.estimate_valid) valid_since = -1.0;
+        else if (valid_since < 0.0) valid_since = f.t;
+        if (std::isfinite(f.nis) && valid_since >= 0.0 && f.t - valid_since >= opt_.settle) {
+          nis.add(f.nis, 2.0);
+          if (series) {
+            series->nis_t.push_back(f.t);
+            series->nis.push_back(f.nis);
+          }
+        }
         double e = std::nan("");
         if (f.estimate_valid && f.estimate.size() >= 2) {
           e = (f.estimate.head<2>() - f.object_true).norm();
@@ -110,6 +120,7 @@ public:
     RunResult r;
     r.seed = seed;
     neesFromLog(tmp, r.nees);
+    r.nis = nis;
     auto& m = r.metrics;
     m["captured"] = res.captured ? 1.0 : 0.0;
     m["capture_time_s"] = res.capture_time;
@@ -123,6 +134,7 @@ public:
         res.localization.count > 0 ? 1e3 * std::sqrt(res.localization.sse_exact / res.localization.count) : std::nan("");
     m["estimate_rmse_mm"] = n > 0 ? 1e3 * std::sqrt(sq / static_cast<double>(n)) : std::nan("");
     m["nees_mean"] = r.nees.mean();
+    m["nis_mean"] = r.nis.mean();
     r.verdict = combinedVerdict(r.nees, r.nis, confidence());
     if (series) {
       series->error.push_back(err);
@@ -138,6 +150,7 @@ private:
   std::shared_ptr<RunSeries> makeSeries() const {
     auto s = std::make_shared<RunSeries>();
     s->error_label = "object position error |p_hat - p| [m]";
+    s->nis_dof = 2.0;
     s->traj_x_label = "floor x [m]";
     s->traj_y_label = "floor y [m] (black: object and robot paths)";
     return s;

@@ -110,8 +110,9 @@ TEST(ScenarioAdapters, MobileCaptureTinySweep) {
                                    "scenario: mobile_capture\nconfig: " + configPath("mobile_capture.yaml") +
                                        "\nseeds: 1\nmetric: estimate_rmse_mm\nparameters:\n"
                                        "  - key: filter.q_v\n    values: [0.003, 0.03]\nadapter: {max_time: 8, settle_s: 1}\n",
-                                   {"estimate_rmse_mm", "detection_rate", "capture_time_s", "nees_mean"});
-  for (const auto& s : j.at("all_settings")) EXPECT_EQ(s.at("nis").at("samples").get<double>(), 0.0) << "NIS is n/a";
+                                   {"estimate_rmse_mm", "detection_rate", "capture_time_s", "nees_mean", "nis_mean"});
+  // The gate's NIS of every tested measurement after the settle time (8 s at the vision rate).
+  for (const auto& s : j.at("all_settings")) EXPECT_GT(s.at("nis").at("samples").get<double>(), 20.0) << s.dump();
 }
 
 TEST(ScenarioAdapters, AutotuneSaysWhenAnAdapterDoesNotSupportIt) {

@@ -51,6 +51,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <optional>
 #include <opencv2/core.hpp>
 #include <string>
@@ -189,6 +190,10 @@ struct MobileCaptureFrame {
   robots::BasePose robot;
   robots::PanTiltJoints joints;
   Eigen::Vector2d object_true = Eigen::Vector2d::Zero();
+  bool fused = false;  ///< this frame's measurement passed the gate and was fused
+  /// NIS d' S⁻¹ d of this frame's measurement against the predicted track (2 dof, S = R + P_pos),
+  /// fused or gated out; NaN without a measurement or without a track to test it against.
+  double nis = std::numeric_limits<double>::quiet_NaN();
   bool estimate_valid = false;
   Eigen::VectorXd estimate;                 ///< (x, y, θ, v, ω)
   std::vector<Eigen::Vector2d> prediction;  ///< p(k+1..k+M)
