@@ -145,7 +145,8 @@ struct TargetFilterConfig {
 /// Constant-speed legs (constant_speed, cv, with jump detection): the target moves along straight legs
 /// at one unknown speed s (a polyline at constant speed). At each detected jump the leg that ended gives
 /// a speed measurement s_k = |b|, b the slope of a weighted least-squares line through its measurements
-/// (var s_k = b̂ᵀ cov(b) b̂), and ŝ is their inverse-variance mean. Once ŝ is known, each jump starts a
+/// (var s_k = b̂ᵀ cov(b) b̂), and ŝ is their inverse-variance mean (kept across re-initialisations:
+/// the target's speed does not change when it is lost). Once ŝ is known, each jump starts a
 /// leg p(t) = c + s (t − t_c) u(θ) from the corner c ~ N(x(j|j) position, its covariance + σ_c² I,
 /// σ_c = jump_corner_sigma) at the jump time t_c, with s ~ N(ŝ, var ŝ + constant_speed_sigma²) and θ
 /// uniform: (c, s) is marginalised in closed form, the posterior of θ is evaluated on a grid (refined
