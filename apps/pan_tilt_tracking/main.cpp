@@ -34,7 +34,7 @@ int main(int argc, char** argv) {
   app.add_option("--duration", duration, "simulated seconds (overrides run.duration)");
   app.add_flag("--headless", headless, "no window (default)");
   app.add_flag("--display", display, "show the image, target, prediction and error live (vpDisplayX)");
-  app.add_option("--log", log_dir, "directory for CSV logs (truth, measurements, estimates, commands)");
+  app.add_option("--log", log_dir, "directory for CSV logs (truth, measurements, estimates, commands; with --replay: replay_frames.csv)");
   app.add_option("--summary", summary_path, "metrics JSON file");
   app.add_flag("--no-baseline", no_baseline, "skip the ViSP baseline run");
   app.add_option("--replay", replay_path,
@@ -61,7 +61,10 @@ int main(int argc, char** argv) {
     if (no_baseline) cfg.run_baseline = false;
     cfg.validate();
     if (!replay_path.empty()) {
-      const scenarios::PanTiltReplayMetrics r = scenarios::replayPanTiltFilter(cfg, seed, replay_path, oracle_corners);
+      io::LogDirectory replay_log(log_dir);
+      const scenarios::PanTiltReplayMetrics r =
+          scenarios::replayPanTiltFilter(cfg, seed, replay_path, oracle_corners, replay_log.enabled() ? &replay_log : nullptr);
+      replay_log.flush();
       if (!summary_path.empty()) io::writeJsonFile(summary_path, r.toJson());
       if (oracle_corners)
         std::printf("replay of %s (seed %llu, oracle: constant-speed legs at the %zu true corners): %zu measurements\n",

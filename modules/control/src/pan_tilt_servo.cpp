@@ -110,6 +110,16 @@ void TargetFilterConfig::validate() const {
   core::requirePositive(jump_prior_sigma, "filter.jump_prior_sigma");
   if (!(jump_corner_sigma >= 0.0) || !std::isfinite(jump_corner_sigma))
     throw core::InvalidInput("filter.jump_corner_sigma must be >= 0");
+  if (!(turn_prior_weight >= 0.0 && turn_prior_weight < 1.0))
+    throw core::InvalidInput("filter.turn_prior_weight must be in [0, 1) (1 would forbid any new turn angle)");
+  if (!(turn_prior_sigma_deg > 0.0 && turn_prior_sigma_deg <= 45.0))
+    throw core::InvalidInput("filter.turn_prior_sigma_deg must be in (0, 45]");
+  if (jump_evidence != "kink" && jump_evidence != "legs")
+    throw core::InvalidInput("filter.jump_evidence must be kink or legs, not '" + jump_evidence + "'");
+  if (jump_evidence == "legs" && !constant_speed)
+    throw core::InvalidInput("filter.jump_evidence: legs needs filter.constant_speed");
+  if (turn_prior_weight > 0.0 && !constant_speed)
+    throw core::InvalidInput("filter.turn_prior_weight needs filter.constant_speed (the prior is on a leg's direction)");
   if (jump_rate > 0.0 && !(jump_window > 0.0))
     throw core::InvalidInput("filter.jump_rate needs jump detection (filter.jump_window > 0)");
   if (jump_rate > 0.0 && (model == TargetModel::CoordinatedTurn || model == TargetModel::Imm))
@@ -143,11 +153,14 @@ estimation::NonlinearTransition cvWithOmega(double q, double q_omega, double dt)
 //   Λ(θ) = P₀⁻¹ + [[A, B_τ u], [uᵀ B_τ, uᵀ C_ττ u]],  η(θ) = P₀⁻¹ β₀ + (B_z, uᵀ C_τz),
 //   β | θ ~ N(Λ⁻¹ η, Λ⁻¹),  log p(z | θ) = −½ (zz + β₀ᵀ P₀⁻¹ β₀ − ηᵀ Λ⁻¹ η) − ½ log det Λ  (+ const).
 // The speed is thus re-estimated on every leg around the learnt ŝ (it absorbs a scale error of the
-// measurements), and only θ needs a grid.
+// measurements), and only θ needs a grid. θ's prior is uniform, or the learnt-turn mixture
+// p(θ) = (1 − w) / 2π + w / K Σ_k N_wrapped(θ; μ_k, σ²): logPrior() is log(2π p(θ)), 0 when uniform.
 struct PlanarTargetFilter::Leg {
   double t_c = 0.0;
   Eigen::Vector3d beta0 = Eigen::Vector3d::Zero();
   Eigen::Matrix3d P0_inv = Eigen::Matrix3d::Identity();
+  std::vector<double> prior_mu;  ///< μ_k (rad); empty: θ uniform
+  double prior_sigma = 0.1, prior_weight = 0.0;
   Eigen::Matrix2d A = Eigen::Matrix2d::Zero(), Bt = Eigen::Matrix2d::Zero(), Ctt = Eigen::Matrix2d::Zero();
   Eigen::Vector2d Bz = Eigen::Vector2d::Zero(), Ctz = Eigen::Vector2d::Zero();
   double zz = 0.0;
@@ -161,6 +174,17 @@ struct PlanarTargetFilter::Leg {
     Ctz += tau * (Ri * z);
     Ctt += tau * tau * Ri;
     zz += z.dot(Ri * z);
+  }
+
+  double logPrior(double th) const {
+    if (prior_mu.empty() || prior_weight <= 0.0) return 0.0;
+    double g = 0.0;
+    for (double mu : prior_mu) {
+      const double d = std::remainder(th - mu, 2.0 * core::kPi);  // wrapped to [−π, π]; σ ≪ π, one wrap suffices
+      g += std::exp(-0.5 * d * d / (prior_sigma * prior_sigma));
+    }
+    g *= std::sqrt(2.0 * core::kPi) / prior_sigma / static_cast<double>(prior_mu.size());
+    return std::log((1.0 - prior_weight) + prior_weight * g);
   }
 
   /// log p(z | θ) (up to a constant), and the posterior mean and covariance of β = (c, s) given θ.
@@ -185,14 +209,18 @@ struct PlanarTargetFilter::Leg {
   }
 
   /// log p(measurements | leg) up to the terms every candidate corner time shares (Σ log det 2πR_i, and
-  /// −½ log det P₀ when P₀ is the same): log of the mean over θ of p(z | θ), on a 360-point grid.
-  double logEvidence() const {
-    std::vector<double> ll(360);
-    for (int k = 0; k < 360; ++k) ll[static_cast<std::size_t>(k)] = logLikelihood(-core::kPi + 2.0 * core::kPi * k / 360.0);
+  /// −½ log det P₀ when P₀ is the same): log of the mean over θ of p(z | θ) p(θ) 2π, on a grid of
+  /// `points` (the rectangle rule, exact to e^(−2π² σ²/h²) for a periodic integrand of width σ, step h).
+  double logEvidence(int points = 360) const {
+    std::vector<double> ll(static_cast<std::size_t>(points));
+    for (int k = 0; k < points; ++k) {
+      const double th = -core::kPi + 2.0 * core::kPi * k / points;
+      ll[static_cast<std::size_t>(k)] = logLikelihood(th) + logPrior(th);
+    }
     const double top = *std::max_element(ll.begin(), ll.end());
     double sum = 0.0;
     for (double v : ll) sum += std::exp(v - top);
-    return top + std::log(sum / 360.0);
+    return top + std::log(sum / points);
   }
 
   /// The posterior moments of (p, v) at time t (p = c + s (t − t_c) u, v = s u).
@@ -205,7 +233,7 @@ struct PlanarTargetFilter::Leg {
     const auto evaluate = [&](double th) {
       Point pt;
       pt.th = th;
-      pt.ll = logLikelihood(th, &pt.m, &pt.cov);
+      pt.ll = logLikelihood(th, &pt.m, &pt.cov) + logPrior(th);
       return pt;
     };
     // Grid over θ: 180 points on the circle, then refined (±2 steps of the previous grid, 81 points)
@@ -323,6 +351,7 @@ void PlanarTargetFilter::reset(core::Timestamp t, const Eigen::Vector2d& z, cons
   rejected_in_a_row_ = 0;
   output_.reset();
   leg_.reset();
+  last_direction_ = std::numeric_limits<double>::quiet_NaN();  // (the learnt turns are kept)
   history_.clear();
   if (config_.jump_window > 0.0) history_.push_back(snapshot(t, z, R));
 }
@@ -443,6 +472,7 @@ bool PlanarTargetFilter::detectJump() {
       best_j = j;
     }
     if (soft) {
+      if (legEvidenceMixture()) log_bf = legBayesFactor(j);
       // Prior probability of a jump at t_j (and nowhere else in the window): rate × the interval it stands for.
       const double dt_j = sj.t - history_[static_cast<std::size_t>(j - 1)].t;
       log_odds.emplace_back(std::log(std::max(config_.jump_rate * dt_j, 1e-300)) + log_bf, j);
@@ -454,6 +484,7 @@ bool PlanarTargetFilter::detectJump() {
   }
   if (config_.constant_speed) learnSpeed(static_cast<std::size_t>(best_j));
   if (config_.constant_speed && speed_info_ > 0.0) best_j = refineCornerTime(best_j);
+  if (config_.constant_speed) learnTurn(direction(history_[static_cast<std::size_t>(best_j)].state));
   applyJump(best_j);
   ++jumps_;
   return true;
@@ -519,7 +550,7 @@ estimation::StateEstimate PlanarTargetFilter::alternative(int j) const {
   const Snapshot& sj = history_[static_cast<std::size_t>(j)];
   const std::size_t n = history_.size();
   if (config_.constant_speed && speed_info_ > 0.0) {
-    Leg leg = makeLeg(sj.t, sj.state.x().head<2>(), sj.state.P().block(0, 0, 2, 2));
+    Leg leg = makeLeg(sj.t, sj.state.x().head<2>(), sj.state.P().block(0, 0, 2, 2), direction(sj.state));
     for (std::size_t i = static_cast<std::size_t>(j) + 1; i < n; ++i) leg.add(history_[i].t, history_[i].z, history_[i].R);
     return leg.moments(history_.back().t);
   }
@@ -535,6 +566,48 @@ estimation::StateEstimate PlanarTargetFilter::alternative(int j) const {
     estimation::update(s, m);
   }
   return s;
+}
+
+bool PlanarTargetFilter::legEvidenceMixture() const {
+  return config_.jump_evidence == "legs" && speed_info_ > 0.0;
+}
+
+double PlanarTargetFilter::legBayesFactor(int j) const {
+  // log p(z_{j+1..n} | a constant-speed leg from x(j|j) at t_j) − log p(z_{j+1..n} | straight on from x(j|j)).
+  // Both are linear-Gaussian evidences; the Σ log det 2πR_i they share cancel.
+  //   leg:  logEvidence() − ½ log det P₀ (see Leg);
+  //   straight on: z_i = H_i x + e_i, H_i = [I  τ_i I], x ~ N(x̂_j, P_j): with Λ = P_j⁻¹ + Σ H_iᵀR_i⁻¹H_i,
+  //         η = P_j⁻¹ x̂_j + Σ H_iᵀR_i⁻¹z_i: −½ (Σ z_iᵀR_i⁻¹z_i + x̂ᵀP_j⁻¹x̂ − ηᵀΛ⁻¹η) − ½ log det Λ − ½ log det P_j.
+  const std::size_t n = history_.size();
+  const Snapshot& sj = history_[static_cast<std::size_t>(j)];
+  const Eigen::Vector4d x = sj.state.x().head<4>();
+  Eigen::Matrix4d P = sj.state.P().topLeftCorner<4, 4>();
+  P.diagonal().array() += 1e-10;
+  const auto llt_P = P.llt();
+  const Eigen::Matrix4d P_inv = llt_P.solve(Eigen::Matrix4d::Identity());
+  Eigen::Matrix4d L = P_inv;
+  Eigen::Vector4d eta = P_inv * x;
+  double zz = 0.0;
+  Leg leg = makeLeg(sj.t, x.head<2>(), P.topLeftCorner<2, 2>(), direction(sj.state));
+  for (std::size_t i = static_cast<std::size_t>(j) + 1; i < n; ++i) {
+    const Snapshot& si = history_[i];
+    const Eigen::Matrix2d Ri = si.R.inverse();
+    Eigen::Matrix<double, 2, 4> H;
+    H << Eigen::Matrix2d::Identity(), (si.t - sj.t) * Eigen::Matrix2d::Identity();
+    L += H.transpose() * Ri * H;
+    eta += H.transpose() * (Ri * si.z);
+    zz += si.z.dot(Ri * si.z);
+    leg.add(si.t, si.z, si.R);
+  }
+  const auto llt_L = L.llt();
+  const double logdet_L = 2.0 * Eigen::Matrix4d(llt_L.matrixL()).diagonal().array().log().sum();
+  const double logdet_P = 2.0 * Eigen::Matrix4d(llt_P.matrixL()).diagonal().array().log().sum();
+  const double straight = -0.5 * (zz + x.dot(P_inv * x) - eta.dot(llt_L.solve(eta))) - 0.5 * logdet_L - 0.5 * logdet_P;
+  const double logdet_P0 = -std::log(leg.P0_inv.determinant());
+  // Steps of 3° or the turn prior's σ if smaller: θ's likelihood is wider than ~2° over a few seconds of
+  // leg, so the rectangle rule's relative error stays below ~1e-4 (see logEvidence).
+  const int points = std::max(120, static_cast<int>(std::ceil(360.0 / config_.turn_prior_sigma_deg)));
+  return leg.logEvidence(points) - 0.5 * logdet_P0 - straight;
 }
 
 int PlanarTargetFilter::refineCornerTime(int j) const {
@@ -556,7 +629,7 @@ int PlanarTargetFilter::refineCornerTime(int j) const {
       e -= 0.5 * r.dot(si.R.ldlt().solve(r));
     }
     const Snapshot& sj = history_[static_cast<std::size_t>(jj)];
-    Leg leg = makeLeg(sj.t, extrapolatePosition(s0.state.x(), sj.t - s0.t), P_pos);
+    Leg leg = makeLeg(sj.t, extrapolatePosition(s0.state.x(), sj.t - s0.t), P_pos, direction(s0.state));
     for (int i = jj + 1; i < n; ++i) {
       const Snapshot& si = history_[static_cast<std::size_t>(i)];
       leg.add(si.t, si.z, si.R);
@@ -579,7 +652,7 @@ void PlanarTargetFilter::applyJump(int best_j) {
   state_ = reopened(sj);
   leg_.reset();
   if (config_.constant_speed && speed_info_ > 0.0)
-    leg_ = std::make_shared<const Leg>(makeLeg(sj.t, state_.x().head<2>(), state_.P().block(0, 0, 2, 2)));
+    leg_ = std::make_shared<const Leg>(makeLeg(sj.t, state_.x().head<2>(), state_.P().block(0, 0, 2, 2), direction(state_)));
   if (imm_) {
     imm_ = *sj.imm;
     imm_->reset(state_.x(), state_.P(), sj.t, sj.imm->probabilities());
@@ -593,10 +666,30 @@ void PlanarTargetFilter::applyJump(int best_j) {
   }
 }
 
+double PlanarTargetFilter::direction(const estimation::StateEstimate& s) {
+  const Eigen::Vector2d v = s.x().segment<2>(2);
+  return v.norm() > 1e-9 ? std::atan2(v.y(), v.x()) : std::numeric_limits<double>::quiet_NaN();
+}
+
+void PlanarTargetFilter::learnTurn(double dir) {
+  // The leg that just ended had direction dir; the one before it last_direction_: that corner's turn.
+  if (config_.turn_prior_weight <= 0.0) return;
+  if (std::isfinite(dir) && std::isfinite(last_direction_)) {
+    turns_.push_back(std::remainder(dir - last_direction_, 2.0 * core::kPi));
+    if (turns_.size() > 8) turns_.erase(turns_.begin());
+  }
+  last_direction_ = dir;
+}
+
 PlanarTargetFilter::Leg PlanarTargetFilter::makeLeg(core::Timestamp t_c, const Eigen::Vector2d& c,
-                                                    const Eigen::Matrix2d& P_c) const {
+                                                    const Eigen::Matrix2d& P_c, double from_direction) const {
   Leg leg;
   leg.t_c = t_c;
+  if (config_.turn_prior_weight > 0.0 && std::isfinite(from_direction) && !turns_.empty()) {
+    for (double turn : turns_) leg.prior_mu.push_back(from_direction + turn);
+    leg.prior_weight = config_.turn_prior_weight;
+    leg.prior_sigma = config_.turn_prior_sigma_deg * core::kPi / 180.0;
+  }
   leg.beta0 << c, speedEstimate();
   Eigen::Matrix3d P0 = Eigen::Matrix3d::Zero();
   P0.topLeftCorner<2, 2>() = P_c + std::pow(config_.jump_corner_sigma, 2) * Eigen::Matrix2d::Identity();
@@ -611,7 +704,9 @@ void PlanarTargetFilter::startLeg(core::Timestamp t_c) {
     throw core::Error("PlanarTargetFilter::startLeg: needs constant_speed and a known speed (setSpeed or a finished leg)");
   if (t_c < state_.t()) throw core::InvalidInput("PlanarTargetFilter::startLeg: t_c is before the last measurement");
   const Kinematics k = at(t_c);
-  leg_ = std::make_shared<const Leg>(makeLeg(t_c, k.p, k.P_pos));
+  const double from = direction(state_);
+  learnTurn(from);
+  leg_ = std::make_shared<const Leg>(makeLeg(t_c, k.p, k.P_pos, from));
   Eigen::VectorXd x = Eigen::VectorXd::Zero(4);
   x.head<2>() = k.p;
   Eigen::MatrixXd P = Eigen::MatrixXd::Zero(4, 4);

@@ -185,8 +185,10 @@ struct LongScore {
 };
 // RMS error of the filter's output estimate after the first 7 s (two legs: the speed is known by then),
 // σ = 4 cm. With `oracle`, legs are started at the true corner times with the true speed instead.
-LongScore scoreSquare(const control::TargetFilterConfig& cfg, std::uint64_t seed, bool oracle = false) {
-  control::PlanarTargetFilter f(cfg);
+LongScore scoreSquare(const control::TargetFilterConfig& cfg, std::uint64_t seed, bool oracle = false,
+                      control::PlanarTargetFilter* filter = nullptr) {
+  control::PlanarTargetFilter own(cfg);
+  control::PlanarTargetFilter& f = filter != nullptr ? *filter : own;
   core::Rng rng = core::makeRng(seed);
   const double sigma = 0.04;
   const Eigen::Matrix2d R = sigma * sigma * Eigen::Matrix2d::Identity();
@@ -221,16 +223,23 @@ TEST(PlanarTargetFilter, SoftJumpsAndConstantSpeedLegsOnASquare) {
   control::TargetFilterConfig soft = hard;
   soft.jump_rate = 1.0;
   soft.jump_prior_sigma = 0.1;
-  control::TargetFilterConfig legs = soft;  // the shipped rectangle filter
+  control::TargetFilterConfig legs = soft;  // round 4's rectangle filter
   legs.jump_threshold = 20.0;
   legs.constant_speed = true;
   legs.constant_speed_sigma = 0.002;
   legs.jump_corner_sigma = 0.005;
+  control::TargetFilterConfig turns = legs;  // the shipped rectangle filter: learnt turns, leg evidence
+  turns.jump_threshold = 30.0;
+  turns.jump_rate = 0.3;
+  turns.jump_evidence = "legs";
+  turns.jump_corner_sigma = 0.01;
+  turns.turn_prior_weight = 0.9;
+  turns.turn_prior_sigma_deg = 4.0;
   control::TargetFilterConfig oracle = hard;
   oracle.jump_threshold = 1e300;
   oracle.constant_speed = true;
   oracle.constant_speed_sigma = 0.0;
-  double r_hard = 0.0, r_soft = 0.0, r_legs = 0.0, r_oracle = 0.0;
+  double r_hard = 0.0, r_soft = 0.0, r_legs = 0.0, r_turns = 0.0, r_oracle = 0.0;
   for (std::uint64_t seed = 1; seed <= 4; ++seed) {
     r_hard += scoreSquare(hard, seed).rms / 4.0;
     r_soft += scoreSquare(soft, seed).rms / 4.0;
@@ -240,13 +249,24 @@ TEST(PlanarTargetFilter, SoftJumpsAndConstantSpeedLegsOnASquare) {
     EXPECT_GE(l.jumps, 8u) << seed;              // 9 corners in 30 s
     EXPECT_LE(l.jumps, 11u) << seed;
     r_oracle += scoreSquare(oracle, seed, true).rms / 4.0;
+    control::PlanarTargetFilter learnt(turns);
+    const LongScore t = scoreSquare(turns, seed, false, &learnt);
+    r_turns += t.rms / 4.0;
+    EXPECT_GE(t.jumps, 8u) << seed;
+    EXPECT_LE(t.jumps, 11u) << seed;
+    ASSERT_GE(learnt.learntTurns().size(), 5u) << seed;
+    std::size_t left_turns = 0;  // the square turns +90° at every corner
+    for (double turn : learnt.learntTurns()) left_turns += std::abs(turn - core::kPi / 2.0) < 0.15 ? 1 : 0;
+    EXPECT_GE(left_turns + 1, learnt.learntTurns().size()) << seed;
   }
   std::cout << "square, RMS (mm): hard " << 1e3 * r_hard << ", soft " << 1e3 * r_soft << ", legs + soft "
-            << 1e3 * r_legs << ", oracle corners " << 1e3 * r_oracle << "\n";
+            << 1e3 * r_legs << ", learnt turns + leg evidence " << 1e3 * r_turns << ", oracle corners "
+            << 1e3 * r_oracle << "\n";
   // measured (mm): hard 20.34, soft 18.79, legs + soft 16.45, oracle 12.47
   EXPECT_LT(r_soft, r_hard);
   EXPECT_LT(r_legs, r_soft);
   EXPECT_LT(r_legs, 0.85 * r_hard);
+  EXPECT_LT(r_turns, r_legs);
   EXPECT_LT(r_oracle, r_legs);  // knowing the corners is a bound
 
   control::TargetFilterConfig bad = legs;
@@ -258,6 +278,21 @@ TEST(PlanarTargetFilter, SoftJumpsAndConstantSpeedLegsOnASquare) {
   bad = soft;
   bad.model = control::TargetModel::Imm;
   EXPECT_THROW(control::PlanarTargetFilter{bad}, core::InvalidInput);  // the soft mixture is for linear models
+  bad = soft;
+  bad.jump_evidence = "legs";
+  EXPECT_THROW(control::PlanarTargetFilter{bad}, core::InvalidInput);  // leg evidence needs constant-speed legs
+  bad = soft;
+  bad.turn_prior_weight = 0.5;
+  EXPECT_THROW(control::PlanarTargetFilter{bad}, core::InvalidInput);  // so does the turn prior
+  bad = turns;
+  bad.jump_evidence = "kinks";
+  EXPECT_THROW(control::PlanarTargetFilter{bad}, core::InvalidInput);
+  bad = turns;
+  bad.turn_prior_weight = 1.0;
+  EXPECT_THROW(control::PlanarTargetFilter{bad}, core::InvalidInput);  // would forbid any new turn
+  bad = turns;
+  bad.turn_prior_sigma_deg = 0.0;
+  EXPECT_THROW(control::PlanarTargetFilter{bad}, core::InvalidInput);
   control::PlanarTargetFilter f(hard);
   EXPECT_THROW(f.startLeg(0.0), core::Error);  // not initialised
   f.update(0.0, Eigen::Vector2d::Zero(), 1e-4 * Eigen::Matrix2d::Identity());

@@ -194,6 +194,10 @@ PanTiltScenarioConfig loadPanTiltScenarioConfig(const io::ConfigNode& root) {
     c.control.filter.jump_corner_sigma = f.getOr<double>("jump_corner_sigma", c.control.filter.jump_corner_sigma);
     c.control.filter.jump_rate = f.getOr<double>("jump_rate", c.control.filter.jump_rate);
     c.control.filter.jump_prior_sigma = f.getOr<double>("jump_prior_sigma", c.control.filter.jump_prior_sigma);
+    c.control.filter.turn_prior_weight = f.getOr<double>("turn_prior_weight", c.control.filter.turn_prior_weight);
+    c.control.filter.jump_evidence = f.getChoiceOr("jump_evidence", {"kink", "legs"}, c.control.filter.jump_evidence);
+    c.control.filter.turn_prior_sigma_deg =
+        f.getOr<double>("turn_prior_sigma_deg", c.control.filter.turn_prior_sigma_deg);
     c.control.filter.imm_sojourn = f.getOr<Eigen::Vector3d>("imm_sojourn", c.control.filter.imm_sojourn);
   }
   {
@@ -593,7 +597,7 @@ nlohmann::json PanTiltReplayMetrics::toJson() const {
 }
 
 PanTiltReplayMetrics replayPanTiltFilter(const PanTiltScenarioConfig& cfg, std::uint64_t seed,
-                                         const std::string& frames_csv, bool oracle_corners) {
+                                         const std::string& frames_csv, bool oracle_corners, io::LogDirectory* log) {
   cfg.validate();
   core::Rng path_rng = core::makeRng(core::deriveSeed(seed, 1));  // the run's path stream
   sim::ScreenPathParams pp = cfg.path;
@@ -642,6 +646,8 @@ PanTiltReplayMetrics replayPanTiltFilter(const PanTiltScenarioConfig& cfg, std::
     fc.jump_threshold = 1e300;  // never fires
     fc.constant_speed = true;
     fc.constant_speed_sigma = 0.0;
+    fc.turn_prior_weight = cfg.control.filter.turn_prior_weight;  // the config's learnt-turn prior, if any
+    fc.turn_prior_sigma_deg = cfg.control.filter.turn_prior_sigma_deg;
     oracle.emplace(fc);
     corners = path.cornerTimes(cfg.duration);
   }
@@ -652,6 +658,10 @@ PanTiltReplayMetrics replayPanTiltFilter(const PanTiltScenarioConfig& cfg, std::
   PanTiltReplayMetrics out;
   out.horizon_s = cfg.processing_delay + cfg.unit.latency + cfg.control.lead;
   Accumulator mx, my, fx_, fy_, px_, py_;
+  io::CsvWriter* csv = nullptr;
+  if (log != nullptr && log->enabled())
+    csv = &log->stream("replay_frames", {"t", "truth_x", "truth_y", "detected", "meas_x", "meas_y", "filt_x", "filt_y",
+                                         "accepted", "jumps"});
   std::size_t row = 1;
   while (std::getline(in, line)) {
     ++row;
@@ -689,6 +699,13 @@ PanTiltReplayMetrics replayPanTiltFilter(const PanTiltScenarioConfig& cfg, std::
       ctrl.observe(obs);
       accepted = ctrl.lastUpdate().accepted;
       filtered = ctrl.filteredPlane();
+    }
+    if (csv != nullptr) {
+      const Vector2d truth = path.position(t);
+      const double nan = std::nan("");
+      csv->row({t, truth.x(), truth.y(), obs.detected ? 1.0 : 0.0, obs.detected ? obs.plane.x() : nan,
+                obs.detected ? obs.plane.y() : nan, accepted ? filtered.x() : nan, accepted ? filtered.y() : nan,
+                accepted ? 1.0 : 0.0, static_cast<double>(oracle ? next_corner : ctrl.filter().jumps())});
     }
     if (!(t >= cfg.metrics_start && !(t >= occ0 && t < occ1 + 2.0))) continue;
     const Vector2d truth = path.position(t);

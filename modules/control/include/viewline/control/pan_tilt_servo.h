@@ -49,6 +49,7 @@
 // not detected, as the ViSP examples do.
 
 #include <Eigen/Geometry>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -119,8 +120,11 @@ struct TargetFilterConfig {
   bool constant_speed = false;           ///< constant-speed legs after each jump (cv; see PlanarTargetFilter)
   double constant_speed_sigma = 0.002;   ///< m/s, std of a leg's speed about the learnt ŝ (beside var ŝ)
   double jump_corner_sigma = 0.0;        ///< m, added to the corner's position std when a leg starts
+  double turn_prior_weight = 0.0;        ///< constant-speed legs: prior mass on the learnt turn angles (0: θ uniform)
+  double turn_prior_sigma_deg = 10.0;    ///< std (deg) of each learnt turn angle in that prior
   double jump_rate = 0.0;                ///< 1/s, prior rate of jumps; > 0: soft jump mixture (see below)
   double jump_prior_sigma = 0.15;        ///< m/s, prior std of a velocity jump per axis (soft mixture)
+  std::string jump_evidence = "kink";    ///< soft mixture's Bayes factors: "kink" (free Δv) or "legs" (see below)
   double gate_probability = 0.9999;      ///< chi-square (2 dof) gate on the NIS
   int reinit_after = 3;                  ///< consecutive gated-out measurements that re-initialise
   void validate() const;
@@ -154,11 +158,21 @@ struct TargetFilterConfig {
 /// corner only the direction is learnt (one unknown instead of a 2-D velocity), without linearising.
 /// The leg's start is re-chosen within ±6 measurements of the test's t_j by evidence (straight on
 /// until t_j', then the leg): a leg started a few samples off bends towards the old direction.
+/// Learnt turn angles (turn_prior_weight w > 0): at every detected jump the turn of the leg that ended
+/// (its direction, that of x(j|j)'s velocity, minus the previous leg's) is remembered, the last 8 kept;
+/// a new leg's θ then has the prior p(θ) = (1 − w) / 2π + w / K Σ_k N_wrapped(θ; θ_old + Δ_k, σ_Δ²),
+/// θ_old the direction of the leg that ended, Δ_k the remembered turns, σ_Δ = turn_prior_sigma_deg.
+/// A target that repeats its manoeuvres (a rectangle, a patrol route) thus has its new direction
+/// nearly known at the corner; random turns give a diffuse prior, and w < 1 keeps any direction open.
 /// Soft jump mixture (jump_rate > 0; cv, ca, singer): between detected jumps the output is not the
 /// filter's x(k|k) alone but the posterior mixture of "no jump in the window" and "a jump at t_j"
 /// for the window's measurement times, with prior probability jump_rate × (t_j − t_{j−1}) and Bayes
 /// factor from the same fits as the test, the jump having the prior Δv ~ N(0, jump_prior_sigma² I);
 /// so the estimate starts to turn before the test is sure of a corner (estimate(), at()).
+/// With jump_evidence "legs" (constant-speed legs, once ŝ is known) the Bayes factor of "a jump at t_j"
+/// is instead the evidence of the measurements after t_j under a constant-speed leg from x(j|j) (θ with
+/// its learnt-turn prior) over their evidence under "straight on from x(j|j)" (both linear-Gaussian,
+/// closed form): a specific alternative (this speed, these turns), so the mixture turns sooner.
 class PlanarTargetFilter {
 public:
   explicit PlanarTargetFilter(const TargetFilterConfig& config = {});
@@ -199,6 +213,8 @@ public:
   /// The learnt speed ŝ (m/s) and its variance; 0 / infinity before the first segment has ended.
   double speedEstimate() const { return speed_info_ > 0.0 ? speed_sum_ / speed_info_ : 0.0; }
   double speedVariance() const { return speed_info_ > 0.0 ? 1.0 / speed_info_ : 1e300; }
+  /// The turn angles (rad, in [−π, π], oldest first) learnt at the last corners (turn_prior_weight > 0).
+  const std::vector<double>& learntTurns() const { return turns_; }
 
 private:
   struct Snapshot {
@@ -215,10 +231,18 @@ private:
   void applyJump(int j);  ///< restart from history_[j] with the motion prior re-opened, re-process the rest
   void softMixture(std::vector<std::pair<double, int>>& log_odds);
   struct Leg;
-  Leg makeLeg(core::Timestamp t_c, const Eigen::Vector2d& c, const Eigen::Matrix2d& P_c) const;
+  /// The constant-speed leg from the corner (t_c, c ~ N(c, P_c)); from_direction: the direction (rad) of
+  /// the leg that ended there, centre of the learnt turn prior (NaN: θ uniform).
+  Leg makeLeg(core::Timestamp t_c, const Eigen::Vector2d& c, const Eigen::Matrix2d& P_c, double from_direction) const;
+  static double direction(const estimation::StateEstimate& s);  ///< atan2 of the velocity (NaN if ~0)
+  void learnTurn(double direction);  ///< a leg of this direction ended at a detected jump
+  std::vector<double> turns_;        ///< the last learnt turn angles (rad, in (−π, π])
+  double last_direction_ = std::numeric_limits<double>::quiet_NaN();  ///< of the leg before the current one
   estimation::StateEstimate reopened(const Snapshot& sj) const;  ///< x(j|j) with the motion prior re-opened
   estimation::StateEstimate alternative(int j) const;            ///< the state now after a jump at history_[j]
-  int refineCornerTime(int j) const;  ///< the constant-speed leg's most likely start near history_[j]
+  int refineCornerTime(int j) const;
+  bool legEvidenceMixture() const;    ///< the soft mixture's Bayes factors from constant-speed legs
+  double legBayesFactor(int j) const; ///< log BF of a leg from history_[j] against straight on  ///< the constant-speed leg's most likely start near history_[j]
   std::shared_ptr<const Leg> leg_;  ///< the current constant-speed leg (immutable: copies share it until it changes)
   std::optional<estimation::StateEstimate> output_;  ///< the soft mixture, when it differs from state_
   void learnSpeed(std::size_t end);  ///< s_k of the segment history_[0..end]

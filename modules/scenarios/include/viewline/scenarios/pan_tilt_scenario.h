@@ -193,8 +193,11 @@ struct PanTiltReplayMetrics {
 /// oracle_corners (rectangle and random paths): instead of the config's filter, a bound: a constant-speed
 /// leg filter told the path's true corner times and speed (control::PlanarTargetFilter::startLeg); `jumps`
 /// is then the number of corners. No causal filter that must detect the corners can expect to beat it.
+/// With a log, writes the stream replay_frames (t, truth, detected, measurement, the filter's output,
+/// accepted, jumps so far) for per-frame comparisons.
 PanTiltReplayMetrics replayPanTiltFilter(const PanTiltScenarioConfig& config, std::uint64_t seed,
-                                         const std::string& frames_csv, bool oracle_corners = false);
+                                         const std::string& frames_csv, bool oracle_corners = false,
+                                         io::LogDirectory* log = nullptr);
 
 /// [T] Table 1 (RMSE in cm, (x, y)): noisy measurement and Kalman filter; nothing for the random path.
 struct TTable1Row {
