@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <unistd.h>
 
 #include "viewline/core/error.h"
@@ -96,6 +97,20 @@ TEST(PanTiltScenario, ConfigErrorsNameTheKey) {
   std::string bad = base;
   bad.replace(bad.find("constant_velocity"), 17, "zigzag");
   EXPECT_THROW(scenarios::loadPanTiltScenarioConfig(io::ConfigNode::fromString(bad, "t.yaml")), core::InvalidInput);
+  // Rounded corners: for the random path only, radius >= 0.
+  std::string rounded = base;
+  rounded.replace(rounded.find("shape: circle"), 13, "shape: random, corner_radius: 0.1");
+  EXPECT_NO_THROW(scenarios::loadPanTiltScenarioConfig(io::ConfigNode::fromString(rounded, "t.yaml")));
+  rounded.replace(rounded.find("corner_radius: 0.1"), 18, "corner_radius: -0.1");
+  EXPECT_THROW(scenarios::loadPanTiltScenarioConfig(io::ConfigNode::fromString(rounded, "t.yaml")), core::InvalidInput);
+  std::string rounded_circle = base;
+  rounded_circle.replace(rounded_circle.find("shape: circle"), 13, "shape: circle, corner_radius: 0.1");
+  EXPECT_THROW(scenarios::loadPanTiltScenarioConfig(io::ConfigNode::fromString(rounded_circle, "t.yaml")),
+               core::InvalidInput);
+  std::string bad_evidence = base;
+  bad_evidence.replace(bad_evidence.find("{model: constant_velocity}"), 26, "{model: constant_velocity, jump_evidence: kinks}");
+  EXPECT_THROW(scenarios::loadPanTiltScenarioConfig(io::ConfigNode::fromString(bad_evidence, "t.yaml")),
+               core::InvalidInput);
   // Inline camera without a rig: one ideal camera and vpPtu46's nominal mount for everything.
   const auto inline_cfg = scenarios::loadPanTiltScenarioConfig(io::ConfigNode::fromString(base, "t.yaml"));
   EXPECT_TRUE(inline_cfg.rig_folder.empty());
@@ -162,7 +177,18 @@ TEST(PanTiltScenario, ReplayOfALoggedRunReproducesItsFilter) {
     run = scenarios::runPanTilt(cfg, 7, PanTiltControllerKind::Predictive, nullptr, &log);
     log.flush();
   }
-  const auto r = scenarios::replayPanTiltFilter(cfg, 7, (dir / "predictive_frames.csv").string());
+  scenarios::PanTiltReplayMetrics r;
+  std::size_t replay_rows = 0;
+  {
+    const auto replay_dir = dir / "replay";
+    io::LogDirectory replay_log(replay_dir.string());
+    r = scenarios::replayPanTiltFilter(cfg, 7, (dir / "predictive_frames.csv").string(), false, &replay_log);
+    replay_log.flush();
+    std::ifstream frames(replay_dir / "replay_frames.csv");
+    std::string line;
+    while (std::getline(frames, line)) ++replay_rows;
+  }
+  EXPECT_EQ(replay_rows, 1u + static_cast<std::size_t>(cfg.duration * 30.0 + 0.5));  // header + one row per frame
   // The oracle bound (legs started at the true corner times) on the same measurements.
   const auto o = scenarios::replayPanTiltFilter(cfg, 7, (dir / "predictive_frames.csv").string(), true);
   auto circle = shipped("circle");

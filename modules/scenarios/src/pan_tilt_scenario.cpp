@@ -33,6 +33,10 @@ constexpr const char* kRigCamera = "ptu_camera";  ///< the camera's name in a pa
 
 void PanTiltScenarioConfig::validate() const {
   core::requirePositive(path.speed, "path.speed");
+  if (!(path.corner_radius >= 0.0) || !std::isfinite(path.corner_radius))
+    throw core::InvalidInput("path.corner_radius must be >= 0 (m)");
+  if (path.corner_radius > 0.0 && path.shape != sim::PathShape::Random)
+    throw core::InvalidInput("path.corner_radius is for shape: random (the rectangle's corners are [T]'s)");
   core::requirePositive(screen_distance, "screen.distance");
   core::requireFinite(screen_center_height, "screen.center_height");
   core::requirePositive(screen_width, "screen.width");
@@ -75,6 +79,7 @@ PanTiltScenarioConfig loadPanTiltScenarioConfig(const io::ConfigNode& root) {
     c.path.width = p.getOr<double>("width", c.path.width);
     c.path.height = p.getOr<double>("height", c.path.height);
     c.path.radius = p.getOr<double>("radius", c.path.radius);
+    c.path.corner_radius = p.getOr<double>("corner_radius", c.path.corner_radius);
   }
   {
     const auto s = root.child("screen");
@@ -636,6 +641,9 @@ PanTiltReplayMetrics replayPanTiltFilter(const PanTiltScenarioConfig& cfg, std::
   std::size_t next_corner = 0;
   if (oracle_corners) {
     if (pp.shape == sim::PathShape::Circle) throw core::InvalidInput("--oracle-corners: the circle has no corners");
+    if (pp.corner_radius > 0.0)
+      throw core::InvalidInput("--oracle-corners: the path's corners are rounded (path.corner_radius > 0); the oracle's "
+                               "legs are straight");
     control::TargetFilterConfig fc;
     fc.model = control::TargetModel::ConstantVelocity;
     fc.q = 1e-5;  // the first leg (before the first corner), a plain CV filter

@@ -207,6 +207,10 @@ TiltTableState TiltTable::stateAt(double t) const {
 ScreenPath::ScreenPath(const ScreenPathParams& params, core::Rng& rng) : params_(params) {
   core::requirePositive(params.speed, "ScreenPathParams.speed");
   core::requireFinite(params.center, "ScreenPathParams.center");
+  if (!(params.corner_radius >= 0.0) || !std::isfinite(params.corner_radius))
+    throw core::InvalidInput("ScreenPathParams.corner_radius must be >= 0");
+  if (params.corner_radius > 0.0 && params.shape != PathShape::Random)
+    throw core::InvalidInput("ScreenPathParams.corner_radius is for the random path");
   const Eigen::Vector2d c = params.center;
   switch (params.shape) {
     case PathShape::Rectangle: {
@@ -229,13 +233,42 @@ ScreenPath::ScreenPath(const ScreenPathParams& params, core::Rng& rng) : params_
       const double hw = 0.5 * params.width, hh = 0.5 * params.height;
       vertices_.push_back(c);
       double length = 0.0;
-      while (length <= needed) {
+      const double r = params.corner_radius;
+      // Segments of at least 2r when rounded: then any turn up to 90° fits (r tan 45° = r).
+      const double min_segment = std::max(0.1 * std::min(params.width, params.height), 2.0 * r);
+      // A rounded corner at the last vertex v needs its tangent length r tan(φ/2) within half of both
+      // segments at v: waypoints that would need a smaller radius are drawn again (after 1000 misses, the
+      // last waypoint itself is drawn again).
+      const auto fits = [&](const Eigen::Vector2d& next) {
+        if (r <= 0.0 || vertices_.size() < 2) return true;
+        const Eigen::Vector2d a = vertices_[vertices_.size() - 2], v = vertices_.back();
+        const Eigen::Vector2d d_in = (v - a).normalized(), d_out = (next - v).normalized();
+        const double phi = std::atan2(std::abs(d_in.x() * d_out.y() - d_in.y() * d_out.x()), d_in.dot(d_out));
+        const double L = r * std::tan(0.5 * std::min(phi, 3.1));
+        return L <= 0.5 * (v - a).norm() && L <= 0.5 * (next - v).norm();
+      };
+      const auto addWaypoint = [&]() {
         Eigen::Vector2d next;
+        int tries = 0;
         do {  // avoid degenerate (very short) segments
           next = c + Eigen::Vector2d(core::uniform(rng, -hw, hw), core::uniform(rng, -hh, hh));
-        } while ((next - vertices_.back()).norm() < 0.1 * std::min(params.width, params.height));
+          if (r > 0.0 && !fits(next) && ++tries >= 1000 && vertices_.size() > 2) {
+            // No turn from here fits (e.g. heading into a corner of the box): draw the last waypoint again.
+            length -= (vertices_.back() - vertices_[vertices_.size() - 2]).norm();
+            vertices_.pop_back();
+            return;
+          }
+        } while ((next - vertices_.back()).norm() < min_segment || !fits(next));
         length += (next - vertices_.back()).norm();
         vertices_.push_back(next);
+      };
+      while (length <= needed) addWaypoint();
+      if (params.corner_radius > 0.0) {  // the arcs cut the corners: draw on until the rounded path is long enough
+        roundCorners();
+        while (pieces_.back().s0 + pieces_.back().length <= needed) {
+          addWaypoint();
+          roundCorners();
+        }
       }
       break;
     }
@@ -246,7 +279,62 @@ ScreenPath::ScreenPath(const ScreenPathParams& params, core::Rng& rng) : params_
   }
 }
 
+void ScreenPath::roundCorners() {
+  pieces_.clear();
+  {  // Fillets: at vertex V with unit directions d_in, d_out and turn φ, the arc of radius r touches the
+    // segments at V − L d_in and V + L d_out, L = r tan(φ/2) (L at most half of either segment; r reduced to
+    // match), centre T_in + r n, n the normal of d_in towards the turn; it sweeps φ.
+    double s = 0.0;
+    Eigen::Vector2d from = vertices_.front();
+    const auto addLine = [&](const Eigen::Vector2d& to) {
+      Piece p;
+      p.s0 = s;
+      p.length = (to - from).norm();
+      p.p0 = from;
+      p.dir = p.length > 0.0 ? Eigen::Vector2d((to - from) / p.length) : Eigen::Vector2d(1.0, 0.0);
+      pieces_.push_back(p);
+      s += p.length;
+      from = to;
+    };
+    for (std::size_t i = 1; i + 1 < vertices_.size(); ++i) {
+      const Eigen::Vector2d a = vertices_[i - 1], v = vertices_[i], b = vertices_[i + 1];
+      const Eigen::Vector2d d_in = (v - a).normalized(), d_out = (b - v).normalized();
+      const double cross = d_in.x() * d_out.y() - d_in.y() * d_out.x();
+      const double phi = std::atan2(std::abs(cross), d_in.dot(d_out));
+      if (phi < 1e-9) continue;  // straight on: no arc
+      // The first tangent point must not go back past `from` (the previous arc's end).
+      const double room = std::min((v - from).norm(), 0.5 * (b - v).norm());
+      double L = params_.corner_radius * std::tan(0.5 * phi);
+      L = std::min(L, std::min(0.5 * (v - a).norm(), room));
+      const double r = L / std::tan(0.5 * phi);
+      const Eigen::Vector2d t_in = v - L * d_in;
+      addLine(t_in);
+      const double sign = cross >= 0.0 ? 1.0 : -1.0;
+      Piece arc;
+      arc.s0 = s;
+      arc.radius = r;
+      arc.sign = sign;
+      arc.length = r * phi;
+      arc.centre = t_in + r * sign * Eigen::Vector2d(-d_in.y(), d_in.x());
+      arc.a0 = std::atan2(t_in.y() - arc.centre.y(), t_in.x() - arc.centre.x());
+      pieces_.push_back(arc);
+      s += arc.length;
+      from = v + L * d_out;
+    }
+    addLine(vertices_.back());
+  }
+}
+
 Eigen::Vector2d ScreenPath::atArcLength(double s) const {
+  if (!pieces_.empty()) {
+    s = std::clamp(s, 0.0, pieces_.back().s0 + pieces_.back().length);
+    const auto it = std::upper_bound(pieces_.begin(), pieces_.end(), s, [](double v, const Piece& p) { return v < p.s0; });
+    const Piece& p = *(it == pieces_.begin() ? it : it - 1);
+    const double u = s - p.s0;
+    if (p.radius <= 0.0) return p.p0 + u * p.dir;
+    const double a = p.a0 + p.sign * u / p.radius;
+    return p.centre + p.radius * Eigen::Vector2d(std::cos(a), std::sin(a));
+  }
   const double total = cumulative_.back();
   if (params_.shape == PathShape::Rectangle) s = std::fmod(std::fmod(s, total) + total, total);
   s = std::clamp(s, 0.0, total);
@@ -281,6 +369,13 @@ Eigen::Vector2d ScreenPath::velocity(double t) const {
 
 std::vector<double> ScreenPath::cornerTimes(double t_end) const {
   std::vector<double> out;
+  if (!pieces_.empty()) {
+    for (const Piece& p : pieces_) {
+      const double t = (p.s0 + 0.5 * p.length) / params_.speed;
+      if (p.radius > 0.0 && t > 0.0 && t <= t_end) out.push_back(t);
+    }
+    return out;
+  }
   if (params_.shape == PathShape::Circle || cumulative_.size() < 3) return out;
   const double total = cumulative_.back();
   const bool closed = params_.shape == PathShape::Rectangle;

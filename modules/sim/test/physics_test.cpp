@@ -204,6 +204,55 @@ TEST(ScreenPath, AllShapesMoveAtConstantSpeed) {
   EXPECT_THROW(ScreenPath(bad, rng), core::InvalidInput);
 }
 
+TEST(ScreenPath, RoundedRandomPathKeepsItsSpeedAndBoundsItsCurvature) {
+  ScreenPathParams p;
+  p.shape = PathShape::Random;
+  p.speed = 0.15;
+  p.width = 0.8;
+  p.height = 0.43;
+  p.duration = 60.0;
+  p.corner_radius = 0.1;
+  core::Rng rng_a = core::makeRng(3), rng_b = core::makeRng(3);
+  const ScreenPath rounded(p, rng_a);
+  ScreenPathParams sharp_p = p;
+  sharp_p.corner_radius = 0.0;
+  const ScreenPath sharp(sharp_p, rng_b);  // other waypoints (the rounded path redraws turns that do not fit)
+  const double dt = 1e-3;
+  double max_step_turn = 0.0, max_step_turn_sharp = 0.0;
+  int on_full_radius = 0;
+  const auto stepTurn = [dt](const ScreenPath& path, double t) {
+    const Eigen::Vector2d v0 = path.velocity(t), v1 = path.velocity(t + dt);
+    return std::abs(std::atan2(v0.x() * v1.y() - v0.y() * v1.x(), v0.dot(v1)));
+  };
+  for (double t = 0.0; t < 55.0; t += 0.0173) {
+    const Eigen::Vector2d x = rounded.position(t);
+    EXPECT_NEAR((rounded.position(t + dt) - x).norm() / dt, p.speed, 1e-5 * p.speed) << t;  // constant speed
+    EXPECT_LE(std::abs(x.x()), 0.4 + 1e-9);  // inside the box (an arc stays inside its corner's triangle)
+    EXPECT_LE(std::abs(x.y()), 0.215 + 1e-9);
+    const double turn = stepTurn(rounded, t);
+    max_step_turn = std::max(max_step_turn, turn);
+    if (std::abs(turn / dt - p.speed / p.corner_radius) < 1e-3 * p.speed / p.corner_radius) ++on_full_radius;
+  }
+  for (double c : sharp.cornerTimes(55.0)) max_step_turn_sharp = std::max(max_step_turn_sharp, stepTurn(sharp, c - 0.5 * dt));
+  // The heading is continuous: within dt = 1 ms it turns by at most speed dt / r (every arc has radius r),
+  // never by the whole turn as at a sharp vertex.
+  EXPECT_LT(max_step_turn, 1.001 * p.speed * dt / p.corner_radius);
+  EXPECT_GT(max_step_turn_sharp, 0.3);
+  EXPECT_GT(on_full_radius, 20);  // on the arcs: turn rate speed / r
+  const std::vector<double> mid = rounded.cornerTimes(55.0);
+  ASSERT_GE(mid.size(), 5u);
+  for (double t : mid) {  // the middle of each arc: turning there
+    const Eigen::Vector2d v0 = rounded.velocity(t - 0.05), v1 = rounded.velocity(t + 0.05);
+    EXPECT_GT((v1 - v0).norm(), 1e-3) << t;
+  }
+  ScreenPathParams bad = p;
+  bad.corner_radius = -0.1;
+  EXPECT_THROW(ScreenPath(bad, rng_a), core::InvalidInput);
+  bad.corner_radius = 0.1;
+  bad.shape = PathShape::Rectangle;
+  EXPECT_THROW(ScreenPath(bad, rng_a), core::InvalidInput);  // only the random path is rounded
+}
+
 TEST(GroundTarget, FollowsKimProfilesInSiUnits) {
   EXPECT_NEAR(GroundTarget::nominal(GroundProfile::Capture, 0.0).x(), 0.60, 1e-12);
   EXPECT_NEAR(GroundTarget::nominal(GroundProfile::Capture, 0.0).y(), 0.7 * std::sin(M_PI / 1.5), 1e-12);

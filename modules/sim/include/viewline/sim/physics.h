@@ -165,18 +165,24 @@ struct ScreenPathParams {
   double height = 0.8;                                   ///< rectangle height / random box height, m
   double radius = 0.4;                                   ///< circle radius, m
   double duration = 120.0;                               ///< random path: length covered (s of travel)
+  double corner_radius = 0.0;  ///< random path: each vertex rounded by a circular arc of this radius (m; 0: sharp)
 };
 
 /// Position of the target on the screen plane (screen frame x right, y down, metres). The
 /// rectangle starts at its top-left corner and runs clockwise as seen on the screen; the circle
 /// starts at angle 0; the random path is a polyline through uniform random waypoints in the box.
+/// With corner_radius r > 0 (random path) each vertex is replaced by the circular arc of radius r tangent
+/// to both segments (tangent length r tan(φ/2), φ the turn), so the heading is continuous and the
+/// curvature is 1/r on the arcs: waypoints whose turn would not fit within half of both segments are
+/// drawn again (so the turns are gentler than on the polyline), and segments are at least 2r long.
 class ScreenPath {
 public:
   /// rng is used only by the random path (drawn at construction).
   ScreenPath(const ScreenPathParams& params, core::Rng& rng);
   Eigen::Vector2d position(double t) const;
   Eigen::Vector2d velocity(double t) const;
-  /// Times in (0, t_end] at which the target passes a vertex of the polyline (its corners); empty for the circle.
+  /// Times in (0, t_end] at which the target passes a vertex of the polyline (its corners); empty for the
+  /// circle; with rounded corners, the times at the middle of each arc.
   std::vector<double> cornerTimes(double t_end) const;
   const ScreenPathParams& params() const { return params_; }
 
@@ -185,6 +191,14 @@ private:
   ScreenPathParams params_;
   std::vector<Eigen::Vector2d> vertices_;  ///< closed (rectangle) or open (random) polyline
   std::vector<double> cumulative_;         ///< arc length at each vertex
+  struct Piece {                           ///< rounded random path: straight pieces and arcs
+    double s0 = 0.0, length = 0.0;         ///< arc length at the start, length
+    Eigen::Vector2d p0 = Eigen::Vector2d::Zero(), dir = Eigen::Vector2d::Zero();  ///< straight piece
+    Eigen::Vector2d centre = Eigen::Vector2d::Zero();                             ///< arc
+    double radius = 0.0, a0 = 0.0, sign = 0.0;  ///< arc: angle at the start about the centre, +1 left / −1 right
+  };
+  std::vector<Piece> pieces_;              ///< empty: the polyline vertices_ is the path
+  void roundCorners();                     ///< pieces_ from vertices_ and corner_radius
 };
 
 // ----------------------------------------------------------------------------------------------
