@@ -442,6 +442,7 @@ bool PlanarTargetFilter::detectJump() {
   std::vector<Eigen::Vector2d> r(static_cast<std::size_t>(n));
   std::vector<std::pair<double, int>> log_odds;  // soft: log(π_j BF_j), j
   const double prior_precision = soft ? 1.0 / (config_.jump_prior_sigma * config_.jump_prior_sigma) : 0.0;
+  const bool leg_bf = soft && legEvidenceMixture();  // the soft mixture's Bayes factors from legs, not kinks
   for (int j = m; j + (soft ? 2 : m) < n; ++j) {
     const Snapshot& sj = history_[static_cast<std::size_t>(j)];
     for (int i = 0; i < n; ++i) {
@@ -474,7 +475,7 @@ bool PlanarTargetFilter::detectJump() {
       const double fit0 = g0.dot(ldlt0.solve(g0));
       const double fit1 = g.dot(M.ldlt().solve(g));
       l += fit1 - fit0;
-      if (soft) {
+      if (soft && !leg_bf) {
         // Bayes factor with Δv_a ~ N(0, jump_prior_sigma²) (α, β flat under both hypotheses):
         // log BF_a = ½ (fit1' − fit0) − ½ log(det M1' / det M0) − ½ log σ_Δ², M1' = M1 + diag(0, 0, 0, 1/σ_Δ²).
         Eigen::Matrix4d M1 = M;
@@ -490,7 +491,7 @@ bool PlanarTargetFilter::detectJump() {
       best_j = j;
     }
     if (soft) {
-      if (legEvidenceMixture()) log_bf = legBayesFactor(j);
+      if (leg_bf) log_bf = legBayesFactor(j);
       // Prior probability of a jump at t_j (and nowhere else in the window): rate × the interval it stands for.
       const double dt_j = sj.t - history_[static_cast<std::size_t>(j - 1)].t;
       log_odds.emplace_back(std::log(std::max(config_.jump_rate * dt_j, 1e-300)) + log_bf, j);
