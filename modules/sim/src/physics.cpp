@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <utility>
 
 #include "viewline/core/checks.h"
 #include "viewline/core/frames.h"
@@ -204,6 +205,15 @@ TiltTableState TiltTable::stateAt(double t) const {
 
 // ----------------------------------------------------------------------------------------------
 
+namespace {
+// The turn at v of the polyline a → v → b: φ in [0, π] and the sign of the cross product (+1 left).
+std::pair<double, double> turnAt(const Eigen::Vector2d& a, const Eigen::Vector2d& v, const Eigen::Vector2d& b) {
+  const Eigen::Vector2d d_in = (v - a).normalized(), d_out = (b - v).normalized();
+  const double cross = d_in.x() * d_out.y() - d_in.y() * d_out.x();
+  return {std::atan2(std::abs(cross), d_in.dot(d_out)), cross >= 0.0 ? 1.0 : -1.0};
+}
+}  // namespace
+
 ScreenPath::ScreenPath(const ScreenPathParams& params, core::Rng& rng) : params_(params) {
   core::requirePositive(params.speed, "ScreenPathParams.speed");
   core::requireFinite(params.center, "ScreenPathParams.center");
@@ -242,8 +252,7 @@ ScreenPath::ScreenPath(const ScreenPathParams& params, core::Rng& rng) : params_
       const auto fits = [&](const Eigen::Vector2d& next) {
         if (r <= 0.0 || vertices_.size() < 2) return true;
         const Eigen::Vector2d a = vertices_[vertices_.size() - 2], v = vertices_.back();
-        const Eigen::Vector2d d_in = (v - a).normalized(), d_out = (next - v).normalized();
-        const double phi = std::atan2(std::abs(d_in.x() * d_out.y() - d_in.y() * d_out.x()), d_in.dot(d_out));
+        const double phi = turnAt(a, v, next).first;
         const double L = r * std::tan(0.5 * std::min(phi, 3.1));
         return L <= 0.5 * (v - a).norm() && L <= 0.5 * (next - v).norm();
       };
@@ -299,8 +308,7 @@ void ScreenPath::roundCorners() {
     for (std::size_t i = 1; i + 1 < vertices_.size(); ++i) {
       const Eigen::Vector2d a = vertices_[i - 1], v = vertices_[i], b = vertices_[i + 1];
       const Eigen::Vector2d d_in = (v - a).normalized(), d_out = (b - v).normalized();
-      const double cross = d_in.x() * d_out.y() - d_in.y() * d_out.x();
-      const double phi = std::atan2(std::abs(cross), d_in.dot(d_out));
+      const auto [phi, sign] = turnAt(a, v, b);
       if (phi < 1e-9) continue;  // straight on: no arc
       // The first tangent point must not go back past `from` (the previous arc's end).
       const double room = std::min((v - from).norm(), 0.5 * (b - v).norm());
@@ -309,7 +317,6 @@ void ScreenPath::roundCorners() {
       const double r = L / std::tan(0.5 * phi);
       const Eigen::Vector2d t_in = v - L * d_in;
       addLine(t_in);
-      const double sign = cross >= 0.0 ? 1.0 : -1.0;
       Piece arc;
       arc.s0 = s;
       arc.radius = r;
