@@ -5,6 +5,9 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
 #include <unistd.h>
 
 #include "viewline/core/error.h"
@@ -189,6 +192,45 @@ TEST(PanTiltScenario, ReplayOfALoggedRunReproducesItsFilter) {
     while (std::getline(frames, line)) ++replay_rows;
   }
   EXPECT_EQ(replay_rows, 1u + static_cast<std::size_t>(cfg.duration * 30.0 + 0.5));  // header + one row per frame
+  // A measurement the gate rejects still counts in the filtered RMSE, with the filter's prediction:
+  // move the one at frame 120 (t = 4 s) by 1 m and replay.
+  {
+    std::ifstream in(dir / "predictive_frames.csv");
+    std::ofstream out(dir / "outlier.csv");
+    std::string line;
+    for (int row = 0; std::getline(in, line); ++row) {
+      if (row == 121) {  // header + frames 0..120; columns t,truth_x,truth_y,detected,meas_x,...
+        std::vector<std::string> f;
+        std::stringstream ss(line);
+        for (std::string c; std::getline(ss, c, ',');) f.push_back(c);
+        ASSERT_EQ(f[3], "1");
+        f[4] = std::to_string(std::stod(f[4]) + 1.0);
+        line = f[0];
+        for (std::size_t i = 1; i < f.size(); ++i) line += "," + f[i];
+      }
+      out << line << "\n";
+    }
+  }
+  const auto outlier_dir = dir / "outlier";
+  scenarios::PanTiltReplayMetrics ro;
+  std::vector<std::string> outlier_row;
+  {
+    io::LogDirectory outlier_log(outlier_dir.string());
+    ro = scenarios::replayPanTiltFilter(cfg, 7, (dir / "outlier.csv").string(), false, &outlier_log);
+    outlier_log.flush();
+    std::ifstream frames(outlier_dir / "replay_frames.csv");
+    std::string line;
+    for (int row = 0; std::getline(frames, line); ++row)
+      if (row == 121) {  // t,truth_x,truth_y,detected,meas_x,meas_y,filt_x,filt_y,accepted,jumps
+        std::stringstream ss(line);
+        for (std::string c; std::getline(ss, c, ',');) outlier_row.push_back(c);
+      }
+  }
+  ASSERT_EQ(outlier_row.size(), 10u);
+  EXPECT_EQ(outlier_row[8], "0");                                         // gated out
+  EXPECT_LT(std::abs(std::stod(outlier_row[6]) - std::stod(outlier_row[1])), 0.05);  // the prediction, not nan
+  EXPECT_GT(ro.rmse_filtered_cm.x(), 0.0);
+  EXPECT_LT(ro.rmse_filtered_cm.x(), 2.0 * r.rmse_filtered_cm.x());  // the outlier did not pull the estimate
   // The oracle bound (legs started at the true corner times) on the same measurements.
   const auto o = scenarios::replayPanTiltFilter(cfg, 7, (dir / "predictive_frames.csv").string(), true);
   auto circle = shipped("circle");

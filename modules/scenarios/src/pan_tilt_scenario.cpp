@@ -503,8 +503,11 @@ PanTiltRunMetrics runPanTilt(const PanTiltScenarioConfig& cfg, std::uint64_t see
       m.reacquired = true;
       m.reacquisition_delay_s = tc - occ1;
     }
+    // The filtered estimate scored on every detected frame: a measurement the gate rejected still
+    // counts, with the filter's own estimate at that time (its prediction).
     Vector2d filt = Vector2d::Constant(std::nan(""));
-    if (ours != nullptr && ours->lastUpdate().accepted) filt = ours->filteredPlane();
+    if (ours != nullptr && obs.detected && ours->filter().initialized())
+      filt = ours->lastUpdate().accepted ? ours->filteredPlane() : Vector2d(ours->filter().at(obs.stamp).p);
     if (in_metrics) {
       ++m.metric_frames;
       img.add(err_px * err_px);
@@ -690,7 +693,7 @@ PanTiltReplayMetrics replayPanTiltFilter(const PanTiltScenarioConfig& cfg, std::
       ++out.measurements;
     }
     bool accepted = false;
-    Vector2d filtered = Vector2d::Zero();
+    Vector2d filtered = Vector2d::Constant(std::nan(""));  // scored on every detected frame, as in the closed loop
     if (oracle) {
       while (next_corner < corners.size() && corners[next_corner] <= t) {
         if (oracle->initialized() && corners[next_corner] >= oracle->state().t()) {
@@ -701,18 +704,19 @@ PanTiltReplayMetrics replayPanTiltFilter(const PanTiltScenarioConfig& cfg, std::
       }
       if (obs.detected) {
         accepted = oracle->update(t, obs.plane, R).accepted;
-        filtered = oracle->estimate().x().head<2>();
+        filtered = accepted ? Vector2d(oracle->estimate().x().head<2>()) : Vector2d(oracle->at(t).p);
       }
     } else {
       ctrl.observe(obs);
       accepted = ctrl.lastUpdate().accepted;
-      filtered = ctrl.filteredPlane();
+      if (obs.detected && ctrl.filter().initialized())
+        filtered = accepted ? ctrl.filteredPlane() : Vector2d(ctrl.filter().at(t).p);
     }
     if (csv != nullptr) {
       const Vector2d truth = path.position(t);
       const double nan = std::nan("");
       csv->row({t, truth.x(), truth.y(), obs.detected ? 1.0 : 0.0, obs.detected ? obs.plane.x() : nan,
-                obs.detected ? obs.plane.y() : nan, accepted ? filtered.x() : nan, accepted ? filtered.y() : nan,
+                obs.detected ? obs.plane.y() : nan, filtered.x(), filtered.y(),
                 accepted ? 1.0 : 0.0, static_cast<double>(oracle ? next_corner : ctrl.filter().jumps())});
     }
     if (!(t >= cfg.metrics_start && !(t >= occ0 && t < occ1 + 2.0))) continue;
@@ -720,7 +724,7 @@ PanTiltReplayMetrics replayPanTiltFilter(const PanTiltScenarioConfig& cfg, std::
     if (obs.detected) {
       mx.add(std::pow(obs.plane.x() - truth.x(), 2));
       my.add(std::pow(obs.plane.y() - truth.y(), 2));
-      if (accepted) {
+      if (std::isfinite(filtered.x())) {
         fx_.add(std::pow(filtered.x() - truth.x(), 2));
         fy_.add(std::pow(filtered.y() - truth.y(), 2));
       }

@@ -27,7 +27,8 @@
 //
 // Metrics (after `metrics_start`, and outside [occlusion start, end + 2 s]):
 //   rmse_measured_cm    RMS of m̃_k − truth per axis (frames with a detection)
-//   rmse_filtered_cm    RMS of the filter's x(k|k) − truth per axis (same frames; ours only)
+//   rmse_filtered_cm    RMS of the filter's x(k|k) − truth per axis (same frames, including those whose
+//                       measurement the gate rejected: then x(k|k−1); ours only)
 //   image_error_rms_px  RMS distance of the *true* target projection from the
 //                       principal point, all frames (target off-image included)
 // Occlusion: the disc is not rendered during [occlusion_start, + duration);
