@@ -240,9 +240,9 @@ private:
   double last_direction_ = std::numeric_limits<double>::quiet_NaN();  ///< of the leg before the current one
   estimation::StateEstimate reopened(const Snapshot& sj) const;  ///< x(j|j) with the motion prior re-opened
   estimation::StateEstimate alternative(int j) const;            ///< the state now after a jump at history_[j]
-  int refineCornerTime(int j) const;
+  int refineCornerTime(int j) const;  ///< the constant-speed leg's most likely start near history_[j]
   bool legEvidenceMixture() const;    ///< the soft mixture's Bayes factors from constant-speed legs
-  double legBayesFactor(int j) const; ///< log BF of a leg from history_[j] against straight on  ///< the constant-speed leg's most likely start near history_[j]
+  double legBayesFactor(int j) const; ///< log BF of a leg from history_[j] against straight on
   std::shared_ptr<const Leg> leg_;  ///< the current constant-speed leg (immutable: copies share it until it changes)
   std::optional<estimation::StateEstimate> output_;  ///< the soft mixture, when it differs from state_
   void learnSpeed(std::size_t end);  ///< s_k of the segment history_[0..end]
