@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <opencv2/aruco/charuco.hpp>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -29,13 +30,47 @@ const std::vector<std::pair<std::string, BoardType>>& typeNames() {
       {"circles_grid", BoardType::CirclesGrid},
       {"asymmetric_circles_grid", BoardType::AsymmetricCirclesGrid},
       {"apriltag_grid", BoardType::AprilTagGrid},
-      {"apriltag", BoardType::AprilTag}};
+      {"apriltag", BoardType::AprilTag},
+      {"charuco", BoardType::ChArUco}};
   return names;
+}
+
+const std::vector<std::pair<std::string, cv::aruco::PREDEFINED_DICTIONARY_NAME>>& dictionaryNames() {
+  using namespace cv::aruco;
+  static const std::vector<std::pair<std::string, PREDEFINED_DICTIONARY_NAME>> names = {
+      {"DICT_4X4_50", DICT_4X4_50},     {"DICT_4X4_100", DICT_4X4_100},     {"DICT_4X4_250", DICT_4X4_250},
+      {"DICT_4X4_1000", DICT_4X4_1000}, {"DICT_5X5_50", DICT_5X5_50},       {"DICT_5X5_100", DICT_5X5_100},
+      {"DICT_5X5_250", DICT_5X5_250},   {"DICT_5X5_1000", DICT_5X5_1000},   {"DICT_6X6_50", DICT_6X6_50},
+      {"DICT_6X6_100", DICT_6X6_100},   {"DICT_6X6_250", DICT_6X6_250},     {"DICT_6X6_1000", DICT_6X6_1000},
+      {"DICT_7X7_50", DICT_7X7_50},     {"DICT_7X7_100", DICT_7X7_100},     {"DICT_7X7_250", DICT_7X7_250},
+      {"DICT_7X7_1000", DICT_7X7_1000}, {"DICT_ARUCO_ORIGINAL", DICT_ARUCO_ORIGINAL}};
+  return names;
+}
+
+std::vector<std::string> dictionaryChoices() {
+  std::vector<std::string> out;
+  for (const auto& d : dictionaryNames()) out.push_back(d.first);
+  return out;
 }
 
 bool isTagBoard(BoardType t) { return t == BoardType::AprilTagGrid || t == BoardType::AprilTag; }
 
 }  // namespace
+
+cv::Ptr<cv::aruco::Dictionary> arucoDictionary(const std::string& name) {
+  for (const auto& d : dictionaryNames())
+    if (d.first == name) return cv::aruco::getPredefinedDictionary(d.second);
+  std::string list;
+  for (const auto& c : dictionaryChoices()) list += (list.empty() ? "" : ", ") + c;
+  throw core::InvalidInput("dictionary '" + name + "': expected one of " + list);
+}
+
+cv::Ptr<cv::aruco::CharucoBoard> charucoBoard(const BoardSpec& board) {
+  if (board.type != BoardType::ChArUco) throw core::InvalidInput("charucoBoard: board is " + toString(board.type));
+  board.validate();
+  return cv::aruco::CharucoBoard::create(board.cols, board.rows, static_cast<float>(board.spacing),
+                                         static_cast<float>(board.marker_size), arucoDictionary(board.dictionary));
+}
 
 std::string toString(BoardType t) {
   for (const auto& n : typeNames())
@@ -46,7 +81,11 @@ std::string toString(BoardType t) {
 std::string BoardSpec::describe() const {
   std::ostringstream os;
   os << toString(type);
-  if (type != BoardType::AprilTag) os << " " << cols << "x" << rows << ", spacing " << spacing << " m";
+  if (type == BoardType::ChArUco)
+    os << " " << cols << "x" << rows << " squares of " << spacing << " m, markers " << dictionary << " of "
+       << marker_size << " m";
+  else if (type != BoardType::AprilTag)
+    os << " " << cols << "x" << rows << ", spacing " << spacing << " m";
   if (isTagBoard(type)) os << ", tags " << tag_family << " of " << tag_size << " m";
   return os.str();
 }
@@ -66,6 +105,22 @@ void BoardSpec::validate(const std::string& where) const {
     if (type == BoardType::AprilTagGrid && tag_size >= spacing)
       throw core::InvalidInput(where + ": tag_size must be smaller than spacing (the tag centre distance)");
   }
+  if (type == BoardType::ChArUco) {
+    if (cols < 3 || rows < 3)
+      throw core::InvalidInput(where + ": charuco cols and rows (squares) must be at least 3, got " +
+                               std::to_string(cols) + "x" + std::to_string(rows));
+    if (!(marker_size > 0.0) || !(marker_size < spacing))
+      throw core::InvalidInput(where + ": marker_size must be a positive length in metres smaller than spacing (the square edge)");
+    try {
+      const int markers = cols * rows / 2;
+      const int available = arucoDictionary(dictionary)->bytesList.rows;
+      if (markers > available)
+        throw core::InvalidInput("dictionary '" + dictionary + "' has " + std::to_string(available) +
+                                 " markers, the board needs " + std::to_string(markers));
+    } catch (const core::InvalidInput& e) {
+      throw core::InvalidInput(where + ": " + e.what());
+    }
+  }
 }
 
 std::vector<cv::Point3f> tagCorners3d(double size) {
@@ -78,8 +133,10 @@ std::vector<cv::Point3f> tagCorners3d(double size) {
 std::vector<cv::Point3f> BoardSpec::objectPoints() const {
   std::vector<cv::Point3f> pts;
   const float s = static_cast<float>(spacing);
-  for (int r = 0; r < rows; ++r)
-    for (int c = 0; c < cols; ++c) {
+  // charuco: the inner corners, ids row-major as OpenCV numbers them.
+  const int nc = type == BoardType::ChArUco ? cols - 1 : cols, nr = type == BoardType::ChArUco ? rows - 1 : rows;
+  for (int r = 0; r < nr; ++r)
+    for (int c = 0; c < nc; ++c) {
       if (type == BoardType::AsymmetricCirclesGrid)
         pts.emplace_back(static_cast<float>(2 * c + r % 2) * s, static_cast<float>(r) * s, 0.f);
       else if (type == BoardType::AprilTagGrid)
@@ -109,6 +166,10 @@ BoardSpec readBoard(const io::ConfigNode& n) {
   }
   if (b.type == BoardType::AprilTagGrid) b.first_id = n.getOr<int>("first_id", 0);
   if (b.type == BoardType::AprilTag) b.tag_ids = n.getOr<std::vector<int>>("tag_ids", {});
+  if (b.type == BoardType::ChArUco) {
+    b.marker_size = n.get<double>("marker_size");
+    b.dictionary = n.getChoice("dictionary", dictionaryChoices());
+  }
   try {
     b.validate(n.location() + ": board");
   } catch (const core::InvalidInput&) {
@@ -232,6 +293,58 @@ Detection detectBoard(const cv::Mat& gray, const BoardSpec& board) {
         d.reason = "found " + std::to_string(obs.tag_ids.size()) + " usable " + board.tag_family +
                    " tags, need at least " + std::to_string(need);
         return d;
+      }
+      break;
+    }
+    case BoardType::ChArUco: {
+      const auto cb = charucoBoard(board);
+      std::vector<std::vector<cv::Point2f>> marker_corners, rejected;
+      std::vector<int> marker_ids;
+      cv::aruco::detectMarkers(gray, cb->dictionary, marker_corners, marker_ids,
+                               cv::aruco::DetectorParameters::create(), rejected);
+      std::vector<cv::Point2f> corners;
+      std::vector<int> ids;
+      if (!marker_ids.empty())
+        cv::aruco::interpolateCornersCharuco(marker_corners, marker_ids, gray, cb, corners, ids);
+      const std::size_t need = 6;
+      const std::string what = "charuco " + std::to_string(board.cols) + "x" + std::to_string(board.rows) + " (" +
+                               board.dictionary + "): ";
+      if (ids.size() < need) {
+        d.reason = what + "found " + std::to_string(ids.size()) + " corners from " + std::to_string(marker_ids.size()) +
+                   " markers, need at least " + std::to_string(need);
+        return d;
+      }
+      // Corners all on one row or column of the board give no homography (degenerate for calibration).
+      const int nc = board.cols - 1;
+      bool one_row = true, one_col = true;
+      for (const int id : ids) {
+        one_row = one_row && id / nc == ids.front() / nc;
+        one_col = one_col && id % nc == ids.front() % nc;
+      }
+      if (one_row || one_col) {
+        d.reason = what + "the " + std::to_string(ids.size()) + " corners found lie on one line of the board";
+        return d;
+      }
+      // OpenCV 4.6's interpolateCornersCharuco returns corners about half a pixel off (+0.5, +0.5)
+      // from cornerSubPix's pixel-centre convention, which findChessboardCorners and the renderers
+      // use (measured on a drawn board: 100.0 where cornerSubPix gives 99.5). Refine each corner
+      // again, its search window kept inside the white gap between the corner and the markers
+      // around it (the gap is ~0.7 of the distance to the nearest marker corner), less 2 px of blur.
+      for (std::size_t i = 0; i < corners.size(); ++i) {
+        double near = 1e9;
+        for (const auto& m : marker_corners)
+          for (const auto& p : m) near = std::min(near, cv::norm(p - corners[i]));
+        const int win = std::clamp(static_cast<int>(0.7 * near - 2.0), 2, 10);
+        std::vector<cv::Point2f> one{corners[i]};
+        cv::cornerSubPix(gray, one, cv::Size(win, win), cv::Size(-1, -1),
+                         cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 50, 1e-3));
+        corners[i] = one.front();
+      }
+      const auto all = board.objectPoints();
+      for (std::size_t i = 0; i < ids.size(); ++i) {
+        obs.image_points.push_back(corners[i]);
+        obs.object_points.push_back(all[static_cast<std::size_t>(ids[i])]);
+        obs.corner_ids.push_back(ids[i]);
       }
       break;
     }

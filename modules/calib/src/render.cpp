@@ -49,10 +49,12 @@ cv::Mat boardTexture(const BoardSpec& board, double ppm, cv::Point2d& origin) {
     x0 = y0 = -board.tag_size;
     x1 = y1 = board.tag_size;
   } else {
+    // charuco: cols x rows squares around (cols - 1) x (rows - 1) inner corners.
+    const int inner = board.type == BoardType::ChArUco ? 1 : 0;
     const double w = board.type == BoardType::AsymmetricCirclesGrid ? (2 * board.cols - 1) * board.spacing
-                                                                     : (board.cols - 1) * board.spacing;
+                                                                     : (board.cols - 1 - inner) * board.spacing;
     x1 = w + unit;
-    y1 = (board.rows - 1) * board.spacing + unit;
+    y1 = (board.rows - 1 - inner) * board.spacing + unit;
   }
   origin = {x0, y0};
   const int W = static_cast<int>(std::ceil((x1 - x0) * ppm)), H = static_cast<int>(std::ceil((y1 - y0) * ppm));
@@ -95,6 +97,16 @@ cv::Mat boardTexture(const BoardSpec& board, double ppm, cv::Point2d& origin) {
         cv::resize(t, scaled, cv::Size(n, n), 0, 0, cv::INTER_NEAREST);
         scaled.copyTo(tex(cv::Rect(static_cast<int>(std::lround(a.x)), static_cast<int>(std::lround(a.y)), n, n)));
       }
+      break;
+    }
+    case BoardType::ChArUco: {
+      // OpenCV draws the squares and markers at a whole number of texels per square (exact edges),
+      // then the drawing is scaled to the requested resolution (the texture is exactly the squares).
+      const int k = std::max(20, static_cast<int>(std::ceil(s * ppm)));
+      cv::Mat drawn;
+      charucoBoard(board)->draw(cv::Size(board.cols * k, board.rows * k), drawn, 0, 1);
+      if (drawn.size() == tex.size()) drawn.copyTo(tex);
+      else cv::resize(drawn, tex, tex.size(), 0, 0, cv::INTER_AREA);
       break;
     }
   }

@@ -141,7 +141,11 @@ cv::Mat renderBoardImage(const core::Camera& camera, const Eigen::Isometry3d& c_
   // Texture: an integer number of texels per spacing (or tag module) so that every square / tag
   // edge lies on a texel edge; nearest lookup keeps it crisp, the renderer anti-aliases.
   const double unit = board.type == BoardType::AprilTag ? board.tag_size : board.spacing;
-  const double texels = board.type == BoardType::AprilTagGrid || board.type == BoardType::AprilTag ? 80.0 : 40.0;
+  // Tag and marker boards have fine modules: twice the texels per spacing.
+  const double texels = board.type == BoardType::AprilTagGrid || board.type == BoardType::AprilTag ||
+                                board.type == BoardType::ChArUco
+                            ? 80.0
+                            : 40.0;
   const double ppm = texels / unit;
   cv::Point2d origin;
   const cv::Mat tex8 = boardTexture(board, ppm, origin);
@@ -191,8 +195,10 @@ std::vector<Eigen::Vector3d> boardOutline(const BoardSpec& board) {
     return {{-a, -a, 0}, {a, -a, 0}, {a, a, 0}, {-a, a, 0}};
   }
   const double s = board.spacing;
-  const double w = board.type == BoardType::AsymmetricCirclesGrid ? (2 * board.cols - 1) * s : (board.cols - 1) * s;
-  const double h = (board.rows - 1) * s;
+  const int inner = board.type == BoardType::ChArUco ? 1 : 0;  // charuco: cols x rows are squares
+  const double w =
+      board.type == BoardType::AsymmetricCirclesGrid ? (2 * board.cols - 1) * s : (board.cols - 1 - inner) * s;
+  const double h = (board.rows - 1 - inner) * s;
   return {{-s, -s, 0}, {w + s, -s, 0}, {w + s, h + s, 0}, {-s, h + s, 0}};
 }
 
