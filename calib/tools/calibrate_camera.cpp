@@ -8,7 +8,7 @@
 #include "viewline/io/files.h"
 
 int main(int argc, char** argv) {
-  CLI::App app{"Intrinsic calibration from images of a chessboard, circle grid or AprilTag grid.\n"
+  CLI::App app{"Intrinsic calibration from images of a chessboard, circle grid, AprilTag grid or ChArUco board.\n"
                "Writes a ViSP camera XML (models with and without distortion) and an OpenCV YAML."};
   std::string board_file, name = "camera", xml, yaml, report;
   std::vector<std::string> images;

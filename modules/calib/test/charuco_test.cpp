@@ -95,6 +95,10 @@ TEST(ChArUco, ReadsBoardFilesStrictlyWithClearErrors) {
     EXPECT_NEAR(cb->chessboardCorners[i].y - 0.025f, b.objectPoints()[i].y, 1e-6);
   }
 
+  // The shipped board file (tests run in the source tree) is this board.
+  const BoardSpec shipped = loadBoard("calib/boards/charuco_10x7_25mm.yaml");
+  EXPECT_EQ(shipped.describe(), b.describe());
+
   auto expectError = [](const std::string& yaml, const std::string& needle) {
     const std::string e = errorOf(yaml);
     EXPECT_NE(e.find(needle), std::string::npos) << "yaml:\n" << yaml << "error: '" << e << "'";
@@ -197,6 +201,7 @@ TEST(ChArUco, HalfHiddenBoardStillGivesItsVisibleCorners) {
   const Detection d = detectBoard(img, b);
   ASSERT_TRUE(d.observation) << d.reason;
   const auto& o = *d.observation;
+  std::cout << "[charuco half] " << o.image_points.size() << " corners\n";
   EXPECT_GE(o.image_points.size(), 18u);
   EXPECT_LT(o.image_points.size(), 54u);
   for (std::size_t i = 0; i < o.image_points.size(); ++i) {
