@@ -326,9 +326,9 @@ Detection detectBoard(const cv::Mat& gray, const BoardSpec& board) {
         return d;
       }
       // OpenCV 4.6's interpolateCornersCharuco returns corners about half a pixel off (+0.5, +0.5)
-      // (a known bug, opencv/opencv#25539, fixed upstream after 4.6)
       // from cornerSubPix's pixel-centre convention, which findChessboardCorners and the renderers
-      // use (measured on a drawn board: 100.0 where cornerSubPix gives 99.5). Refine each corner
+      // use (measured on a drawn board: 100.0 where cornerSubPix gives 99.5; a known bug,
+      // opencv/opencv#25539, fixed upstream after 4.6). Refine each corner
       // again, its search window kept inside the white gap between the corner and the markers
       // around it (the gap is ~0.7 of the distance to the nearest marker corner), less 2 px of blur.
       for (std::size_t i = 0; i < corners.size(); ++i) {
