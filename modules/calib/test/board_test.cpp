@@ -7,39 +7,12 @@
 #include "viewline/calib/render.h"
 #include "viewline/core/error.h"
 #include "viewline/core/frames.h"
+#include "board_fixtures.h"
 
 using namespace viewline;
 using namespace viewline::calib;
-
-namespace {
-core::Camera trueCamera(bool distortion) {
-  core::Camera c;
-  c.width = 640;
-  c.height = 480;
-  if (distortion)
-    c.intrinsics.initPersProjWithDistortion(600, 605, 318, 243, -0.08, 0.0815);
-  else
-    c.intrinsics.initPersProjWithoutDistortion(600, 605, 318, 243);
-  return c;
-}
-
-// Board pose: board centre at distance d, tilted by (ax, ay) about the board's x and y axes.
-Eigen::Isometry3d boardPose(const BoardSpec& b, double d, double ax_deg, double ay_deg, double dx = 0, double dy = 0) {
-  const double w = (b.cols - 1) * b.spacing, h = (b.rows - 1) * b.spacing;
-  Eigen::Isometry3d c_M_o = Eigen::Isometry3d::Identity();
-  c_M_o.linear() = (Eigen::AngleAxisd(core::deg2rad(ax_deg), Eigen::Vector3d::UnitX()) *
-                    Eigen::AngleAxisd(core::deg2rad(ay_deg), Eigen::Vector3d::UnitY()))
-                       .toRotationMatrix();
-  c_M_o.translation() = Eigen::Vector3d(dx, dy, d) - c_M_o.linear() * Eigen::Vector3d(w / 2, h / 2, 0);
-  return c_M_o;
-}
-
-std::vector<Eigen::Isometry3d> poses(const BoardSpec& b) {
-  return {boardPose(b, 0.45, 0, 0),        boardPose(b, 0.5, 25, 0, 0.03),   boardPose(b, 0.5, -25, 10, -0.03),
-          boardPose(b, 0.5, 5, 30, 0, 0.03), boardPose(b, 0.55, -10, -30),    boardPose(b, 0.6, 20, 20, 0.05, 0.04),
-          boardPose(b, 0.4, -15, 20, -0.05, -0.04)};
-}
-}  // namespace
+using viewline::calib::test::boardPose;
+using viewline::calib::test::trueCamera;
 
 TEST(Board, ReadsBoardFilesStrictly) {
   const auto cfg = io::ConfigNode::fromString("type: chessboard\ncols: 9\nrows: 6\nspacing: 0.025\ncolor: red\n", "b.yaml");
@@ -108,7 +81,7 @@ TEST(Intrinsics, RecoversRenderedCameraWithViSPDistortion) {
   core::Rng rng = core::makeRng(11);
   const BoardSpec b{BoardType::Chessboard, 9, 6, 0.025, "36h11", 0, 0, {}};
   std::vector<ViewInput> views;
-  for (const auto& p : poses(b)) {
+  for (const auto& p : test::intrinsicsPoses(b)) {
     const Detection d = detectBoard(renderBoard(cam, p, b, rng), b);
     ASSERT_TRUE(d.observation) << d.reason;
     views.push_back({"view" + std::to_string(views.size()), *d.observation});

@@ -11,23 +11,14 @@
 #include "viewline/calib/synthetic.h"
 #include "viewline/core/error.h"
 #include "viewline/core/frames.h"
+#include "board_fixtures.h"
 
 using namespace viewline;
 using namespace viewline::calib;
+using viewline::calib::test::boardPose;
+using viewline::calib::test::trueCamera;
 
 namespace {
-
-// Same true camera as the chessboard intrinsics test (board_test.cpp).
-core::Camera trueCamera(bool distortion) {
-  core::Camera c;
-  c.width = 640;
-  c.height = 480;
-  if (distortion)
-    c.intrinsics.initPersProjWithDistortion(600, 605, 318, 243, -0.08, 0.0815);
-  else
-    c.intrinsics.initPersProjWithoutDistortion(600, 605, 318, 243);
-  return c;
-}
 
 // 10 x 7 squares of 25 mm: the same 9 x 6 inner corners as the chessboard of board_test.cpp.
 BoardSpec charuco() {
@@ -39,24 +30,6 @@ BoardSpec charuco() {
   b.marker_size = 0.019;
   b.dictionary = "DICT_5X5_100";
   return b;
-}
-
-// Board pose: inner-corner centre at distance d, tilted by (ax, ay) about the board's x and y axes.
-Eigen::Isometry3d boardPose(const BoardSpec& b, double d, double ax_deg, double ay_deg, double dx = 0, double dy = 0) {
-  const double w = (b.cols - 2) * b.spacing, h = (b.rows - 2) * b.spacing;
-  Eigen::Isometry3d c_M_o = Eigen::Isometry3d::Identity();
-  c_M_o.linear() = (Eigen::AngleAxisd(core::deg2rad(ax_deg), Eigen::Vector3d::UnitX()) *
-                    Eigen::AngleAxisd(core::deg2rad(ay_deg), Eigen::Vector3d::UnitY()))
-                       .toRotationMatrix();
-  c_M_o.translation() = Eigen::Vector3d(dx, dy, d) - c_M_o.linear() * Eigen::Vector3d(w / 2, h / 2, 0);
-  return c_M_o;
-}
-
-// The poses of board_test.cpp's intrinsics test.
-std::vector<Eigen::Isometry3d> poses(const BoardSpec& b) {
-  return {boardPose(b, 0.45, 0, 0),        boardPose(b, 0.5, 25, 0, 0.03),   boardPose(b, 0.5, -25, 10, -0.03),
-          boardPose(b, 0.5, 5, 30, 0, 0.03), boardPose(b, 0.55, -10, -30),    boardPose(b, 0.6, 20, 20, 0.05, 0.04),
-          boardPose(b, 0.4, -15, 20, -0.05, -0.04)};
 }
 
 std::string errorOf(const std::string& yaml) {
@@ -221,7 +194,7 @@ TEST(ChArUco, IntrinsicsRecoverRenderedCameraWithViSPDistortion) {
   core::Rng rng = core::makeRng(11);
   const BoardSpec b = charuco();
   std::vector<ViewInput> views;
-  auto ps = poses(b);
+  auto ps = test::intrinsicsPoses(b);
   for (std::size_t k = 0; k < ps.size(); ++k) {
     const Detection d = detectBoard(renderBoard(cam, ps[k], b, rng), b);
     ASSERT_TRUE(d.observation) << d.reason;
