@@ -1,10 +1,13 @@
 // Shared fixtures of the board tests: the true camera and the intrinsics poses, for every board type.
 #pragma once
 
+#include <gtest/gtest.h>
+
 #include <Eigen/Geometry>
 #include <vector>
 
 #include "viewline/calib/board.h"
+#include "viewline/calib/intrinsics.h"
 #include "viewline/core/camera.h"
 #include "viewline/core/frames.h"
 
@@ -42,6 +45,20 @@ inline std::vector<Eigen::Isometry3d> intrinsicsPoses(const BoardSpec& b) {
   return {boardPose(b, 0.45, 0, 0),        boardPose(b, 0.5, 25, 0, 0.03),   boardPose(b, 0.5, -25, 10, -0.03),
           boardPose(b, 0.5, 5, 30, 0, 0.03), boardPose(b, 0.55, -10, -30),    boardPose(b, 0.6, 20, 20, 0.05, 0.04),
           boardPose(b, 0.4, -15, 20, -0.05, -0.04)};
+}
+
+/// The bounds every intrinsics test holds against trueCamera(true): RMS < 0.3 px (OpenCV and ViSP
+/// with distortion), focal lengths within 1 %, principal point within 3 px, kud within 0.02, and
+/// the model without distortion worse than the one with it.
+inline void expectRecoversTrueCamera(const IntrinsicsResult& r) {
+  EXPECT_LT(r.rms_px, 0.3);
+  EXPECT_LT(r.visp_with_rms_px, 0.3);
+  EXPECT_NEAR(r.visp_with.get_px(), 600, 600 * 0.01);
+  EXPECT_NEAR(r.visp_with.get_py(), 605, 605 * 0.01);
+  EXPECT_NEAR(r.visp_with.get_u0(), 318, 3.0);
+  EXPECT_NEAR(r.visp_with.get_v0(), 243, 3.0);
+  EXPECT_NEAR(r.visp_with.get_kud(), -0.08, 0.02);
+  EXPECT_GT(r.visp_without_rms_px, r.visp_with_rms_px);
 }
 
 }  // namespace viewline::calib::test
