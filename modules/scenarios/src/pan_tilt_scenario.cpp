@@ -270,9 +270,7 @@ Vector2d pathAmplitude(const sim::ScreenPath& path, double duration) {
   return 0.5 * (hi - lo);
 }
 
-namespace {
-
-const char* shapeName(sim::PathShape s) {
+const char* pathShapeName(sim::PathShape s) {
   switch (s) {
     case sim::PathShape::Rectangle: return "rectangle";
     case sim::PathShape::Circle: return "circle";
@@ -280,6 +278,8 @@ const char* shapeName(sim::PathShape s) {
   }
   return "?";
 }
+
+namespace {
 
 /// The screen world with the disc hidden during an occlusion window.
 class OccludedWorld : public sim::World {
@@ -748,7 +748,7 @@ PanTiltComparison runPanTiltComparison(const PanTiltScenarioConfig& config, std:
                                        const std::function<void(double)>& progress) {
   PanTiltComparison c;
   c.seed = seed;
-  c.path = shapeName(config.path.shape);
+  c.path = pathShapeName(config.path.shape);
   const double share = config.run_baseline ? 0.5 : 1.0;
   c.ours = runPanTilt(config, seed, PanTiltControllerKind::Predictive, sink, log,
                       progress ? std::function<void(double)>([&](double f) { progress(share * f); }) : nullptr);

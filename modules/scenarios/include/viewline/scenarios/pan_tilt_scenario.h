@@ -207,6 +207,9 @@ struct TTable1Row {
 };
 TTable1Row tTable1(sim::PathShape shape);
 
+/// "rectangle", "circle" or "random" (the config's path.shape).
+const char* pathShapeName(sim::PathShape shape);
+
 /// Per-axis amplitude A = (max − min)/2 of a path's true position over [0, duration] (m).
 Eigen::Vector2d pathAmplitude(const sim::ScreenPath& path, double duration);
 
