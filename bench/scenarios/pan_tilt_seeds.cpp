@@ -14,6 +14,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -40,6 +41,7 @@ struct SeedResult {
   scenarios::PanTiltComparison run;
   scenarios::PanTiltReplayMetrics filter, oracle;
   bool has_oracle = false;
+  std::string error;  ///< what stopped this seed (the worker threads must not throw)
 };
 
 /// x with `digits` decimals.
@@ -84,25 +86,35 @@ int main(int argc, char** argv) {
     std::vector<SeedResult> results(static_cast<std::size_t>(seeds));
     std::mutex out;
     std::size_t done = 0;
+    std::atomic<bool> stop{false};
     tuning::parallelFor(results.size(), jobs, [&](std::size_t i) {
       SeedResult& r = results[i];
       r.seed = first_seed + i;
-      const fs::path dir = logs / ("log_" + path + "_s" + std::to_string(r.seed));
-      {
-        io::LogDirectory log(dir.string());
-        r.run = scenarios::runPanTiltComparison(cfg, r.seed, nullptr, &log);
-        log.flush();
-      }
-      const std::string frames = (dir / "predictive_frames.csv").string();
-      r.filter = scenarios::replayPanTiltFilter(cfg, r.seed, frames, false);
-      if (corners) {
-        r.oracle = scenarios::replayPanTiltFilter(cfg, r.seed, frames, true);
-        r.has_oracle = true;
+      try {
+        const fs::path dir = logs / ("log_" + path + "_s" + std::to_string(r.seed));
+        {
+          io::LogDirectory log(dir.string());
+          r.run = scenarios::runPanTiltComparison(cfg, r.seed, nullptr, &log);
+          log.flush();
+        }
+        const std::string frames = (dir / "predictive_frames.csv").string();
+        r.filter = scenarios::replayPanTiltFilter(cfg, r.seed, frames, false);
+        if (corners) {
+          r.oracle = scenarios::replayPanTiltFilter(cfg, r.seed, frames, true);
+          r.has_oracle = true;
+        }
+      } catch (const std::exception& e) {
+        r.error = e.what();
+        stop = true;
       }
       std::lock_guard<std::mutex> lock(out);
-      std::cerr << "pan_tilt_seeds: seed " << r.seed << " done (" << ++done << "/" << results.size() << ")\n";
-    });
+      std::cerr << "pan_tilt_seeds: seed " << r.seed << (r.error.empty() ? " done (" : " FAILED (") << ++done << "/"
+                << results.size() << ")\n";
+    }, &stop);
     if (!keep) fs::remove_all(logs);
+    for (const SeedResult& r : results)
+      if (!r.error.empty()) throw core::Error("seed " + std::to_string(r.seed) + ": " + r.error);
+    if (stop) throw core::Error("stopped before every seed ran");
 
     const scenarios::TTable1Row t = scenarios::tTable1(cfg.path.shape);
     const bool ratio_target = cfg.path.shape != sim::PathShape::Rectangle;  // issue 6: circle and random
