@@ -116,6 +116,18 @@ void TargetFilterConfig::validate() const {
     throw core::InvalidInput("filter.turn_prior_sigma_deg must be in (0, 45]");
   if (jump_evidence != "kink" && jump_evidence != "legs")
     throw core::InvalidInput("filter.jump_evidence must be kink or legs, not '" + jump_evidence + "'");
+  if (!region_center.allFinite() || !region_size.allFinite() || region_size.minCoeff() < 0.0)
+    throw core::InvalidInput("filter.region: center and size must be finite, size >= 0");
+  if ((region_size.x() > 0.0) != (region_size.y() > 0.0))
+    throw core::InvalidInput("filter.region.size: both width and height > 0 (or both 0: no region)");
+  if (hasRegion() && !constant_speed)
+    throw core::InvalidInput("filter.region needs filter.constant_speed (the region is where the legs' waypoints lie)");
+  if (jump_decision != "test" && jump_decision != "posterior")
+    throw core::InvalidInput("filter.jump_decision must be test or posterior, not '" + jump_decision + "'");
+  if (jump_decision == "posterior" && !(jump_rate > 0.0))
+    throw core::InvalidInput("filter.jump_decision: posterior needs the soft jump mixture (filter.jump_rate > 0)");
+  if (!(jump_posterior > 0.0 && jump_posterior < 1.0))
+    throw core::InvalidInput("filter.jump_posterior must be in (0, 1)");
   if (jump_evidence == "legs" && !constant_speed)
     throw core::InvalidInput("filter.jump_evidence: legs needs filter.constant_speed");
   if (turn_prior_weight > 0.0 && !constant_speed)
@@ -155,12 +167,37 @@ estimation::NonlinearTransition cvWithOmega(double q, double q_omega, double dt)
 // The speed is thus re-estimated on every leg around the learnt ŝ (it absorbs a scale error of the
 // measurements), and only θ needs a grid. θ's prior is uniform, or the learnt-turn mixture
 // p(θ) = (1 − w) / 2π + w / K Σ_k N_wrapped(θ; μ_k, σ²): logPrior() is log(2π p(θ)), 0 when uniform.
+namespace {
+// Distance from c (inside the box [lo, hi]) to the box's boundary along u(θ).
+double boxReach(const Eigen::Vector2d& c, const Eigen::Vector2d& lo, const Eigen::Vector2d& hi, double th) {
+  const Eigen::Vector2d u(std::cos(th), std::sin(th));
+  double r = std::numeric_limits<double>::infinity();
+  for (int a = 0; a < 2; ++a) {
+    if (u(a) > 1e-12) r = std::min(r, (hi(a) - c(a)) / u(a));
+    if (u(a) < -1e-12) r = std::min(r, (lo(a) - c(a)) / u(a));
+  }
+  return std::max(r, 0.0);
+}
+}  // namespace
+
+double waypointDirectionDensity(const Eigen::Vector2d& c, const Eigen::Vector2d& center, const Eigen::Vector2d& size,
+                                double theta) {
+  if (!(size.x() > 0.0 && size.y() > 0.0)) throw core::InvalidInput("waypointDirectionDensity: size must be > 0");
+  const Eigen::Vector2d lo = center - 0.5 * size, hi = center + 0.5 * size;
+  const double R = boxReach(c.cwiseMax(lo).cwiseMin(hi), lo, hi, theta);
+  return R * R / (2.0 * size.x() * size.y());
+}
+
 struct PlanarTargetFilter::Leg {
   double t_c = 0.0;
   Eigen::Vector3d beta0 = Eigen::Vector3d::Zero();
   Eigen::Matrix3d P0_inv = Eigen::Matrix3d::Identity();
   std::vector<double> prior_mu;  ///< μ_k (rad); empty: θ uniform
   double prior_sigma = 0.1, prior_weight = 0.0;
+  bool region = false;            ///< waypoint-region prior p(θ) = R(θ)² / (2A) from region_c
+  Eigen::Vector2d region_c = Eigen::Vector2d::Zero(), region_lo = Eigen::Vector2d::Zero(), region_hi = Eigen::Vector2d::Zero();
+  double region_log_scale = 0.0;  ///< log(π / A)
+  double log_norm = 0.0;          ///< normalises the product of the two priors (0 when at most one is on)
   Eigen::Matrix2d A = Eigen::Matrix2d::Zero(), Bt = Eigen::Matrix2d::Zero(), Ctt = Eigen::Matrix2d::Zero();
   Eigen::Vector2d Bz = Eigen::Vector2d::Zero(), Ctz = Eigen::Vector2d::Zero();
   double zz = 0.0;
@@ -177,14 +214,20 @@ struct PlanarTargetFilter::Leg {
   }
 
   double logPrior(double th) const {
-    if (prior_mu.empty() || prior_weight <= 0.0) return 0.0;
+    double lp = log_norm;
+    if (region) {
+      // log(2π R² / (2A)); R floored at 0.1 mm so that a corner estimated on the boundary stays finite.
+      const double R = std::max(boxReach(region_c, region_lo, region_hi, th), 1e-4);
+      lp += region_log_scale + 2.0 * std::log(R);
+    }
+    if (prior_mu.empty() || prior_weight <= 0.0) return lp;
     double g = 0.0;
     for (double mu : prior_mu) {
       const double d = std::remainder(th - mu, 2.0 * core::kPi);  // wrapped to [−π, π]; σ ≪ π, one wrap suffices
       if (d * d < 100.0 * prior_sigma * prior_sigma) g += std::exp(-0.5 * d * d / (prior_sigma * prior_sigma));  // (e^-50 beyond)
     }
     g *= std::sqrt(2.0 * core::kPi) / prior_sigma / static_cast<double>(prior_mu.size());
-    return std::log((1.0 - prior_weight) + prior_weight * g);
+    return lp + std::log((1.0 - prior_weight) + prior_weight * g);
   }
 
   /// log p(z | θ) (up to a constant), and the posterior mean and covariance of β = (c, s) given θ.
@@ -443,6 +486,7 @@ bool PlanarTargetFilter::detectJump() {
   std::vector<std::pair<double, int>> log_odds;  // soft: log(π_j BF_j), j
   const double prior_precision = soft ? 1.0 / (config_.jump_prior_sigma * config_.jump_prior_sigma) : 0.0;
   const bool leg_bf = soft && legEvidenceMixture();  // the soft mixture's Bayes factors from legs, not kinks
+  const std::vector<double> region_odds = soft ? regionJumpOdds() : std::vector<double>{};
   for (int j = m; j + (soft ? 2 : m) < n; ++j) {
     const Snapshot& sj = history_[static_cast<std::size_t>(j)];
     for (int i = 0; i < n; ++i) {
@@ -494,8 +538,33 @@ bool PlanarTargetFilter::detectJump() {
       if (leg_bf) log_bf = legBayesFactor(j);
       // Prior probability of a jump at t_j (and nowhere else in the window): rate × the interval it stands for.
       const double dt_j = sj.t - history_[static_cast<std::size_t>(j - 1)].t;
-      log_odds.emplace_back(std::log(std::max(config_.jump_rate * dt_j, 1e-300)) + log_bf, j);
+      const double log_prior = region_odds.empty() ? std::log(std::max(config_.jump_rate * dt_j, 1e-300))
+                                                   : region_odds[static_cast<std::size_t>(j)];
+      log_odds.emplace_back(log_prior + log_bf, j);
     }
+  }
+  if (config_.jump_decision == "posterior" && soft) {
+    // Decide by the mixture's posterior instead of the test: a jump once the hypotheses "a jump at t_j"
+    // with jump_min_samples measurements after t_j hold more than jump_posterior of the posterior mass
+    // (against no jump and the later t_j), at the most probable of them. The prior odds (jump_rate or
+    // the waypoint region) thus count: a corner is declared sooner where one is likely, and a run of
+    // noise mid-leg needs more evidence.
+    double top = 0.0;
+    for (const auto& entry : log_odds) top = std::max(top, entry.first);
+    double total = std::exp(-top);
+    for (const auto& entry : log_odds) total += std::exp(entry.first - top);
+    double mass = 0.0, best_p = 0.0;
+    int arg = -1;
+    for (const auto& [lo, j] : log_odds) {
+      if (j + m >= n) continue;
+      const double p = std::exp(lo - top) / total;
+      mass += p;
+      if (p > best_p) {
+        best_p = p;
+        arg = j;
+      }
+    }
+    best_j = mass > config_.jump_posterior ? arg : -1;
   }
   if (best_j < 0) {
     if (soft) softMixture(log_odds);
@@ -585,6 +654,35 @@ estimation::StateEstimate PlanarTargetFilter::alternative(int j) const {
     estimation::update(s, m);
   }
   return s;
+}
+
+double PlanarTargetFilter::regionReach(const Eigen::Vector2d& c, double theta) const {
+  const Eigen::Vector2d half = 0.5 * config_.region_size, inset = 1e-3 * config_.region_size;
+  const Eigen::Vector2d lo = config_.region_center - half, hi = config_.region_center + half;
+  return boxReach(c.cwiseMax(lo + inset).cwiseMin(hi - inset), lo, hi, theta);
+}
+
+std::vector<double> PlanarTargetFilter::regionJumpOdds() const {
+  // The current leg started at t_c from c and runs at speed s along u (the estimate's velocity): the
+  // target is s (t − t_c) along it at t, and the next waypoint lies on the ray within R = R(θ_u) with
+  // density ∝ r (see the class comment). odds_j = (s_j² − s_{j−1}²) / (R² − s_n²), s_n now; the
+  // denominator is floored at (1 mm)² once the straight leg would have left the region.
+  if (!config_.hasRegion() || !leg_ || history_.size() < 2) return {};
+  const Eigen::Vector2d p = state_.x().head<2>(), v = state_.x().segment<2>(2);
+  const double speed = v.norm();
+  if (!(speed > 1e-6)) return {};
+  const double t_n = history_.back().t, t_c = leg_->t_c;
+  const Eigen::Vector2d c = p - v * (t_n - t_c);
+  const double R = regionReach(c, std::atan2(v.y(), v.x()));
+  const auto along = [&](double t) { return speed * std::max(t - t_c, 0.0); };
+  const double s_n = along(t_n);
+  const double log_den = std::log(std::max(R * R - s_n * s_n, 1e-6));
+  std::vector<double> odds(history_.size(), -1e300);
+  for (std::size_t j = 1; j < history_.size(); ++j) {
+    const double a = along(history_[j - 1].t), b = along(history_[j].t);
+    odds[j] = std::log(std::max(b * b - a * a, 1e-300)) - log_den;
+  }
+  return odds;
 }
 
 bool PlanarTargetFilter::legEvidenceMixture() const {
@@ -708,6 +806,23 @@ PlanarTargetFilter::Leg PlanarTargetFilter::makeLeg(core::Timestamp t_c, const E
     for (double turn : turns_) leg.prior_mu.push_back(from_direction + turn);
     leg.prior_weight = config_.turn_prior_weight;
     leg.prior_sigma = config_.turn_prior_sigma_deg * core::kPi / 180.0;
+  }
+  if (config_.hasRegion()) {
+    // The corner clamped into the region (an estimate can fall just outside it).
+    const Eigen::Vector2d half = 0.5 * config_.region_size;
+    leg.region = true;
+    leg.region_lo = config_.region_center - half;
+    leg.region_hi = config_.region_center + half;
+    const Eigen::Vector2d inset = 1e-3 * config_.region_size;
+    leg.region_c = c.cwiseMax(leg.region_lo + inset).cwiseMin(leg.region_hi - inset);
+    leg.region_log_scale = std::log(core::kPi / (config_.region_size.x() * config_.region_size.y()));
+    if (!leg.prior_mu.empty()) {
+      // Both priors: normalise their product on a fine grid (each alone already has mean 1 in 2π p(θ)).
+      constexpr int kPoints = 720;
+      double sum = 0.0;
+      for (int k = 0; k < kPoints; ++k) sum += std::exp(leg.logPrior(-core::kPi + 2.0 * core::kPi * k / kPoints));
+      leg.log_norm = -std::log(sum / kPoints);
+    }
   }
   leg.beta0 << c, speedEstimate();
   Eigen::Matrix3d P0 = Eigen::Matrix3d::Zero();

@@ -384,6 +384,85 @@ TEST(PlanarTargetFilter, LegEvidenceOnARandomPolyline) {
   EXPECT_LT(r_oracle, r_legs);  // knowing the corners is a bound
 }
 
+TEST(PlanarTargetFilter, WaypointDirectionDensityAndNewKeys) {
+  // p(θ) = R(θ)² / (2A) integrates to 1 from anywhere in the box, favours the long way, and is 0
+  // straight out of the box from a point on its boundary.
+  const Eigen::Vector2d center(0.1, -0.05), size(0.8, 0.43);
+  for (const Eigen::Vector2d& c : {Eigen::Vector2d(0.1, -0.05), Eigen::Vector2d(0.4, 0.1), Eigen::Vector2d(-0.29, -0.26)}) {
+    double sum = 0.0;
+    const int points = 3600;
+    for (int k = 0; k < points; ++k)
+      sum += control::waypointDirectionDensity(c, center, size, -core::kPi + 2.0 * core::kPi * k / points);
+    EXPECT_NEAR(sum * 2.0 * core::kPi / points, 1.0, 1e-3) << c.transpose();
+  }
+  EXPECT_GT(control::waypointDirectionDensity(center, center, size, 0.0),
+            3.0 * control::waypointDirectionDensity(center, center, size, 0.5 * core::kPi));
+  const Eigen::Vector2d right_edge(0.5, 0.0);
+  EXPECT_DOUBLE_EQ(control::waypointDirectionDensity(right_edge, center, size, 0.0), 0.0);
+  EXPECT_NEAR(control::waypointDirectionDensity(right_edge, center, size, core::kPi), 0.64 / (2.0 * 0.8 * 0.43), 1e-12);
+  EXPECT_THROW(control::waypointDirectionDensity(center, center, Eigen::Vector2d(0.8, 0.0), 0.0), core::InvalidInput);
+
+  control::TargetFilterConfig bad;
+  bad.model = control::TargetModel::ConstantVelocity;
+  bad.jump_window = 3.0;
+  bad.region_size = Eigen::Vector2d(0.8, 0.43);
+  EXPECT_THROW(control::PlanarTargetFilter{bad}, core::InvalidInput);  // needs constant-speed legs
+  bad.constant_speed = true;
+  EXPECT_NO_THROW(control::PlanarTargetFilter{bad});
+  bad.region_size = Eigen::Vector2d(0.8, 0.0);
+  EXPECT_THROW(control::PlanarTargetFilter{bad}, core::InvalidInput);
+  bad.region_size = Eigen::Vector2d(-0.8, -0.4);
+  EXPECT_THROW(control::PlanarTargetFilter{bad}, core::InvalidInput);
+  bad.region_size = Eigen::Vector2d(0.8, 0.43);
+  bad.jump_decision = "posterior";
+  EXPECT_THROW(control::PlanarTargetFilter{bad}, core::InvalidInput);  // needs the soft mixture
+  bad.jump_rate = 1.0;
+  EXPECT_NO_THROW(control::PlanarTargetFilter{bad});
+  bad.jump_posterior = 1.0;
+  EXPECT_THROW(control::PlanarTargetFilter{bad}, core::InvalidInput);
+  bad.jump_posterior = 0.99;
+  bad.jump_decision = "vote";
+  EXPECT_THROW(control::PlanarTargetFilter{bad}, core::InvalidInput);
+}
+
+TEST(PlanarTargetFilter, WaypointRegionOnARandomPolyline) {
+  // The same random polylines, whose waypoints are uniform in the 0.8 x 0.43 m box: the shipped random
+  // filter without and with that box as its waypoint region (direction prior and turn odds), and with
+  // its jumps then decided by the mixture's posterior instead of the chi-square test.
+  control::TargetFilterConfig legs;  // config/pan_tilt_random.yaml before the region
+  legs.model = control::TargetModel::ConstantVelocity;
+  legs.q = 1e-5;
+  legs.init_velocity_sigma = 0.3;
+  legs.jump_window = 3.0;
+  legs.jump_threshold = 15.0;
+  legs.jump_min_samples = 8;
+  legs.jump_rate = 1.0;
+  legs.jump_prior_sigma = 0.2;
+  legs.constant_speed = true;
+  legs.constant_speed_sigma = 0.005;
+  legs.jump_corner_sigma = 0.01;
+  legs.jump_evidence = "legs";
+  control::TargetFilterConfig region = legs;
+  region.region_size = Eigen::Vector2d(0.80, 0.43);
+  control::TargetFilterConfig posterior = region;  // config/pan_tilt_random.yaml
+  posterior.jump_decision = "posterior";
+  posterior.jump_posterior = 0.99;
+  const Eigen::Vector2d sigma(0.036, 0.021);
+  const double duration = 40.0, score_from = 8.0;
+  double r_legs = 0.0, r_region = 0.0, r_posterior = 0.0;
+  for (std::uint64_t seed = 1; seed <= 4; ++seed) {
+    std::vector<double> corners;
+    const auto track = randomPolyline(seed, duration, corners);
+    r_legs += scoreLegs(legs, track, corners, 0.15, sigma, duration, score_from, seed, false, nullptr).rms / 4.0;
+    r_region += scoreLegs(region, track, corners, 0.15, sigma, duration, score_from, seed, false, nullptr).rms / 4.0;
+    r_posterior += scoreLegs(posterior, track, corners, 0.15, sigma, duration, score_from, seed, false, nullptr).rms / 4.0;
+  }
+  std::cout << "random polyline, RMS (mm): legs " << 1e3 * r_legs << ", legs + waypoint region " << 1e3 * r_region
+            << ", + jumps decided by the posterior " << 1e3 * r_posterior << "\n";
+  EXPECT_LT(r_region, 0.97 * r_legs);
+  EXPECT_LT(r_posterior, 0.97 * r_region);
+}
+
 namespace {
 // Kinematic closed loop without images: the target on a plane 1.3 m in front, seen through the
 // exact projection with noise on the plane coordinates. Returns the RMS image error (rad).

@@ -201,9 +201,16 @@ PanTiltScenarioConfig loadPanTiltScenarioConfig(const io::ConfigNode& root) {
     c.control.filter.jump_prior_sigma = f.getOr<double>("jump_prior_sigma", c.control.filter.jump_prior_sigma);
     c.control.filter.turn_prior_weight = f.getOr<double>("turn_prior_weight", c.control.filter.turn_prior_weight);
     c.control.filter.jump_evidence = f.getChoiceOr("jump_evidence", {"kink", "legs"}, c.control.filter.jump_evidence);
+    c.control.filter.jump_decision = f.getChoiceOr("jump_decision", {"test", "posterior"}, c.control.filter.jump_decision);
+    c.control.filter.jump_posterior = f.getOr<double>("jump_posterior", c.control.filter.jump_posterior);
     c.control.filter.turn_prior_sigma_deg =
         f.getOr<double>("turn_prior_sigma_deg", c.control.filter.turn_prior_sigma_deg);
     c.control.filter.imm_sojourn = f.getOr<Eigen::Vector3d>("imm_sojourn", c.control.filter.imm_sojourn);
+    if (f.has("region")) {
+      const auto g = f.child("region");
+      c.control.filter.region_center = g.get<Eigen::Vector2d>("center");
+      c.control.filter.region_size = g.get<Eigen::Vector2d>("size");
+    }
   }
   {
     const auto r = root.child("run");
@@ -659,6 +666,8 @@ PanTiltReplayMetrics replayPanTiltFilter(const PanTiltScenarioConfig& cfg, std::
     fc.constant_speed_sigma = 0.0;
     fc.turn_prior_weight = cfg.control.filter.turn_prior_weight;  // the config's learnt-turn prior, if any
     fc.turn_prior_sigma_deg = cfg.control.filter.turn_prior_sigma_deg;
+    fc.region_center = cfg.control.filter.region_center;  // and its waypoint region, if any
+    fc.region_size = cfg.control.filter.region_size;
     oracle.emplace(fc);
     corners = path.cornerTimes(cfg.duration);
   }

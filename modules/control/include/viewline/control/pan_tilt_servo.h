@@ -125,10 +125,23 @@ struct TargetFilterConfig {
   double jump_rate = 0.0;                ///< 1/s, prior rate of jumps; > 0: soft jump mixture (see below)
   double jump_prior_sigma = 0.15;        ///< m/s, prior std of a velocity jump per axis (soft mixture)
   std::string jump_evidence = "kink";    ///< soft mixture's Bayes factors: "kink" (free Δv) or "legs" (see below)
+  std::string jump_decision = "test";    ///< what declares a jump: "test" (jump_threshold) or "posterior" (see below)
+  double jump_posterior = 0.99;          ///< "posterior": the soft mixture's jump mass that declares a jump
+  /// Waypoint region (constant-speed legs; size 0: none): the target turns at points spread uniformly over
+  /// this box (plane coordinates, m) and never leaves it. See "Waypoint region" below.
+  Eigen::Vector2d region_center = Eigen::Vector2d::Zero();
+  Eigen::Vector2d region_size = Eigen::Vector2d::Zero();  ///< (width, height), m
+  bool hasRegion() const { return region_size.x() > 0.0 && region_size.y() > 0.0; }
   double gate_probability = 0.9999;      ///< chi-square (2 dof) gate on the NIS
   int reinit_after = 3;                  ///< consecutive gated-out measurements that re-initialise
   void validate() const;
 };
+
+/// The density p(θ) = R(θ)² / (2A) of the direction θ from c to a point drawn uniformly in the box
+/// (centre, size = (width, height), area A), R(θ) the distance from c to the box's boundary along
+/// (cos θ, sin θ); c is clamped into the box. ∫ p dθ over [−π, π) = 1. (The waypoint-region prior.)
+double waypointDirectionDensity(const Eigen::Vector2d& c, const Eigen::Vector2d& center, const Eigen::Vector2d& size,
+                                double theta);
 
 /// Kalman filter of a target moving on a plane, state (p, v[, a]) in plane coordinates (m),
 /// models built as continuous-time systems and discretised exactly (estimation::discretize,
@@ -173,6 +186,21 @@ struct TargetFilterConfig {
 /// is instead the evidence of the measurements after t_j under a constant-speed leg from x(j|j) (θ with
 /// its learnt-turn prior) over their evidence under "straight on from x(j|j)" (both linear-Gaussian,
 /// closed form): a specific alternative (this speed, these turns), so the mixture turns sooner.
+/// Jump decision "posterior" (soft mixture on): a jump is declared, at the most probable t_j, once the
+/// mixture's hypotheses "a jump at t_j" that have jump_min_samples measurements after t_j hold more than
+/// jump_posterior of its posterior mass, instead of when the test statistic passes jump_threshold; the
+/// prior odds then count, and jump_threshold is not used.
+/// Waypoint region (region_size > 0; constant-speed legs): the legs join waypoints drawn uniformly in a
+/// known box B (area A) — a target confined to a known workspace, e.g. [T]'s projection screen. From a
+/// corner c, the next waypoint w is uniform in B, so in polar coordinates about c its density is r / A
+/// for r < R(θ), R(θ) the distance from c to B's boundary along u(θ). Hence:
+///  - a new leg's direction has the prior p(θ) = R(θ)² / (2A) (more room, more likely; ∫ p dθ = 1),
+///    multiplied with the learnt-turn prior when both are on (then normalised on a grid);
+///  - the soft mixture's prior odds of "the turn was at t_j" against "no turn yet" come from where the
+///    target is along its leg: with s the distance travelled from the leg's start c along u and R = R(θ_u),
+///    P(turn in (s_{j−1}, s_j]) : P(no turn by s_n) = (s_j² − s_{j−1}²) : (R² − s_n²),
+///    instead of jump_rate × (t_j − t_{j−1}) : 1. A leg cannot leave B, so the odds of a turn grow without
+///    bound as the target nears the boundary, and are small just after a corner.
 class PlanarTargetFilter {
 public:
   explicit PlanarTargetFilter(const TargetFilterConfig& config = {});
@@ -243,6 +271,11 @@ private:
   int refineCornerTime(int j) const;  ///< the constant-speed leg's most likely start near history_[j]
   bool legEvidenceMixture() const;    ///< the soft mixture's Bayes factors from constant-speed legs
   double legBayesFactor(int j) const; ///< log BF of a leg from history_[j] against straight on
+  /// Distance from c (clamped into the region) to the region's boundary along u(θ) (region set).
+  double regionReach(const Eigen::Vector2d& c, double theta) const;
+  /// log prior odds of a turn at each soft-mixture candidate j (index into history_) against none,
+  /// from the waypoint region; empty if it does not apply (no region, or the leg's direction unknown).
+  std::vector<double> regionJumpOdds() const;
   std::shared_ptr<const Leg> leg_;  ///< the current constant-speed leg (immutable: copies share it until it changes)
   std::optional<estimation::StateEstimate> output_;  ///< the soft mixture, when it differs from state_
   void learnSpeed(std::size_t end);  ///< s_k of the segment history_[0..end]
