@@ -77,6 +77,7 @@ int main(int argc, char** argv) {
       std::printf("  rmse filtered (cm)          x %.4f  y %.4f\n", r.rmse_filtered_cm.x(), r.rmse_filtered_cm.y());
       std::printf("  rmse predicted %.4f s ahead (cm)  x %.4f  y %.4f  (%.2f px)\n", r.horizon_s, r.rmse_predicted_cm.x(),
                   r.rmse_predicted_cm.y(), r.predicted_error_px);
+      std::printf("  predicted %.4f s ahead, what the frames see (px)  %.2f\n", r.frame_horizon_s, r.frame_predicted_error_px);
       return 0;
     }
 

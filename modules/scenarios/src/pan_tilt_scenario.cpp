@@ -608,7 +608,9 @@ nlohmann::json PanTiltReplayMetrics::toJson() const {
           {"rmse_filtered_cm", {rmse_filtered_cm.x(), rmse_filtered_cm.y()}},
           {"horizon_s", horizon_s},
           {"rmse_predicted_cm", {rmse_predicted_cm.x(), rmse_predicted_cm.y()}},
-          {"predicted_error_px", predicted_error_px}};
+          {"predicted_error_px", predicted_error_px},
+          {"frame_horizon_s", frame_horizon_s},
+          {"frame_predicted_error_px", frame_predicted_error_px}};
 }
 
 PanTiltReplayMetrics replayPanTiltFilter(const PanTiltScenarioConfig& cfg, std::uint64_t seed,
@@ -677,7 +679,8 @@ PanTiltReplayMetrics replayPanTiltFilter(const PanTiltScenarioConfig& cfg, std::
   const double occ1 = cfg.occlusion_start >= 0.0 ? cfg.occlusion_start + cfg.occlusion_duration : 1e300;
   PanTiltReplayMetrics out;
   out.horizon_s = cfg.processing_delay + cfg.unit.latency + cfg.control.lead;
-  Accumulator mx, my, fx_, fy_, px_, py_;
+  out.frame_horizon_s = (std::floor((cfg.processing_delay + cfg.unit.latency) * cfg.fps + 1e-9) + 1.0) / cfg.fps;
+  Accumulator mx, my, fx_, fy_, px_, py_, frame_p;
   io::CsvWriter* csv = nullptr;
   if (log != nullptr && log->enabled())
     csv = &log->stream("replay_frames", {"t", "truth_x", "truth_y", "detected", "meas_x", "meas_y", "filt_x", "filt_y",
@@ -742,6 +745,7 @@ PanTiltReplayMetrics replayPanTiltFilter(const PanTiltScenarioConfig& cfg, std::
       const Vector2d e = filterAt(t + out.horizon_s).p - path.position(t + out.horizon_s);
       px_.add(e.x() * e.x());
       py_.add(e.y() * e.y());
+      frame_p.add((filterAt(t + out.frame_horizon_s).p - path.position(t + out.frame_horizon_s)).squaredNorm());
     }
   }
   out.jumps = oracle ? corners.size() : ctrl.filter().jumps();
@@ -749,6 +753,7 @@ PanTiltReplayMetrics replayPanTiltFilter(const PanTiltScenarioConfig& cfg, std::
   out.rmse_filtered_cm = 100.0 * Vector2d(fx_.rms(), fy_.rms());
   out.rmse_predicted_cm = 100.0 * Vector2d(px_.rms(), py_.rms());
   out.predicted_error_px = std::hypot(px_.rms(), py_.rms()) * cfg.fx / cfg.screen_distance;
+  out.frame_predicted_error_px = frame_p.rms() * cfg.fx / cfg.screen_distance;
   return out;
 }
 

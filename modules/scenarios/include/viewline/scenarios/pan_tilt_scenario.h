@@ -189,6 +189,11 @@ struct PanTiltReplayMetrics {
   double horizon_s = 0.0;  ///< processing delay + latency + lead: how far ahead the law predicts
   Eigen::Vector2d rmse_predicted_cm = Eigen::Vector2d::Zero();  ///< x(t + horizon | t) − truth, every frame
   double predicted_error_px = 0.0;  ///< its RMS norm × fx / screen distance (px near the image centre)
+  /// The horizon the image error sees: a command issued after capture t acts from t + processing delay +
+  /// latency, so the first frame it moves is n frames later, n = ⌊(processing delay + latency) fps⌋ + 1
+  /// (66.7 ms at 40 ms and 30 fps), and each frame's error is set by a prediction that old.
+  double frame_horizon_s = 0.0;
+  double frame_predicted_error_px = 0.0;  ///< as predicted_error_px, at frame_horizon_s
   nlohmann::json toJson() const;
 };
 /// oracle_corners (rectangle and random paths): instead of the config's filter, a bound: a constant-speed
