@@ -244,6 +244,32 @@ std::function<Eigen::Vector2d(double)> randomPolyline(std::uint64_t seed, double
     return pts[i - 1] + a * (pts[i] - pts[i - 1]);
   };
 }
+
+// Round 4's random filter: CV, corners by the kink test, soft mixture from kinks.
+control::TargetFilterConfig randomKinksFilter() {
+  control::TargetFilterConfig c;
+  c.model = control::TargetModel::ConstantVelocity;
+  c.q = 0.003;
+  c.init_velocity_sigma = 0.3;
+  c.jump_window = 3.0;
+  c.jump_threshold = 15.0;
+  c.jump_min_samples = 8;
+  c.jump_rate = 0.5;
+  c.jump_prior_sigma = 0.2;
+  return c;
+}
+
+// Round 6's random filter: constant-speed legs, soft mixture from leg evidence, uniform turn prior.
+control::TargetFilterConfig randomLegsFilter() {
+  control::TargetFilterConfig c = randomKinksFilter();
+  c.q = 1e-5;
+  c.jump_rate = 1.0;
+  c.constant_speed = true;
+  c.constant_speed_sigma = 0.005;
+  c.jump_corner_sigma = 0.01;
+  c.jump_evidence = "legs";
+  return c;
+}
 }  // namespace
 
 TEST(PlanarTargetFilter, SoftJumpsAndConstantSpeedLegsOnASquare) {
@@ -341,24 +367,9 @@ TEST(PlanarTargetFilter, SoftJumpsAndConstantSpeedLegsOnASquare) {
 
 TEST(PlanarTargetFilter, LegEvidenceOnARandomPolyline) {
   // The pan-tilt app's random path: uniformly random turns every ~2 s, [T]'s 10 % noise (σ 3.6 / 2.1 cm).
-  // Round 4's random filter (CV, corners by the kink test, soft mixture from kinks) against the shipped
-  // one (constant-speed legs, soft mixture from leg evidence, uniform turn prior), and the oracle.
-  control::TargetFilterConfig kinks;
-  kinks.model = control::TargetModel::ConstantVelocity;
-  kinks.q = 0.003;
-  kinks.init_velocity_sigma = 0.3;
-  kinks.jump_window = 3.0;
-  kinks.jump_threshold = 15.0;
-  kinks.jump_min_samples = 8;
-  kinks.jump_rate = 0.5;
-  kinks.jump_prior_sigma = 0.2;
-  control::TargetFilterConfig legs = kinks;  // config/pan_tilt_random.yaml
-  legs.q = 1e-5;
-  legs.jump_rate = 1.0;
-  legs.constant_speed = true;
-  legs.constant_speed_sigma = 0.005;
-  legs.jump_corner_sigma = 0.01;
-  legs.jump_evidence = "legs";
+  // Round 4's random filter (CV, corners by the kink test, soft mixture from kinks) against round 6's
+  // (constant-speed legs, soft mixture from leg evidence, uniform turn prior), and the oracle.
+  const control::TargetFilterConfig kinks = randomKinksFilter(), legs = randomLegsFilter();
   control::TargetFilterConfig oracle = legs;
   oracle.jump_threshold = 1e300;
   oracle.jump_rate = 0.0;
@@ -426,22 +437,10 @@ TEST(PlanarTargetFilter, WaypointDirectionDensityAndNewKeys) {
 }
 
 TEST(PlanarTargetFilter, WaypointRegionOnARandomPolyline) {
-  // The same random polylines, whose waypoints are uniform in the 0.8 x 0.43 m box: the shipped random
+  // The same random polylines, whose waypoints are uniform in the 0.8 x 0.43 m box: round 6's random
   // filter without and with that box as its waypoint region (direction prior and turn odds), and with
   // its jumps then decided by the mixture's posterior instead of the chi-square test.
-  control::TargetFilterConfig legs;  // config/pan_tilt_random.yaml before the region
-  legs.model = control::TargetModel::ConstantVelocity;
-  legs.q = 1e-5;
-  legs.init_velocity_sigma = 0.3;
-  legs.jump_window = 3.0;
-  legs.jump_threshold = 15.0;
-  legs.jump_min_samples = 8;
-  legs.jump_rate = 1.0;
-  legs.jump_prior_sigma = 0.2;
-  legs.constant_speed = true;
-  legs.constant_speed_sigma = 0.005;
-  legs.jump_corner_sigma = 0.01;
-  legs.jump_evidence = "legs";
+  const control::TargetFilterConfig legs = randomLegsFilter();  // round 6
   control::TargetFilterConfig region = legs;
   region.region_size = Eigen::Vector2d(0.80, 0.43);
   control::TargetFilterConfig posterior = region;  // config/pan_tilt_random.yaml
