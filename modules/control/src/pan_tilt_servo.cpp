@@ -166,7 +166,8 @@ estimation::NonlinearTransition cvWithOmega(double q, double q_omega, double dt)
 //   β | θ ~ N(Λ⁻¹ η, Λ⁻¹),  log p(z | θ) = −½ (zz + β₀ᵀ P₀⁻¹ β₀ − ηᵀ Λ⁻¹ η) − ½ log det Λ  (+ const).
 // The speed is thus re-estimated on every leg around the learnt ŝ (it absorbs a scale error of the
 // measurements), and only θ needs a grid. θ's prior is uniform, or the learnt-turn mixture
-// p(θ) = (1 − w) / 2π + w / K Σ_k N_wrapped(θ; μ_k, σ²): logPrior() is log(2π p(θ)), 0 when uniform.
+// p(θ) = (1 − w) / 2π + w / K Σ_k N_wrapped(θ; μ_k, σ²), times the waypoint-region prior R(θ)² / 2A when a
+// region is set (normalised on a grid when both are on): logPrior() is log(2π p(θ)), 0 when uniform.
 namespace {
 // Distance from c (inside the box [lo, hi]) to the box's boundary along u(θ).
 double boxReach(const Eigen::Vector2d& c, const Eigen::Vector2d& lo, const Eigen::Vector2d& hi, double th) {
