@@ -78,6 +78,9 @@ int main(int argc, char** argv) {
       std::printf("  rmse predicted %.4f s ahead (cm)  x %.4f  y %.4f  (%.2f px)\n", r.horizon_s, r.rmse_predicted_cm.x(),
                   r.rmse_predicted_cm.y(), r.predicted_error_px);
       std::printf("  predicted %.4f s ahead, what the frames see (px)  %.2f\n", r.frame_horizon_s, r.frame_predicted_error_px);
+      if (r.region_dropped)
+        std::printf("  WARNING: the target left filter.region (measurements outside it): the region was dropped; "
+                    "check its center and size\n");
       return 0;
     }
 
@@ -135,6 +138,9 @@ int main(int argc, char** argv) {
       std::printf("\n");
     }
     std::printf("  filter: %zu velocity jumps (corners) detected\n", o.filter_jumps);
+    if (o.filter_region_dropped)
+      std::printf("  WARNING: the target left filter.region (measurements outside it): the region was dropped; "
+                  "check its center and size\n");
     std::printf("  %.1f ms per frame (render + detect + control)\n", o.wall_ms_per_frame);
     return 0;
   } catch (const core::Error& e) {

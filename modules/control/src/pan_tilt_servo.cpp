@@ -422,6 +422,7 @@ PlanarTargetFilter::Update PlanarTargetFilter::update(core::Timestamp t, const E
                                                       const Eigen::Matrix2d& R) {
   output_.reset();
   Update out = step(t, z, R);
+  if (out.accepted) checkRegion(z, R);
   // Gated-out measurements are kept for the jump test too: after a sharp corner the first
   // measurements of the new leg are the ones the gate rejects, and they are the evidence of the jump.
   if (config_.jump_window <= 0.0 || out.reinitialized) return out;
@@ -668,7 +669,7 @@ std::vector<double> PlanarTargetFilter::regionJumpOdds() const {
   // target is s (t − t_c) along it at t, and the next waypoint lies on the ray within R = R(θ_u) with
   // density ∝ r (see the class comment). odds_j = (s_j² − s_{j−1}²) / (R² − s_n²), s_n now; the
   // denominator is floored at (1 mm)² once the straight leg would have left the region.
-  if (!config_.hasRegion() || !leg_ || history_.size() < 2) return {};
+  if (!regionActive() || !leg_ || history_.size() < 2) return {};
   const Eigen::Vector2d p = state_.x().head<2>(), v = state_.x().segment<2>(2);
   const double speed = v.norm();
   if (!(speed > 1e-6)) return {};
@@ -684,6 +685,16 @@ std::vector<double> PlanarTargetFilter::regionJumpOdds() const {
     odds[j] = std::log(std::max(b * b - a * a, 1e-300)) - log_den;
   }
   return odds;
+}
+
+void PlanarTargetFilter::checkRegion(const Eigen::Vector2d& p, const Eigen::Matrix2d& R) {
+  if (!regionActive()) return;
+  const Eigen::Vector2d sd = R.diagonal().cwiseMax(0.0).cwiseSqrt();
+  const Eigen::Vector2d half = 0.5 * config_.region_size;
+  const Eigen::Vector2d outside = ((p - config_.region_center).cwiseAbs() - half).cwiseMax(0.0);
+  const bool out = (outside.array() > 2.0 * sd.array()).any();
+  region_outside_run_ = out ? region_outside_run_ + 1 : 0;
+  if (region_outside_run_ >= 5) region_dropped_ = true;
 }
 
 bool PlanarTargetFilter::legEvidenceMixture() const {
@@ -808,7 +819,7 @@ PlanarTargetFilter::Leg PlanarTargetFilter::makeLeg(core::Timestamp t_c, const E
     leg.prior_weight = config_.turn_prior_weight;
     leg.prior_sigma = config_.turn_prior_sigma_deg * core::kPi / 180.0;
   }
-  if (config_.hasRegion()) {
+  if (regionActive()) {
     // The corner clamped into the region (an estimate can fall just outside it).
     const Eigen::Vector2d half = 0.5 * config_.region_size;
     leg.region = true;

@@ -462,6 +462,33 @@ TEST(PlanarTargetFilter, WaypointRegionOnARandomPolyline) {
   EXPECT_LT(r_posterior, 0.97 * r_region);
 }
 
+TEST(PlanarTargetFilter, AWrongWaypointRegionIsDropped) {
+  // A box of half the size: the measurements leave it, the filter drops it and goes on as without one.
+  // The true box is never dropped on these tracks.
+  control::TargetFilterConfig region = randomLegsFilter();
+  region.region_size = Eigen::Vector2d(0.80, 0.43);
+  region.jump_decision = "posterior";
+  control::TargetFilterConfig wrong = region;
+  wrong.region_size = Eigen::Vector2d(0.40, 0.215);
+  control::TargetFilterConfig none = region;
+  none.region_size = Eigen::Vector2d::Zero();
+  const Eigen::Vector2d sigma(0.036, 0.021);
+  const double duration = 40.0, score_from = 8.0;
+  double r_wrong = 0.0, r_none = 0.0;
+  for (std::uint64_t seed = 1; seed <= 4; ++seed) {
+    std::vector<double> corners;
+    const auto track = randomPolyline(seed, duration, corners);
+    control::PlanarTargetFilter right_filter(region), wrong_filter(wrong);
+    scoreLegs(region, track, corners, 0.15, sigma, duration, score_from, seed, false, &right_filter);
+    EXPECT_FALSE(right_filter.regionDropped()) << seed;
+    r_wrong += scoreLegs(wrong, track, corners, 0.15, sigma, duration, score_from, seed, false, &wrong_filter).rms / 4.0;
+    EXPECT_TRUE(wrong_filter.regionDropped()) << seed;
+    r_none += scoreLegs(none, track, corners, 0.15, sigma, duration, score_from, seed, false, nullptr).rms / 4.0;
+  }
+  std::cout << "random polyline, RMS (mm): half-size region " << 1e3 * r_wrong << ", no region " << 1e3 * r_none << "\n";
+  EXPECT_LT(r_wrong, 1.05 * r_none);
+}
+
 namespace {
 // Kinematic closed loop without images: the target on a plane 1.3 m in front, seen through the
 // exact projection with noise on the plane coordinates. Returns the RMS image error (rad).

@@ -355,6 +355,7 @@ nlohmann::json PanTiltRunMetrics::toJson() const {
             {"reacquisitions", reacquisitions},
             {"frames_searching", frames_searching}}},
           {"filter_jumps", filter_jumps},
+          {"filter_region_dropped", filter_region_dropped},
           {"wall_ms_per_frame", wall_ms_per_frame}};
 }
 
@@ -589,6 +590,7 @@ PanTiltRunMetrics runPanTilt(const PanTiltScenarioConfig& cfg, std::uint64_t see
     m.rmse_filtered_cm = 100.0 * Vector2d(fx_.rms(), fy_.rms());
     m.reacquisitions = ours->reacquisitions();
     m.filter_jumps = ours->filter().jumps();
+    m.filter_region_dropped = ours->filter().regionDropped();
   }
   m.detection_pixel_rmse_px = det_px.rms();
   m.rate_violations = unit.rateViolations();
@@ -610,7 +612,8 @@ nlohmann::json PanTiltReplayMetrics::toJson() const {
           {"rmse_predicted_cm", {rmse_predicted_cm.x(), rmse_predicted_cm.y()}},
           {"predicted_error_px", predicted_error_px},
           {"frame_horizon_s", frame_horizon_s},
-          {"frame_predicted_error_px", frame_predicted_error_px}};
+          {"frame_predicted_error_px", frame_predicted_error_px},
+          {"region_dropped", region_dropped}};
 }
 
 PanTiltReplayMetrics replayPanTiltFilter(const PanTiltScenarioConfig& cfg, std::uint64_t seed,
@@ -749,6 +752,7 @@ PanTiltReplayMetrics replayPanTiltFilter(const PanTiltScenarioConfig& cfg, std::
     }
   }
   out.jumps = oracle ? corners.size() : ctrl.filter().jumps();
+  out.region_dropped = oracle ? oracle->regionDropped() : ctrl.filter().regionDropped();
   out.rmse_measured_cm = 100.0 * Vector2d(mx.rms(), my.rms());
   out.rmse_filtered_cm = 100.0 * Vector2d(fx_.rms(), fy_.rms());
   out.rmse_predicted_cm = 100.0 * Vector2d(px_.rms(), py_.rms());

@@ -201,6 +201,11 @@ double waypointDirectionDensity(const Eigen::Vector2d& c, const Eigen::Vector2d&
 ///    P(turn in (s_{j−1}, s_j]) : P(no turn by s_n) = (s_j² − s_{j−1}²) : (R² − s_n²),
 ///    instead of jump_rate × (t_j − t_{j−1}) : 1. A leg cannot leave B, so the odds of a turn grow without
 ///    bound as the target nears the boundary, and are small just after a corner.
+///  The model says the target never leaves B. Once 5 accepted measurements in a row lie outside B by
+///  more than 2 of their standard deviations (on either axis), the region is taken to be wrong and is
+///  dropped for good (regionDropped()): the filter goes on as without one (θ uniform, jump_rate odds). A
+///  too small or shifted box would otherwise make every step near its edge look like a turn. (The
+///  measurements, not the estimate: a turn at the edge is detected late, and the estimate overshoots.)
 class PlanarTargetFilter {
 public:
   explicit PlanarTargetFilter(const TargetFilterConfig& config = {});
@@ -241,6 +246,8 @@ public:
   /// The learnt speed ŝ (m/s) and its variance; 0 / infinity before the first segment has ended.
   double speedEstimate() const { return speed_info_ > 0.0 ? speed_sum_ / speed_info_ : 0.0; }
   double speedVariance() const { return speed_info_ > 0.0 ? 1.0 / speed_info_ : 1e300; }
+  /// The configured waypoint region was dropped because the estimate left it (see the class comment).
+  bool regionDropped() const { return region_dropped_; }
   /// The turn angles (rad, in [−π, π], oldest first) learnt at the last corners (turn_prior_weight > 0).
   const std::vector<double>& learntTurns() const { return turns_; }
 
@@ -276,6 +283,10 @@ private:
   /// log prior odds of a turn at each soft-mixture candidate j (index into history_) against none,
   /// from the waypoint region; empty if it does not apply (no region, or the leg's direction unknown).
   std::vector<double> regionJumpOdds() const;
+  bool regionActive() const { return config_.hasRegion() && !region_dropped_; }
+  void checkRegion(const Eigen::Vector2d& z, const Eigen::Matrix2d& R);  ///< drops the region (see the class comment)
+  bool region_dropped_ = false;
+  int region_outside_run_ = 0;
   std::shared_ptr<const Leg> leg_;  ///< the current constant-speed leg (immutable: copies share it until it changes)
   std::optional<estimation::StateEstimate> output_;  ///< the soft mixture, when it differs from state_
   void learnSpeed(std::size_t end);  ///< s_k of the segment history_[0..end]

@@ -152,6 +152,7 @@ struct PanTiltRunMetrics {
   std::size_t reacquisitions = 0;
   std::size_t frames_searching = 0;
   std::size_t filter_jumps = 0;              ///< velocity jumps (corners) the filter detected (ours)
+  bool filter_region_dropped = false;        ///< ours: filter.region was dropped (the target left it: a wrong box)
   double wall_ms_per_frame = 0.0;
 
   nlohmann::json toJson() const;
@@ -194,6 +195,7 @@ struct PanTiltReplayMetrics {
   /// (66.7 ms at 40 ms and 30 fps), and each frame's error is set by a prediction that old.
   double frame_horizon_s = 0.0;
   double frame_predicted_error_px = 0.0;  ///< as predicted_error_px, at frame_horizon_s
+  bool region_dropped = false;            ///< the filter dropped filter.region (the target left it)
   nlohmann::json toJson() const;
 };
 /// oracle_corners (rectangle and random paths): instead of the config's filter, a bound: a constant-speed
