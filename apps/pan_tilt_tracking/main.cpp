@@ -7,6 +7,8 @@
 //   pan_tilt_tracking --config <variant>.yaml --seed 1 --replay <log>/predictive_frames.csv   (filter only)
 //   pan_tilt_tracking --config <path>.yaml --seed 1 --replay <log>/predictive_frames.csv --oracle-corners
 //       (a bound: the filter told the true corner times and speed; rectangle and random paths)
+//   pan_tilt_tracking --config config/pan_tilt_random.yaml --seed 1 --replay <log>/predictive_frames.csv --particles
+//       (the reference: the waypoint particle filter, posterior mean under the random path's generator)
 
 #include <CLI/CLI.hpp>
 #include <cmath>
@@ -28,7 +30,8 @@ int main(int argc, char** argv) {
   std::string config_path, log_dir, summary_path, replay_path;
   std::uint64_t seed = 1;
   double duration = -1.0;
-  bool headless = false, display = false, no_baseline = false, oracle_corners = false;
+  bool headless = false, display = false, no_baseline = false, oracle_corners = false, use_particles = false;
+  std::size_t particles = 20000;
   app.add_option("--config", config_path, "scenario YAML (config/pan_tilt_*.yaml)")->required();
   app.add_option("--seed", seed, "random seed (path, sensor noise, [T] measurement noise)");
   app.add_option("--duration", duration, "simulated seconds (overrides run.duration)");
@@ -43,11 +46,23 @@ int main(int argc, char** argv) {
   app.add_flag("--oracle-corners", oracle_corners,
                "with --replay (rectangle, random): instead of the config's filter, a bound: constant-speed legs "
                "told the path's true corner times and speed");
+  app.add_flag("--particles", use_particles,
+               "with --replay (random path): instead of the config's filter, the reference: a particle filter of "
+               "the path's generator (waypoints uniform in filter.region, one constant speed)");
+  app.add_option("--particle-count", particles, "particles of --particles")->check(CLI::Range(10, 10000000));
   CLI11_PARSE(app, argc, argv);
-  if (oracle_corners && replay_path.empty()) {
-    std::cerr << "--oracle-corners needs --replay\n";
+  if ((oracle_corners || use_particles) && replay_path.empty()) {
+    std::cerr << (oracle_corners ? "--oracle-corners" : "--particles") << " needs --replay\n";
     return 2;
   }
+  if (oracle_corners && use_particles) {
+    std::cerr << "--oracle-corners and --particles are exclusive\n";
+    return 2;
+  }
+  const scenarios::PanTiltReplayEstimator estimator =
+      oracle_corners  ? scenarios::PanTiltReplayEstimator::OracleCorners
+      : use_particles ? scenarios::PanTiltReplayEstimator::WaypointParticles
+                      : scenarios::PanTiltReplayEstimator::Filter;
   if (headless && display) {
     std::cerr << "--headless and --display are exclusive\n";
     return 2;
@@ -63,12 +78,16 @@ int main(int argc, char** argv) {
     if (!replay_path.empty()) {
       io::LogDirectory replay_log(log_dir);
       const scenarios::PanTiltReplayMetrics r =
-          scenarios::replayPanTiltFilter(cfg, seed, replay_path, oracle_corners, replay_log.enabled() ? &replay_log : nullptr);
+          scenarios::replayPanTiltFilter(cfg, seed, replay_path, estimator, replay_log.enabled() ? &replay_log : nullptr,
+                                         particles);
       replay_log.flush();
       if (!summary_path.empty()) io::writeJsonFile(summary_path, r.toJson());
       if (oracle_corners)
         std::printf("replay of %s (seed %llu, oracle: constant-speed legs at the %zu true corners): %zu measurements\n",
                     replay_path.c_str(), static_cast<unsigned long long>(seed), r.jumps, r.measurements);
+      else if (use_particles)
+        std::printf("replay of %s (seed %llu, reference: waypoint particle filter, %zu particles): %zu measurements\n",
+                    replay_path.c_str(), static_cast<unsigned long long>(seed), particles, r.measurements);
       else
         std::printf("replay of %s (seed %llu, filter %s): %zu measurements, %zu velocity jumps detected\n",
                     replay_path.c_str(), static_cast<unsigned long long>(seed),

@@ -1,9 +1,10 @@
-// pan_tilt_seeds: the issue-6 seed tables of docs/results.md ("Pan-tilt tracking", rounds 4-6) in one
+// pan_tilt_seeds: the issue-6 seed tables of docs/results.md ("Pan-tilt tracking", rounds 4-8) in one
 // command. For every seed, the closed loop of apps/pan_tilt_tracking (ours, then ViSP's law on the same
-// seed: scenarios::runPanTiltComparison), then two filter-only replays of its logged measurements
+// seed: scenarios::runPanTiltComparison), then filter-only replays of its logged measurements
 // (scenarios::replayPanTiltFilter): the config's filter, for its prediction error at the law's horizon
 // and at the one the frames see,
-// and (rectangle, random) the oracle bound told the path's true corner times and speed.
+// and (rectangle, random) the oracle bound told the path's true corner times and speed, and (random, with
+// filter.region) the causal reference: the waypoint particle filter of the path's generator.
 //
 //   build/bench/pan_tilt_seeds --config config/pan_tilt_random.yaml --seeds 10 --jobs 2
 //
@@ -40,8 +41,8 @@ namespace {
 struct SeedResult {
   std::uint64_t seed = 0;
   scenarios::PanTiltComparison run;
-  scenarios::PanTiltReplayMetrics filter, oracle;
-  bool has_oracle = false;
+  scenarios::PanTiltReplayMetrics filter, oracle, reference;
+  bool has_oracle = false, has_reference = false;
   std::string error;  ///< what stopped this seed (the worker threads must not throw)
 };
 
@@ -62,6 +63,7 @@ int main(int argc, char** argv) {
   int seeds = 5, jobs = 2;
   std::uint64_t first_seed = 1;
   double duration = 0.0;
+  std::size_t particles = 100000;
   app.add_option("--config", config_file, "pan-tilt scenario (config/pan_tilt_*.yaml)")->required();
   app.add_option("--seeds", seeds, "number of seeds")->check(CLI::PositiveNumber);
   app.add_option("--first-seed", first_seed, "first seed (then +1 each)");
@@ -69,6 +71,8 @@ int main(int argc, char** argv) {
   app.add_option("--duration", duration, "s per run (0: the config's run.duration)")->check(CLI::NonNegativeNumber);
   app.add_option("--log-dir", log_dir, "keep each seed's logs here (default: a temporary folder, removed)");
   app.add_option("--json", json_file, "write every seed's figures (JSON)");
+  app.add_option("--particles", particles,
+                 "random path with filter.region: particles of the reference replay (waypoint particle filter; 0: none)");
   CLI11_PARSE(app, argc, argv);
 
   try {
@@ -79,6 +83,8 @@ int main(int argc, char** argv) {
     cfg.validate();
     const std::string path = scenarios::pathShapeName(cfg.path.shape);
     const bool corners = cfg.path.shape != sim::PathShape::Circle;
+    const bool reference = particles > 0 && cfg.path.shape == sim::PathShape::Random && cfg.path.corner_radius == 0.0 &&
+                           cfg.control.filter.region_size.x() > 0.0;
     const bool keep = !log_dir.empty();
     const fs::path logs = keep ? fs::path(log_dir)
                                : fs::temp_directory_path() / ("viewline_pan_tilt_seeds_" + std::to_string(::getpid()));
@@ -99,10 +105,16 @@ int main(int argc, char** argv) {
           log.flush();
         }
         const std::string frames = (dir / "predictive_frames.csv").string();
-        r.filter = scenarios::replayPanTiltFilter(cfg, r.seed, frames, false);
+        r.filter = scenarios::replayPanTiltFilter(cfg, r.seed, frames, scenarios::PanTiltReplayEstimator::Filter);
         if (corners) {
-          r.oracle = scenarios::replayPanTiltFilter(cfg, r.seed, frames, true);
+          r.oracle = scenarios::replayPanTiltFilter(cfg, r.seed, frames, scenarios::PanTiltReplayEstimator::OracleCorners);
           r.has_oracle = true;
+        }
+        if (reference) {
+          r.reference = scenarios::replayPanTiltFilter(cfg, r.seed, frames,
+                                                       scenarios::PanTiltReplayEstimator::WaypointParticles, nullptr,
+                                                       particles);
+          r.has_reference = true;
         }
       } catch (const std::exception& e) {
         r.error = e.what();
@@ -123,7 +135,7 @@ int main(int argc, char** argv) {
               << first_seed + results.size() - 1 << " (" << config_file << ")\n\n";
     std::cout << "Filtered RMSE (cm, x / y)" << (t.available ? "; target <= 1/2 [T]: " + pair(0.5 * t.kalman.x(), 0.5 * t.kalman.y()) : std::string())
               << "\n\n| seed | measured | filtered (ours) | oracle (true corners) | met |\n|---|---|---|---|---|\n";
-    std::size_t rmse_met = 0, ratio_met = 0, oracle_over = 0;
+    std::size_t rmse_met = 0, ratio_met = 0, oracle_over = 0, reference_over = 0;
     double ratio_lo = 1e9, ratio_hi = 0.0, ratio_sum = 0.0, max_rate = 0.0, reacq = 0.0;
     std::size_t unsafe = 0;
     std::size_t occluded = 0, lost = 0;  // runs long enough to contain the occlusion; not reacquired
@@ -141,8 +153,8 @@ int main(int argc, char** argv) {
               << " ms that the frames see (the first frame a command moves)"
               << (ratio_target ? "; target: ours <= 1/3 of ViSP's law" : "")
               << "\n\n| seed | ours | ViSP law | ratio | 1/3 baseline | ours, worst | baseline, worst | filter's prediction | oracle's prediction "
-                 "| filter, frames' horizon | oracle, frames' horizon |\n"
-                 "|---|---|---|---|---|---|---|---|---|---|---|\n";
+                 "| filter, frames' horizon | oracle, frames' horizon | reference, frames' horizon |\n"
+                 "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     for (const SeedResult& r : results) {
       const auto& o = r.run.ours;
       const auto& b = r.run.baseline;
@@ -152,6 +164,7 @@ int main(int argc, char** argv) {
       ratio_sum += ratio;
       ratio_met += ratio <= 1.0 / 3.0 ? 1 : 0;
       if (r.has_oracle && r.oracle.frame_predicted_error_px > third) ++oracle_over;
+      if (r.has_reference && r.reference.frame_predicted_error_px > third) ++reference_over;
       for (const auto* m : {&o, &b}) {
         unsafe += m->unsafe_commands + m->rate_violations + m->limit_hits;
         max_rate = std::max(max_rate, m->max_rate_fraction);
@@ -162,11 +175,12 @@ int main(int argc, char** argv) {
         else ++lost;
       }
       char buf[512];
-      std::snprintf(buf, sizeof buf, "| %llu | %.2f | %.2f | **%.3f** | %.2f | %.1f | %.1f | %.2f | %s | %.2f | %s |\n",
+      std::snprintf(buf, sizeof buf, "| %llu | %.2f | %.2f | **%.3f** | %.2f | %.1f | %.1f | %.2f | %s | %.2f | %s | %s |\n",
                     static_cast<unsigned long long>(r.seed), o.image_error_rms_px, b.image_error_rms_px, ratio, third,
                     o.image_error_max_px, b.image_error_max_px, r.filter.predicted_error_px,
                     r.has_oracle ? num(r.oracle.predicted_error_px, 2).c_str() : "–", r.filter.frame_predicted_error_px,
-                    r.has_oracle ? num(r.oracle.frame_predicted_error_px, 2).c_str() : "–");
+                    r.has_oracle ? num(r.oracle.frame_predicted_error_px, 2).c_str() : "–",
+                    r.has_reference ? num(r.reference.frame_predicted_error_px, 2).c_str() : "–");
       std::cout << buf;
     }
     const double n = static_cast<double>(results.size());
@@ -174,6 +188,8 @@ int main(int argc, char** argv) {
     if (ratio_target) std::cout << ", <= 1/3 on " << ratio_met << " of " << results.size() << " seeds";
     if (t.available) std::cout << "; filtered RMSE <= 1/2 [T] on " << rmse_met << " of " << results.size() << " seeds";
     if (corners) std::cout << "; the oracle's prediction at the frames' horizon alone is above 1/3 of the baseline on " << oracle_over << " seeds";
+    if (reference)
+      std::cout << "; the reference's (" << particles << " particles) on " << reference_over << " seeds";
     std::cout << ".\nLimits (both controllers): " << unsafe << " unsafe commands, rate violations and hard-stop hits; largest commanded rate "
               << num(100.0 * max_rate, 0) << " % of the maximum";
     if (occluded > 0) {
@@ -189,6 +205,7 @@ int main(int argc, char** argv) {
         s["seed"] = r.seed;
         s["filter_replay"] = r.filter.toJson();
         if (r.has_oracle) s["oracle_replay"] = r.oracle.toJson();
+        if (r.has_reference) s["reference_replay"] = r.reference.toJson();
         j.push_back(s);
       }
       std::ofstream f(json_file);

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -185,7 +186,8 @@ TEST(PanTiltScenario, ReplayOfALoggedRunReproducesItsFilter) {
   {
     const auto replay_dir = dir / "replay";
     io::LogDirectory replay_log(replay_dir.string());
-    r = scenarios::replayPanTiltFilter(cfg, 7, (dir / "predictive_frames.csv").string(), false, &replay_log);
+    r = scenarios::replayPanTiltFilter(cfg, 7, (dir / "predictive_frames.csv").string(),
+                                       scenarios::PanTiltReplayEstimator::Filter, &replay_log);
     replay_log.flush();
     std::ifstream frames(replay_dir / "replay_frames.csv");
     std::string line;
@@ -216,7 +218,8 @@ TEST(PanTiltScenario, ReplayOfALoggedRunReproducesItsFilter) {
   std::vector<std::string> outlier_row;
   {
     io::LogDirectory outlier_log(outlier_dir.string());
-    ro = scenarios::replayPanTiltFilter(cfg, 7, (dir / "outlier.csv").string(), false, &outlier_log);
+    ro = scenarios::replayPanTiltFilter(cfg, 7, (dir / "outlier.csv").string(),
+                                        scenarios::PanTiltReplayEstimator::Filter, &outlier_log);
     outlier_log.flush();
     std::ifstream frames(outlier_dir / "replay_frames.csv");
     std::string line;
@@ -232,10 +235,12 @@ TEST(PanTiltScenario, ReplayOfALoggedRunReproducesItsFilter) {
   EXPECT_GT(ro.rmse_filtered_cm.x(), 0.0);
   EXPECT_LT(ro.rmse_filtered_cm.x(), 2.0 * r.rmse_filtered_cm.x());  // the outlier did not pull the estimate
   // The oracle bound (legs started at the true corner times) on the same measurements.
-  const auto o = scenarios::replayPanTiltFilter(cfg, 7, (dir / "predictive_frames.csv").string(), true);
+  const auto o = scenarios::replayPanTiltFilter(cfg, 7, (dir / "predictive_frames.csv").string(),
+                                      scenarios::PanTiltReplayEstimator::OracleCorners);
   auto circle = shipped("circle");
   circle.duration = 6.0;
-  EXPECT_THROW(scenarios::replayPanTiltFilter(circle, 7, (dir / "predictive_frames.csv").string(), true),
+  EXPECT_THROW(scenarios::replayPanTiltFilter(circle, 7, (dir / "predictive_frames.csv").string(),
+                                      scenarios::PanTiltReplayEstimator::OracleCorners),
                core::InvalidInput);  // no corners
   std::filesystem::remove_all(dir);
   EXPECT_EQ(o.jumps, 1u);  // corners passed
@@ -250,4 +255,42 @@ TEST(PanTiltScenario, ReplayOfALoggedRunReproducesItsFilter) {
   EXPECT_NEAR(r.rmse_filtered_cm.y(), run.rmse_filtered_cm.y(), 1e-9);
   EXPECT_GT(r.predicted_error_px, 0.0);
   EXPECT_THROW(scenarios::replayPanTiltFilter(cfg, 7, (dir / "missing.csv").string()), core::InvalidInput);
+}
+
+TEST(PanTiltScenario, TheParticleReferenceReplaysARandomRun) {
+  // The reference replay (waypoint particle filter of the random path's generator) on a logged random
+  // run: it tracks (filtered well below the [T] noise) and predicts, and it refuses other paths.
+  auto cfg = shipped("random");
+  cfg.duration = 8.0;
+  cfg.metrics_start = 2.0;
+  cfg.occlusion_start = -1.0;
+  const auto dir = std::filesystem::temp_directory_path() / ("viewline_pt_particles_" + std::to_string(::getpid()));
+  {
+    io::LogDirectory log(dir.string());
+    scenarios::runPanTilt(cfg, 3, PanTiltControllerKind::Predictive, nullptr, &log);
+    log.flush();
+  }
+  const std::string frames = (dir / "predictive_frames.csv").string();
+  const auto f = scenarios::replayPanTiltFilter(cfg, 3, frames, scenarios::PanTiltReplayEstimator::Filter);
+  const auto p =
+      scenarios::replayPanTiltFilter(cfg, 3, frames, scenarios::PanTiltReplayEstimator::WaypointParticles, nullptr, 5000);
+  auto no_region = cfg;
+  no_region.control.filter.region_size = Eigen::Vector2d::Zero();
+  EXPECT_THROW(
+      scenarios::replayPanTiltFilter(no_region, 3, frames, scenarios::PanTiltReplayEstimator::WaypointParticles),
+      core::InvalidInput);  // the reference needs the generator's box
+  auto rectangle = shipped("rectangle");
+  rectangle.duration = cfg.duration;
+  EXPECT_THROW(
+      scenarios::replayPanTiltFilter(rectangle, 3, frames, scenarios::PanTiltReplayEstimator::WaypointParticles),
+      core::InvalidInput);  // not the random path's generator
+  std::filesystem::remove_all(dir);
+  std::cout << "random, 8 s: filtered (cm) filter " << f.rmse_filtered_cm.transpose() << ", reference "
+            << p.rmse_filtered_cm.transpose() << "; frames' horizon (px) " << f.frame_predicted_error_px << " / "
+            << p.frame_predicted_error_px << "\n";
+  EXPECT_EQ(p.measurements, f.measurements);
+  EXPECT_EQ(p.jumps, 0u);
+  EXPECT_LT(p.rmse_filtered_cm.norm(), 0.5 * p.rmse_measured_cm.norm());
+  EXPECT_GT(p.frame_predicted_error_px, 0.0);
+  EXPECT_LT(p.frame_predicted_error_px, 1.5 * f.frame_predicted_error_px);
 }

@@ -13,6 +13,7 @@
 #include "viewline/core/error.h"
 #include "viewline/core/frames.h"
 #include "viewline/core/random.h"
+#include "viewline/control/waypoint_particle_filter.h"
 #include "viewline/io/rig.h"
 #include "viewline/robots/pan_tilt_kinematics.h"
 #include "viewline/sim/rig.h"
@@ -617,7 +618,9 @@ nlohmann::json PanTiltReplayMetrics::toJson() const {
 }
 
 PanTiltReplayMetrics replayPanTiltFilter(const PanTiltScenarioConfig& cfg, std::uint64_t seed,
-                                         const std::string& frames_csv, bool oracle_corners, io::LogDirectory* log) {
+                                         const std::string& frames_csv, PanTiltReplayEstimator estimator,
+                                         io::LogDirectory* log, std::size_t particles) {
+  const bool oracle_corners = estimator == PanTiltReplayEstimator::OracleCorners;
   cfg.validate();
   core::Rng path_rng = core::makeRng(core::deriveSeed(seed, 1));  // the run's path stream
   sim::ScreenPathParams pp = cfg.path;
@@ -676,8 +679,31 @@ PanTiltReplayMetrics replayPanTiltFilter(const PanTiltScenarioConfig& cfg, std::
     oracle.emplace(fc);
     corners = path.cornerTimes(cfg.duration);
   }
-  const auto filterReady = [&]() { return oracle ? oracle->initialized() : ctrl.filter().initialized(); };
-  const auto filterAt = [&](double t) { return oracle ? oracle->at(t) : ctrl.filter().at(t); };
+  // Reference (not a controller): the waypoint particle filter, the posterior mean under the random
+  // path's generator. It knows the generator's box (filter.region) and minimum leg, not the path.
+  std::optional<control::WaypointParticleFilter> pf;
+  if (estimator == PanTiltReplayEstimator::WaypointParticles) {
+    if (pp.shape != sim::PathShape::Random || pp.corner_radius > 0.0)
+      throw core::InvalidInput("--particles: the model is the random path's (sharp corners, "
+                               "path.corner_radius 0)");
+    const auto& fcfg = cfg.control.filter;
+    if (!(fcfg.region_size.x() > 0.0 && fcfg.region_size.y() > 0.0))
+      throw core::InvalidInput("--particles: needs the waypoint region (filter.region: {center, size})");
+    control::WaypointParticleConfig wc;
+    wc.particles = particles;
+    wc.region_center = fcfg.region_center;
+    wc.region_size = fcfg.region_size;
+    wc.min_leg = 0.1 * std::min(fcfg.region_size.x(), fcfg.region_size.y());  // as sim::ScreenPath
+    wc.speed_min = wc.speed_max = pp.speed;  // the generator's speed: the speed learnt early, as the oracle's
+    wc.seed = core::deriveSeed(seed, 77);
+    pf.emplace(wc);
+  }
+  const auto filterReady = [&]() {
+    return pf ? pf->initialized() : oracle ? oracle->initialized() : ctrl.filter().initialized();
+  };
+  const auto filterAt = [&](double t) {
+    return pf ? pf->predict(t) : oracle ? Vector2d(oracle->at(t).p) : Vector2d(ctrl.filter().at(t).p);
+  };
   const double occ0 = cfg.occlusion_start >= 0.0 ? cfg.occlusion_start : 1e300;
   const double occ1 = cfg.occlusion_start >= 0.0 ? cfg.occlusion_start + cfg.occlusion_duration : 1e300;
   PanTiltReplayMetrics out;
@@ -709,7 +735,15 @@ PanTiltReplayMetrics replayPanTiltFilter(const PanTiltScenarioConfig& cfg, std::
     }
     bool accepted = false;
     Vector2d filtered = Vector2d::Constant(std::nan(""));  // scored on every detected frame, as in the closed loop
-    if (oracle) {
+    if (pf) {
+      if (obs.detected) {
+        pf->update(t, obs.plane, R);
+        accepted = true;
+        filtered = pf->mean();
+      } else {
+        pf->propagateTo(t);
+      }
+    } else if (oracle) {
       while (next_corner < corners.size() && corners[next_corner] <= t) {
         if (oracle->initialized() && corners[next_corner] >= oracle->state().t()) {
           oracle->setSpeed(pp.speed, 1e-12);
@@ -745,14 +779,14 @@ PanTiltReplayMetrics replayPanTiltFilter(const PanTiltScenarioConfig& cfg, std::
       }
     }
     if (filterReady()) {
-      const Vector2d e = filterAt(t + out.horizon_s).p - path.position(t + out.horizon_s);
+      const Vector2d e = filterAt(t + out.horizon_s) - path.position(t + out.horizon_s);
       px_.add(e.x() * e.x());
       py_.add(e.y() * e.y());
-      frame_p.add((filterAt(t + out.frame_horizon_s).p - path.position(t + out.frame_horizon_s)).squaredNorm());
+      frame_p.add((filterAt(t + out.frame_horizon_s) - path.position(t + out.frame_horizon_s)).squaredNorm());
     }
   }
-  out.jumps = oracle ? corners.size() : ctrl.filter().jumps();
-  out.region_dropped = oracle ? oracle->regionDropped() : ctrl.filter().regionDropped();
+  out.jumps = pf ? 0 : oracle ? corners.size() : ctrl.filter().jumps();
+  out.region_dropped = pf ? false : oracle ? oracle->regionDropped() : ctrl.filter().regionDropped();
   out.rmse_measured_cm = 100.0 * Vector2d(mx.rms(), my.rms());
   out.rmse_filtered_cm = 100.0 * Vector2d(fx_.rms(), fy_.rms());
   out.rmse_predicted_cm = 100.0 * Vector2d(px_.rms(), py_.rms());

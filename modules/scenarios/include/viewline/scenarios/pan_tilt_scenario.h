@@ -198,14 +198,25 @@ struct PanTiltReplayMetrics {
   bool region_dropped = false;            ///< the filter dropped filter.region (the target left it)
   nlohmann::json toJson() const;
 };
-/// oracle_corners (rectangle and random paths): instead of the config's filter, a bound: a constant-speed
-/// leg filter told the path's true corner times and speed (control::PlanarTargetFilter::startLeg); `jumps`
-/// is then the number of corners. No causal filter that must detect the corners can expect to beat it.
-/// With a log, writes the stream replay_frames (t, truth, detected, measurement, the filter's output,
-/// accepted, jumps so far) for per-frame comparisons.
+/// What a replay runs on the logged measurements.
+enum class PanTiltReplayEstimator {
+  /// The config's filter (the predictive controller's, same reacquisition rule).
+  Filter,
+  /// Rectangle and random paths: a bound, a constant-speed leg filter told the path's true corner times
+  /// and speed (control::PlanarTargetFilter::startLeg); `jumps` is then the number of corners. No causal
+  /// filter that must detect the corners can expect to beat it.
+  OracleCorners,
+  /// Random path: control::WaypointParticleFilter, the posterior mean under the path's generator
+  /// (waypoints uniform in filter.region, one constant speed), the causal reference; `jumps` is 0.
+  WaypointParticles,
+};
+/// With a log, writes the stream replay_frames (t, truth, detected, measurement, the estimator's output,
+/// accepted, jumps so far) for per-frame comparisons. `particles`: the particle count of
+/// WaypointParticles.
 PanTiltReplayMetrics replayPanTiltFilter(const PanTiltScenarioConfig& config, std::uint64_t seed,
-                                         const std::string& frames_csv, bool oracle_corners = false,
-                                         io::LogDirectory* log = nullptr);
+                                         const std::string& frames_csv,
+                                         PanTiltReplayEstimator estimator = PanTiltReplayEstimator::Filter,
+                                         io::LogDirectory* log = nullptr, std::size_t particles = 20000);
 
 /// [T] Table 1 (RMSE in cm, (x, y)): noisy measurement and Kalman filter; nothing for the random path.
 struct TTable1Row {

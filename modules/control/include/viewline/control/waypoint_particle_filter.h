@@ -1,0 +1,87 @@
+#pragma once
+// Waypoint particle filter: the Bayes reference for a target on a random polyline (issue 6).
+//
+// Model (exactly the simulator's random path, sim::ScreenPath with shape random, in the screen plane's
+// coordinates, m): waypoints W_0, W_1, … are drawn independently and uniformly in a known box B
+// (filter.region); the target runs from waypoint to waypoint in straight legs at one constant speed s
+// (learnt from a uniform prior, or known: speed_min = speed_max, as the replays set it, since our filter
+// learns it within the first legs); at a waypoint it heads for the next. The state of particle i is
+//   (p_i, W_i, s_i): position, the waypoint it heads for, speed.
+// Propagation over dt moves p_i by d = s_i dt towards W_i; if the leg ends first (|W_i − p_i| < d), the
+// rest of d is run towards a fresh waypoint W ~ U(B) (legs shorter than min_leg are drawn again, as the
+// simulator does). Measurements z = p + v, v ~ N(0, R), with a small uniform outlier mass:
+//   w_i ∝ w_i [(1 − ε) N(z; p_i, R) + ε / |B₊|]      (B₊: B grown by 3σ on each side)
+// Systematic resampling when the effective sample size falls below N/2, then a small jitter of p, W and
+// s (regularisation: without it the deterministic legs would collapse onto a few ancestors).
+//
+// Given the model and enough particles the weighted mean is the posterior mean E[p(t + h) | z_1..k]:
+// the predictor with the least expected squared error, which is what the image error measures. It is
+// used as a reference (pan_tilt_tracking --replay <log> --particles; bench/pan_tilt_seeds): what any
+// causal filter that knows the path's generator could reach at the law's horizon. It is not a Kalman filter and the
+// controllers do not use it.
+#include <Eigen/Core>
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "viewline/core/random.h"
+
+namespace viewline::control {
+
+struct WaypointParticleConfig {
+  std::size_t particles = 20000;
+  Eigen::Vector2d region_center = Eigen::Vector2d::Zero();  ///< box B of the waypoints (m)
+  Eigen::Vector2d region_size = Eigen::Vector2d::Zero();    ///< its width and height (m), > 0
+  double min_leg = 0.0;             ///< m, shorter legs are drawn again (the simulator's min segment)
+  double speed_min = 0.02;          ///< m/s, uniform speed prior
+  double speed_max = 0.5;           ///< m/s (= speed_min: the speed is known)
+  double jitter_position = 0.0005;  ///< m, std of the position jitter after a resampling
+  double jitter_waypoint = 0.005;   ///< m, std of the waypoint jitter after a resampling (kept in B)
+  double jitter_speed = 0.0005;     ///< m/s, std of the speed jitter after a resampling
+  double outlier_probability = 0.01;
+  std::uint64_t seed = 1;
+  void validate() const;  ///< throws core::InvalidInput
+};
+
+class WaypointParticleFilter {
+ public:
+  explicit WaypointParticleFilter(const WaypointParticleConfig& config);
+
+  bool initialized() const { return initialized_; }
+  double t() const { return t_; }
+  /// The first call draws the prior (p ~ N(z, R), W ~ U(B), s ~ U(speed_min, speed_max)); later calls
+  /// propagate to t (t ≥ the last stamp) and weight. R: the measurement's covariance (m²).
+  void update(double t, const Eigen::Vector2d& z, const Eigen::Matrix2d& R);
+  /// Propagates without a measurement (a missed detection).
+  void propagateTo(double t);
+  /// Posterior mean of the position at t ≥ t(): each particle run ahead once (fresh waypoints drawn
+  /// from a stream of its own, so the estimate does not change the filter).
+  Eigen::Vector2d predict(double t) const;
+  Eigen::Vector2d mean() const { return predict(t_); }
+  /// Posterior mean of the speed (m/s).
+  double speedMean() const;
+  double effectiveSampleSize() const { return ess_; }
+  std::size_t resamplings() const { return resamplings_; }
+
+ private:
+  struct Particle {
+    Eigen::Vector2d p, w;
+    double s = 0.0;
+  };
+  Eigen::Vector2d drawWaypoint(const Eigen::Vector2d& from, core::Rng& rng) const;
+  void advance(Particle& q, double dt, core::Rng& rng) const;
+  void resample();
+  void resetWeights();  ///< all weights 1 (after the prior and a resampling)
+
+  WaypointParticleConfig cfg_;
+  core::Rng rng_;
+  std::vector<Particle> particles_;
+  std::vector<double> log_w_;  ///< log weights, max 0
+  std::vector<double> w_;      ///< exp(log_w_)
+  double w_sum_ = 0.0, ess_ = 0.0;
+  bool initialized_ = false;
+  double t_ = 0.0;
+  std::size_t resamplings_ = 0, updates_ = 0;
+};
+
+}  // namespace viewline::control

@@ -1,0 +1,182 @@
+// Waypoint particle filter: model and equations in the header.
+#include "viewline/control/waypoint_particle_filter.h"
+
+#include <Eigen/Cholesky>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <random>
+#include <string>
+
+#include "viewline/core/error.h"
+#include "viewline/core/frames.h"
+
+namespace viewline::control {
+
+using Eigen::Matrix2d;
+using Eigen::Vector2d;
+
+void WaypointParticleConfig::validate() const {
+  if (particles < 10) throw core::InvalidInput("waypoint particle filter: particles must be >= 10");
+  if (!region_center.allFinite() || !(region_size.x() > 0.0) || !(region_size.y() > 0.0) || !region_size.allFinite())
+    throw core::InvalidInput("waypoint particle filter: the waypoint region (filter.region) needs a finite centre and "
+                             "a positive size");
+  if (!(min_leg >= 0.0) || min_leg >= 0.5 * std::min(region_size.x(), region_size.y()))
+    throw core::InvalidInput("waypoint particle filter: min_leg must be in [0, half the region's smaller side)");
+  if (!(speed_min > 0.0) || !(speed_max >= speed_min) || !std::isfinite(speed_max))
+    throw core::InvalidInput("waypoint particle filter: need 0 < speed_min <= speed_max (equal: a known speed)");
+  if (!(jitter_position >= 0.0) || !(jitter_waypoint >= 0.0) || !(jitter_speed >= 0.0))
+    throw core::InvalidInput("waypoint particle filter: jitters must be >= 0");
+  if (!(outlier_probability >= 0.0 && outlier_probability < 1.0))
+    throw core::InvalidInput("waypoint particle filter: outlier_probability must be in [0, 1)");
+}
+
+WaypointParticleFilter::WaypointParticleFilter(const WaypointParticleConfig& config)
+    : cfg_(config), rng_(core::makeRng(config.seed)) {
+  cfg_.validate();
+}
+
+Vector2d WaypointParticleFilter::drawWaypoint(const Vector2d& from, core::Rng& rng) const {
+  const Vector2d h = 0.5 * cfg_.region_size;
+  for (;;) {  // min_leg < half the smaller side: the rejection ends
+    const Vector2d w = cfg_.region_center + Vector2d(core::uniform(rng, -h.x(), h.x()), core::uniform(rng, -h.y(), h.y()));
+    if ((w - from).norm() >= cfg_.min_leg) return w;
+  }
+}
+
+void WaypointParticleFilter::advance(Particle& q, double dt, core::Rng& rng) const {
+  double d = q.s * dt;
+  for (int legs = 0; d > 0.0 && legs < 1000; ++legs) {
+    const Vector2d to = q.w - q.p;
+    const double L = to.norm();
+    if (L >= d) {
+      q.p += (d / L) * to;
+      return;
+    }
+    d -= L;
+    q.p = q.w;
+    q.w = drawWaypoint(q.p, rng);
+  }
+}
+
+void WaypointParticleFilter::propagateTo(double t) {
+  if (!initialized_) return;
+  if (!(t >= t_)) throw core::InvalidInput("waypoint particle filter: time went back (" + std::to_string(t) + " < " +
+                                           std::to_string(t_) + ")");
+  const double dt = t - t_;
+  if (dt > 0.0)
+    for (auto& q : particles_) advance(q, dt, rng_);
+  t_ = t;
+}
+
+void WaypointParticleFilter::update(double t, const Vector2d& z, const Matrix2d& R) {
+  if (!z.allFinite() || !R.allFinite() || !(R.determinant() > 0.0))
+    throw core::InvalidInput("waypoint particle filter: non-finite measurement or covariance not positive definite");
+  const std::size_t n = cfg_.particles;
+  if (!initialized_) {
+    particles_.resize(n);
+    log_w_.assign(n, 0.0);
+    const Eigen::LLT<Matrix2d> llt(R);
+    const Matrix2d Lr = llt.matrixL();
+    for (auto& q : particles_) {
+      q.p = z + Lr * Vector2d(core::gaussian(rng_), core::gaussian(rng_));
+      q.w = drawWaypoint(q.p, rng_);
+      q.s = core::uniform(rng_, cfg_.speed_min, cfg_.speed_max);
+    }
+    resetWeights();
+    initialized_ = true;
+    t_ = t;
+    ++updates_;
+    return;
+  }
+  propagateTo(t);
+  const Matrix2d Ri = R.inverse();
+  const double log_norm = -std::log(2.0 * core::kPi) - 0.5 * std::log(R.determinant());
+  const Vector2d grown = cfg_.region_size + 6.0 * R.diagonal().cwiseSqrt();
+  const double log_out = std::log(cfg_.outlier_probability) - std::log(grown.x() * grown.y());
+  const double log_in = std::log1p(-cfg_.outlier_probability) + log_norm;
+  double best = -std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vector2d e = z - particles_[i].p;
+    const double a = log_in - 0.5 * e.dot(Ri * e);
+    // log((1 − ε) N + ε / |B₊|); the outlier term is below 1e-8 of it when a > log_out + 20
+    const double ll = cfg_.outlier_probability > 0.0 && a < log_out + 20.0
+                          ? std::max(a, log_out) + std::log1p(std::exp(-std::abs(a - log_out)))
+                          : a;
+    log_w_[i] += ll;
+    best = std::max(best, log_w_[i]);
+  }
+  w_.resize(n);
+  w_sum_ = 0.0;
+  double w2 = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    log_w_[i] -= best;  // max 0: no overflow
+    w_[i] = std::exp(log_w_[i]);
+    w_sum_ += w_[i];
+    w2 += w_[i] * w_[i];
+  }
+  ess_ = w_sum_ * w_sum_ / w2;
+  ++updates_;
+  if (effectiveSampleSize() < 0.5 * static_cast<double>(n)) resample();
+}
+
+void WaypointParticleFilter::resample() {
+  const std::size_t n = particles_.size();
+  std::vector<double> c(n);
+  double acc = 0.0;
+  for (std::size_t i = 0; i < n; ++i) c[i] = (acc += w_[i]);
+  std::vector<Particle> next;
+  next.reserve(n);
+  const double step = acc / static_cast<double>(n);
+  double u = core::uniform(rng_, 0.0, step);
+  std::size_t j = 0;
+  const Vector2d lo = cfg_.region_center - 0.5 * cfg_.region_size, hi = cfg_.region_center + 0.5 * cfg_.region_size;
+  std::normal_distribution<double> g;  // one for the whole pass: it keeps the second of each pair it draws
+  const bool known_speed = cfg_.speed_max == cfg_.speed_min;
+  for (std::size_t i = 0; i < n; ++i, u += step) {
+    while (j + 1 < n && c[j] < u) ++j;
+    Particle q = particles_[j];
+    q.p += cfg_.jitter_position * Vector2d(g(rng_), g(rng_));
+    q.w += cfg_.jitter_waypoint * Vector2d(g(rng_), g(rng_));
+    q.w = q.w.cwiseMax(lo).cwiseMin(hi);
+    if (!known_speed) q.s = std::clamp(q.s + cfg_.jitter_speed * g(rng_), cfg_.speed_min, cfg_.speed_max);
+    next.push_back(q);
+  }
+  particles_.swap(next);
+  std::fill(log_w_.begin(), log_w_.end(), 0.0);
+  resetWeights();
+  ++resamplings_;
+}
+
+void WaypointParticleFilter::resetWeights() {
+  w_.assign(particles_.size(), 1.0);
+  w_sum_ = ess_ = static_cast<double>(particles_.size());
+}
+
+Vector2d WaypointParticleFilter::predict(double t) const {
+  if (!initialized_) throw core::InvalidInput("waypoint particle filter: predict before the first measurement");
+  if (!(t >= t_)) throw core::InvalidInput("waypoint particle filter: predict into the past");
+  core::Rng rng = core::makeRng(core::deriveSeed(cfg_.seed, 1000003 + updates_));
+  Vector2d sum = Vector2d::Zero();
+  const double dt = t - t_;
+  for (std::size_t i = 0; i < particles_.size(); ++i) {
+    if (dt <= 0.0) {
+      sum += w_[i] * particles_[i].p;
+      continue;
+    }
+    Particle q = particles_[i];
+    advance(q, dt, rng);
+    sum += w_[i] * q.p;
+  }
+  return sum / w_sum_;
+}
+
+double WaypointParticleFilter::speedMean() const {
+  if (!initialized_) return std::nan("");
+  double sum = 0.0;
+  for (std::size_t i = 0; i < particles_.size(); ++i) sum += w_[i] * particles_[i].s;
+  return sum / w_sum_;
+}
+
+}  // namespace viewline::control
