@@ -82,6 +82,12 @@ void SimulatedPanTiltUnit::advanceTo(core::Timestamp t) {
     if (!pending_.empty()) h = std::min(h, pending_.front().t - state_.t);
     step(h);
   }
+  // The sub-steps' sums can stop up to 1e-12 short of t: land on t, so that now().t is the time asked
+  // for (a command at now().t after one at t must not look like time going backwards).
+  if (state_.t < t) {
+    state_.t = t;
+    history_.back().t = t;
+  }
 }
 
 JointState SimulatedPanTiltUnit::read(core::Timestamp t) {

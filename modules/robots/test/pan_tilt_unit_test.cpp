@@ -116,6 +116,26 @@ TEST(SimulatedPanTilt, LatencyAccelerationRampAndHistory) {
   EXPECT_EQ(unit.limitHits(), 0u);
 }
 
+TEST(SimulatedPanTilt, NowIsTheTimeAskedFor) {
+  // The scenario's loop: read at the capture and at the command time, command, and at the end stop at
+  // now(). With 20 ms
+  // latency the sub-steps summed to a hair short of the last command time, and the stop threw "time
+  // goes backwards" (any run of the pan-tilt app with unit.latency 0.02 or 0.05).
+  for (const double latency : {0.02, 0.03, 0.05}) {
+    SimulatedPanTiltParams p;
+    p.latency = latency;
+    SimulatedPanTiltUnit unit(p);
+    for (int k = 0; k < 90; ++k) {
+      unit.read(k / 30.0);  // the capture
+      const double t = k / 30.0 + 0.01;
+      EXPECT_EQ(unit.read(t).t, t);
+      unit.commandVelocity(t, Eigen::Vector2d(0.1, -0.05));
+      EXPECT_EQ(unit.now().t, t) << latency << " " << k;
+    }
+    EXPECT_NO_THROW(unit.stop(unit.now().t)) << latency;
+  }
+}
+
 TEST(SimulatedPanTilt, CountsRateViolationsAndHardStops) {
   SimulatedPanTiltParams p;
   p.latency = 0.0;
