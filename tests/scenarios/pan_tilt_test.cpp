@@ -284,6 +284,7 @@ TEST(PanTiltScenario, TheParticleReferenceReplaysARandomRun) {
   EXPECT_THROW(
       scenarios::replayPanTiltFilter(rectangle, 3, frames, scenarios::PanTiltReplayEstimator::WaypointParticles),
       core::InvalidInput);  // not the random path's generator
+  EXPECT_THROW(scenarios::replayPanTiltFilter(cfg, 4, frames), core::InvalidInput);  // logged with seed 3
   std::filesystem::remove_all(dir);
   std::cout << "random, 8 s: filtered (cm) filter " << f.rmse_filtered_cm.transpose() << ", reference "
             << p.rmse_filtered_cm.transpose() << "; frames' horizon (px) " << f.frame_predicted_error_px << " / "

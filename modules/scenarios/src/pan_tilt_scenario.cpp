@@ -649,6 +649,11 @@ PanTiltReplayMetrics replayPanTiltFilter(const PanTiltScenarioConfig& cfg, std::
     return static_cast<std::size_t>(it - header.begin());
   };
   const std::size_t ct = col("t"), cd = col("detected"), cx = col("meas_x"), cy = col("meas_y");
+  // The log's own truth (when it has it) must be the path of `seed`: a log of another seed, path or
+  // speed would otherwise be scored against the wrong truth without a word.
+  const auto has = [&](const std::string& name) { return std::find(header.begin(), header.end(), name) != header.end(); };
+  const bool check_truth = has("truth_x") && has("truth_y");
+  const std::size_t ctx = check_truth ? col("truth_x") : 0, cty = check_truth ? col("truth_y") : 0;
 
   control::PredictivePanTiltController ctrl(cfg.control, cfg.unit.limits, cfg.unit.latency, screenPose(cfg));
   // Oracle (a bound, not a controller): constant-speed legs started at the path's true corner times with
@@ -725,6 +730,11 @@ PanTiltReplayMetrics replayPanTiltFilter(const PanTiltScenarioConfig& cfg, std::
     if (v.size() != header.size()) throw core::InvalidInput(frames_csv + ":" + std::to_string(row) + ": wrong number of columns");
     const double t = v[ct];
     if (t >= cfg.duration) break;
+    if (check_truth && (path.position(t) - Vector2d(v[ctx], v[cty])).norm() > 1e-6)
+      throw core::InvalidInput(frames_csv + ":" + std::to_string(row) + ": the logged truth (" + std::to_string(v[ctx]) +
+                               ", " + std::to_string(v[cty]) + ") is not the path of seed " + std::to_string(seed) +
+                               " at t = " + std::to_string(t) +
+                               " s: replay with the --seed and the path settings the log was made with");
     control::TargetObservation obs;
     obs.stamp = t;
     obs.detected = v[cd] > 0.5;

@@ -183,7 +183,8 @@ PanTiltComparison runPanTiltComparison(const PanTiltScenarioConfig& config, std:
 /// rule) re-run on the measurements of a logged run (`<log>/predictive_frames.csv` of
 /// pan_tilt_tracking --log), scored against the path of `seed` with the run's metric windows.
 /// Used to compare filters on identical measurements without rendering; the closed loop is not
-/// re-run (the measurements depend on it only through the detector's sub-pixel error).
+/// re-run (the measurements depend on it only through the detector's sub-pixel error). A log whose truth
+/// columns are not the path of `seed` (another seed, shape, size or speed) is refused (core::InvalidInput).
 struct PanTiltReplayMetrics {
   std::size_t measurements = 0, jumps = 0;
   Eigen::Vector2d rmse_measured_cm = Eigen::Vector2d::Zero(), rmse_filtered_cm = Eigen::Vector2d::Zero();
