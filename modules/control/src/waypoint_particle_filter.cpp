@@ -30,6 +30,7 @@ void WaypointParticleConfig::validate() const {
     throw core::InvalidInput("waypoint particle filter: jitters must be >= 0");
   if (!(outlier_probability >= 0.0 && outlier_probability < 1.0))
     throw core::InvalidInput("waypoint particle filter: outlier_probability must be in [0, 1)");
+  if (reinit_after < 1) throw core::InvalidInput("waypoint particle filter: reinit_after must be >= 1");
 }
 
 WaypointParticleFilter::WaypointParticleFilter(const WaypointParticleConfig& config)
@@ -75,19 +76,7 @@ void WaypointParticleFilter::update(double t, const Vector2d& z, const Matrix2d&
     throw core::InvalidInput("waypoint particle filter: non-finite measurement or covariance not positive definite");
   const std::size_t n = cfg_.particles;
   if (!initialized_) {
-    particles_.resize(n);
-    log_w_.assign(n, 0.0);
-    const Eigen::LLT<Matrix2d> llt(R);
-    const Matrix2d Lr = llt.matrixL();
-    for (auto& q : particles_) {
-      q.p = z + Lr * Vector2d(core::gaussian(rng_), core::gaussian(rng_));
-      q.w = drawWaypoint(q.p, rng_);
-      q.s = core::uniform(rng_, cfg_.speed_min, cfg_.speed_max);
-    }
-    resetWeights();
-    initialized_ = true;
-    t_ = t;
-    ++updates_;
+    drawPrior(t, z, R);
     return;
   }
   propagateTo(t);
@@ -96,16 +85,29 @@ void WaypointParticleFilter::update(double t, const Vector2d& z, const Matrix2d&
   const Vector2d grown = cfg_.region_size + 6.0 * R.diagonal().cwiseSqrt();
   const double log_out = std::log(cfg_.outlier_probability) - std::log(grown.x() * grown.y());
   const double log_in = std::log1p(-cfg_.outlier_probability) + log_norm;
-  double best = -std::numeric_limits<double>::infinity();
+  double best = -std::numeric_limits<double>::infinity(), best_in = best;
   for (std::size_t i = 0; i < n; ++i) {
     const Vector2d e = z - particles_[i].p;
     const double a = log_in - 0.5 * e.dot(Ri * e);
+    best_in = std::max(best_in, a);
     // log((1 − ε) N + ε / |B₊|); the outlier term is below 1e-8 of it when a > log_out + 20
     const double ll = cfg_.outlier_probability > 0.0 && a < log_out + 20.0
                           ? std::max(a, log_out) + std::log1p(std::exp(-std::abs(a - log_out)))
                           : a;
     log_w_[i] += ll;
     best = std::max(best, log_w_[i]);
+  }
+  // No particle explains the measurement better than an outlier does: after reinit_after of these in a
+  // row the cloud has lost the target (e.g. it turned during an occlusion), and starts again from the
+  // measurement.
+  if (best_in < log_out) {
+    if (++far_in_a_row_ >= cfg_.reinit_after) {
+      drawPrior(t, z, R);
+      ++reinitialisations_;
+      return;
+    }
+  } else {
+    far_in_a_row_ = 0;
   }
   w_.resize(n);
   w_sum_ = 0.0;
@@ -147,6 +149,23 @@ void WaypointParticleFilter::resample() {
   std::fill(log_w_.begin(), log_w_.end(), 0.0);
   resetWeights();
   ++resamplings_;
+}
+
+void WaypointParticleFilter::drawPrior(double t, const Vector2d& z, const Matrix2d& R) {
+  particles_.resize(cfg_.particles);
+  log_w_.assign(cfg_.particles, 0.0);
+  const Eigen::LLT<Matrix2d> llt(R);
+  const Matrix2d Lr = llt.matrixL();
+  for (auto& q : particles_) {
+    q.p = z + Lr * Vector2d(core::gaussian(rng_), core::gaussian(rng_));
+    q.w = drawWaypoint(q.p, rng_);
+    q.s = core::uniform(rng_, cfg_.speed_min, cfg_.speed_max);
+  }
+  resetWeights();
+  initialized_ = true;
+  far_in_a_row_ = 0;
+  t_ = t;
+  ++updates_;
 }
 
 void WaypointParticleFilter::resetWeights() {

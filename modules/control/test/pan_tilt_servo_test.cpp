@@ -567,6 +567,12 @@ TEST(WaypointParticleFilter, IsDeterministicAndRejectsBadInput) {
   EXPECT_EQ(a.predict(2.1), b.predict(2.1));
   EXPECT_NEAR(a.mean().x(), 0.15 * 59 / 30.0, 0.01);
   EXPECT_NEAR(a.speedMean(), 0.15, 0.03);  // learnt from 2 s of a straight leg at 0.15 m/s
+  EXPECT_EQ(a.reinitialisations(), 0u);
+  // The target reappears 0.5 m away (as after an occlusion it turned in): two measurements there are
+  // taken as outliers, the third starts the filter again from it.
+  for (int k = 60; k < 63; ++k) a.update(k / 30.0, Eigen::Vector2d(0.3, 0.5), R);
+  EXPECT_EQ(a.reinitialisations(), 1u);
+  EXPECT_NEAR((a.mean() - Eigen::Vector2d(0.3, 0.5)).norm(), 0.0, 0.01);
   EXPECT_THROW(a.update(1.0, Eigen::Vector2d::Zero(), R), core::InvalidInput);  // time went back
   EXPECT_THROW(a.update(3.0, Eigen::Vector2d(std::nan(""), 0.0), R), core::InvalidInput);
   EXPECT_THROW(a.update(3.0, Eigen::Vector2d::Zero(), Eigen::Matrix2d::Zero()), core::InvalidInput);
@@ -581,6 +587,9 @@ TEST(WaypointParticleFilter, IsDeterministicAndRejectsBadInput) {
   EXPECT_THROW(control::WaypointParticleFilter{bad}, core::InvalidInput);
   bad = c;
   bad.speed_max = 0.01;
+  EXPECT_THROW(control::WaypointParticleFilter{bad}, core::InvalidInput);
+  bad = c;
+  bad.reinit_after = 0;
   EXPECT_THROW(control::WaypointParticleFilter{bad}, core::InvalidInput);
   bad = c;
   bad.particles = 3;

@@ -12,7 +12,9 @@
 // simulator does). Measurements z = p + v, v ~ N(0, R), with a small uniform outlier mass:
 //   w_i ∝ w_i [(1 − ε) N(z; p_i, R) + ε / |B₊|]      (B₊: B grown by 3σ on each side)
 // Systematic resampling when the effective sample size falls below N/2, then a small jitter of p, W and
-// s (regularisation: without it the deterministic legs would collapse onto a few ancestors).
+// s (regularisation: without it the deterministic legs would collapse onto a few ancestors). When no
+// particle explains reinit_after measurements in a row better than the outlier term, the prior is drawn
+// again around the last one.
 //
 // Given the model and enough particles the weighted mean is the posterior mean E[p(t + h) | z_1..k]:
 // the predictor with the least expected squared error, which is what the image error measures. It is
@@ -39,6 +41,9 @@ struct WaypointParticleConfig {
   double jitter_waypoint = 0.005;   ///< m, std of the waypoint jitter after a resampling (kept in B)
   double jitter_speed = 0.0005;     ///< m/s, std of the speed jitter after a resampling
   double outlier_probability = 0.01;
+  /// Measurements in a row that no particle explains better than an outlier (the cloud lost the target,
+  /// e.g. it turned during an occlusion) before the filter starts again from the measurement.
+  int reinit_after = 3;
   std::uint64_t seed = 1;
   void validate() const;  ///< throws core::InvalidInput
 };
@@ -50,7 +55,8 @@ class WaypointParticleFilter {
   bool initialized() const { return initialized_; }
   double t() const { return t_; }
   /// The first call draws the prior (p ~ N(z, R), W ~ U(B), s ~ U(speed_min, speed_max)); later calls
-  /// propagate to t (t ≥ the last stamp) and weight. R: the measurement's covariance (m²).
+  /// propagate to t (t ≥ the last stamp) and weight (or draw the prior again: reinit_after). R: the
+  /// measurement's covariance (m²).
   void update(double t, const Eigen::Vector2d& z, const Eigen::Matrix2d& R);
   /// Propagates without a measurement (a missed detection).
   void propagateTo(double t);
@@ -62,6 +68,7 @@ class WaypointParticleFilter {
   double speedMean() const;
   double effectiveSampleSize() const { return ess_; }
   std::size_t resamplings() const { return resamplings_; }
+  std::size_t reinitialisations() const { return reinitialisations_; }
 
  private:
   struct Particle {
@@ -72,6 +79,8 @@ class WaypointParticleFilter {
   void advance(Particle& q, double dt, core::Rng& rng) const;
   void resample();
   void resetWeights();  ///< all weights 1 (after the prior and a resampling)
+  /// p ~ N(z, R), W ~ U(B), s ~ U(speed_min, speed_max), at t.
+  void drawPrior(double t, const Eigen::Vector2d& z, const Eigen::Matrix2d& R);
 
   WaypointParticleConfig cfg_;
   core::Rng rng_;
@@ -81,7 +90,8 @@ class WaypointParticleFilter {
   double w_sum_ = 0.0, ess_ = 0.0;
   bool initialized_ = false;
   double t_ = 0.0;
-  std::size_t resamplings_ = 0, updates_ = 0;
+  std::size_t resamplings_ = 0, updates_ = 0, reinitialisations_ = 0;
+  int far_in_a_row_ = 0;
 };
 
 }  // namespace viewline::control
