@@ -699,7 +699,7 @@ PanTiltReplayMetrics replayPanTiltFilter(const PanTiltScenarioConfig& cfg, std::
     wc.region_center = fcfg.region_center;
     wc.region_size = fcfg.region_size;
     wc.min_leg = 0.1 * std::min(fcfg.region_size.x(), fcfg.region_size.y());  // as sim::ScreenPath
-    wc.speed_min = wc.speed_max = pp.speed;  // the generator's speed: the speed learnt early, as the oracle's
+    wc.speed_min = wc.speed_max = pp.speed;  // given, as to the oracle (our filter learns it in the first legs)
     wc.seed = core::deriveSeed(seed, 77);
     pf.emplace(wc);
   }
