@@ -37,6 +37,36 @@ std::vector<KeySegment> parseDottedKey(const std::string& dotted) {
   return out;
 }
 
+std::pair<std::string, YAML::Node> parseKeyValue(const std::string& text) {
+  const auto eq = text.find('=');
+  if (eq == std::string::npos || eq == 0) throw InvalidInput("'" + text + "': expected key=value (e.g. camera.fps=60)");
+  const std::string key = text.substr(0, eq);
+  parseDottedKey(key);  // throws on a malformed key
+  YAML::Node value;
+  try {
+    value = YAML::Load(text.substr(eq + 1));
+  } catch (const YAML::Exception& e) {
+    throw InvalidInput("'" + text + "': the value is not YAML (" + e.msg + ")");
+  }
+  if (!value.IsDefined() || value.IsNull()) throw InvalidInput("'" + text + "': empty value");
+  return {key, value};
+}
+
+io::ConfigNode loadConfigWithValues(const std::string& path, const std::vector<std::string>& key_values) {
+  if (key_values.empty()) return io::ConfigNode::loadFile(path);
+  std::vector<std::pair<std::string, YAML::Node>> kv;
+  for (const std::string& s : key_values) kv.push_back(parseKeyValue(s));
+  io::ConfigNode::loadFile(path);  // the file's own errors (syntax, duplicate keys) with its own line numbers
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(path);
+  } catch (const YAML::Exception& e) {
+    throw InvalidInput(path + ": " + e.what());
+  }
+  const std::string base = std::filesystem::absolute(path).parent_path().string();
+  return io::ConfigNode::fromString(emitYaml(withValues(root, kv)), path + " (with --set)", base);
+}
+
 std::optional<YAML::Node> findKey(const YAML::Node& root, const std::string& dotted) {
   YAML::Node cur = root;
   for (const KeySegment& s : parseDottedKey(dotted)) {

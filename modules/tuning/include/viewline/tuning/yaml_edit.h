@@ -13,6 +13,8 @@
 #include <vector>
 #include <yaml-cpp/yaml.h>
 
+#include "viewline/io/config.h"
+
 namespace viewline::tuning {
 
 struct KeySegment {
@@ -38,6 +40,18 @@ std::string scalarText(const YAML::Node& value);
 
 /// YAML text of a node (block style).
 std::string emitYaml(const YAML::Node& node);
+
+/// "key=value" (a command line's --set): the dotted key and the value parsed as YAML ("0.3", "[1, 2]",
+/// "ct"). Throws core::InvalidInput naming the text when there is no '=', the key is malformed or the
+/// value is not YAML.
+std::pair<std::string, YAML::Node> parseKeyValue(const std::string& text);
+
+/// A scenario file with `key_values` ("key=value", as parseKeyValue) applied: io::ConfigNode::loadFile
+/// when there are none; otherwise the file's tree with the values set (maps created as needed), read
+/// back through io::ConfigNode, so the scenario's strict loader still rejects a key it does not know
+/// and a wrong type. Relative paths in the file resolve against its folder as with loadFile; messages
+/// name the file "with --set" (their line numbers are those of the edited tree).
+io::ConfigNode loadConfigWithValues(const std::string& path, const std::vector<std::string>& key_values);
 
 /// The scenario text with the values replaced (see the file comment). `header` is put in a
 /// comment at the top.
