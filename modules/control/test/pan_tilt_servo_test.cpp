@@ -486,6 +486,37 @@ TEST(PlanarTargetFilter, AWrongWaypointRegionIsDropped) {
   EXPECT_LT(r_wrong, 1.05 * r_none);
 }
 
+TEST(PlanarTargetFilter, AnExtrapolationStopsAtTheWaypointRegionsEdge) {
+  // A straight leg at 0.15 m/s towards the right edge of the 0.8 x 0.43 m box (x = 0.4), measured up
+  // to x = 0.35. Coasting 1 s (an occlusion) must not carry the estimate out of the box: it stops on
+  // the edge, still. Without the region it runs on to x ~ 0.5.
+  control::TargetFilterConfig region = randomLegsFilter();
+  region.region_size = Eigen::Vector2d(0.80, 0.43);
+  region.jump_decision = "posterior";
+  control::TargetFilterConfig none = region;
+  none.region_size = Eigen::Vector2d::Zero();
+  control::PlanarTargetFilter with(region), without(none);
+  const Eigen::Matrix2d R = std::pow(0.005, 2) * Eigen::Matrix2d::Identity();
+  core::Rng rng = core::makeRng(3);
+  double t = 0.0;
+  for (int k = 0; 0.15 * t < 0.35; ++k) {
+    t = k / 30.0;
+    const Eigen::Vector2d z(0.15 * t + core::gaussian(rng, 0.005), 0.05 + core::gaussian(rng, 0.005));
+    with.update(t, z, R);
+    without.update(t, z, R);
+  }
+  EXPECT_FALSE(with.regionDropped());
+  const auto near = with.at(t + 0.1);  // inside: the plain extrapolation
+  EXPECT_NEAR(near.p.x(), 0.15 * (t + 0.1), 0.01);
+  EXPECT_NEAR(near.v.x(), 0.15, 0.01);
+  EXPECT_NEAR((near.p - without.at(t + 0.1).p).norm(), 0.0, 1e-9);
+  const auto far = with.at(t + 1.0);
+  EXPECT_NEAR(far.p.x(), 0.4, 1e-9);  // on the edge
+  EXPECT_NEAR(far.p.y(), 0.05, 0.01);
+  EXPECT_EQ(far.v.norm(), 0.0);
+  EXPECT_GT(without.at(t + 1.0).p.x(), 0.48);
+}
+
 namespace {
 // RMS error (m) of a prediction `h` ahead on the four random polylines of randomPolylineRms (same noise
 // draws), after 8 s: `predict(t, z, R)` takes the measurement at t and returns the estimate of p(t + h).

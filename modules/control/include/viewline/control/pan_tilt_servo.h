@@ -226,7 +226,9 @@ public:
     Eigen::Matrix2d P_pos = Eigen::Matrix2d::Zero();
   };
   /// The state extrapolated to t (no change to the filter); t may be before the state's time
-  /// only by rounding (it is then evaluated at the state's time).
+  /// only by rounding (it is then evaluated at the state's time). With an active waypoint region, an
+  /// extrapolation that would leave the box stops on its boundary with v = a = 0 (the model's target
+  /// never leaves it; it turns there, direction unknown): what coasting through an occlusion follows.
   Kinematics at(core::Timestamp t) const;
   const estimation::StateEstimate& state() const { return state_; }
   /// The output estimate at the last measurement: the soft jump mixture when it applies, else state().
