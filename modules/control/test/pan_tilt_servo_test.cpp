@@ -273,6 +273,15 @@ control::TargetFilterConfig randomLegsFilter() {
   return c;
 }
 
+// config/pan_tilt_random.yaml's filter: the legs above, the 0.8 x 0.43 m waypoint region, jumps decided
+// by the mixture's posterior.
+control::TargetFilterConfig randomRegionFilter() {
+  control::TargetFilterConfig c = randomLegsFilter();
+  c.region_size = Eigen::Vector2d(0.80, 0.43);
+  c.jump_decision = "posterior";
+  return c;
+}
+
 // Mean over the four random polylines (40 s, [T]'s 10 % noise σ 3.6 / 2.1 cm, scored after 8 s) of the
 // filter's RMS error; `check` (optional) sees each seed's filter once its track is done.
 double randomPolylineRms(const control::TargetFilterConfig& cfg, bool oracle = false,
@@ -468,9 +477,7 @@ TEST(PlanarTargetFilter, WaypointRegionOnARandomPolyline) {
 TEST(PlanarTargetFilter, AWrongWaypointRegionIsDropped) {
   // A box of half the size: the measurements leave it, the filter drops it and goes on as without one.
   // The true box is never dropped on these tracks.
-  control::TargetFilterConfig region = randomLegsFilter();
-  region.region_size = Eigen::Vector2d(0.80, 0.43);
-  region.jump_decision = "posterior";
+  const control::TargetFilterConfig region = randomRegionFilter();
   control::TargetFilterConfig wrong = region;
   wrong.region_size = Eigen::Vector2d(0.40, 0.215);
   control::TargetFilterConfig none = region;
@@ -490,9 +497,7 @@ TEST(PlanarTargetFilter, AnExtrapolationStopsAtTheWaypointRegionsEdge) {
   // A straight leg at 0.15 m/s towards the right edge of the 0.8 x 0.43 m box (x = 0.4), measured up
   // to x = 0.35. Coasting 1 s (an occlusion) must not carry the estimate out of the box: it stops on
   // the edge, still. Without the region it runs on to x ~ 0.5.
-  control::TargetFilterConfig region = randomLegsFilter();
-  region.region_size = Eigen::Vector2d(0.80, 0.43);
-  region.jump_decision = "posterior";
+  const control::TargetFilterConfig region = randomRegionFilter();
   control::TargetFilterConfig none = region;
   none.region_size = Eigen::Vector2d::Zero();
   control::PlanarTargetFilter with(region), without(none);
