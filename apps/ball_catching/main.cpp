@@ -9,7 +9,7 @@
 #include <memory>
 
 #include "viewline/core/error.h"
-#include "viewline/io/config.h"
+#include "viewline/io/config_edit.h"
 #include "viewline/io/files.h"
 #include "viewline/io/log.h"
 #include "viewline/scenarios/ball_catching.h"
@@ -27,7 +27,9 @@ int main(int argc, char** argv) {
   double rate = 0.0, noise = -1.0, vmax = 0.0, amax = 0.0;
   bool headless = false, display = false;
   std::string robot_kind;
+  std::vector<std::string> sets;
   app.add_option("--config", config_path, "scenario YAML")->check(CLI::ExistingFile);
+  app.add_option("--set", sets, io::kSetOptionHelp)->take_all();
   app.add_option("--seed", seed, "random seed (throw i uses deriveSeed(seed, i))");
   app.add_option("--throws", throws, "number of throws")->check(CLI::PositiveNumber);
   app.add_option("--jobs", jobs, "worker threads (default: the config's threads)");
@@ -49,7 +51,7 @@ int main(int argc, char** argv) {
     return 2;
   }
   try {
-    scenarios::BallCatchingConfig cfg = scenarios::loadBallCatchingConfig(io::ConfigNode::loadFile(config_path));
+    scenarios::BallCatchingConfig cfg = scenarios::loadBallCatchingConfig(io::loadConfigWithValues(config_path, sets));
     if (jobs > 0) cfg.threads = jobs;
     if (cameras > 0) cfg.camera_count = cameras;
     if (rate > 0.0) cfg.rate_override_hz = rate;
@@ -86,7 +88,8 @@ int main(int argc, char** argv) {
     };
     const auto s = scenarios::runBallCatching(cfg, throws, seed, hooks);
     std::fprintf(stderr, "\n");
-    const nlohmann::json j = scenarios::summaryJson(s, cfg);
+    nlohmann::json j = scenarios::summaryJson(s, cfg);
+    if (!sets.empty()) j["config_set"] = sets;
     if (!summary_path.empty()) io::writeJsonFile(summary_path, j);
     std::printf("ball_catching: %d throws, seed %llu, %zu cameras, %s robot (%.2f m/s, %.1f m/s²), planner %s, %.1f s wall\n",
                 s.throws, static_cast<unsigned long long>(seed), cfg.camera_count > 0 ? cfg.camera_count : cfg.cameras.size(),

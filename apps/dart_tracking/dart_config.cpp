@@ -1,7 +1,7 @@
 #include "dart_config.h"
 
 #include "viewline/core/frames.h"
-#include "viewline/io/config.h"
+#include "viewline/io/config_edit.h"
 
 namespace viewline::apps {
 
@@ -104,8 +104,8 @@ nlohmann::json gateJson(const tracking::GateFigures& g) {
 
 }  // namespace
 
-tracking::DartScenarioConfig loadDartScenario(const std::string& path) {
-  return fromNode(io::ConfigNode::loadFile(path));
+tracking::DartScenarioConfig loadDartScenario(const std::string& path, const std::vector<std::string>& key_values) {
+  return fromNode(io::loadConfigWithValues(path, key_values));
 }
 
 tracking::DartScenarioConfig dartScenarioFromString(const std::string& yaml, const std::string& name) {

@@ -12,7 +12,7 @@
 
 #include "viewline/core/error.h"
 #include "viewline/core/random.h"
-#include "viewline/io/config.h"
+#include "viewline/io/config_edit.h"
 #include "viewline/io/files.h"
 #include "viewline/io/log.h"
 #include "viewline/scenarios/mobile_capture.h"
@@ -28,7 +28,9 @@ int main(int argc, char** argv) {
   int runs = 1, jobs = 0;
   double duration = -1.0;
   bool headless = false, display = false;
+  std::vector<std::string> sets;
   app.add_option("--config", config_path, "scenario YAML")->check(CLI::ExistingFile);
+  app.add_option("--set", sets, io::kSetOptionHelp)->take_all();
   app.add_option("--seed", seed, "random seed (run i uses deriveSeed(seed, i))");
   app.add_option("--runs", runs, "number of capture runs")->check(CLI::PositiveNumber);
   app.add_option("--duration", duration, "time limit of one run, s (default: world.max_time)");
@@ -44,7 +46,7 @@ int main(int argc, char** argv) {
     return 2;
   }
   try {
-    scenarios::MobileCaptureConfig cfg = scenarios::loadMobileCaptureConfig(io::ConfigNode::loadFile(config_path));
+    scenarios::MobileCaptureConfig cfg = scenarios::loadMobileCaptureConfig(io::loadConfigWithValues(config_path, sets));
     if (duration > 0.0) cfg.max_time = duration;
     if (jobs > 0) cfg.threads = jobs;
     cfg.validate();
@@ -81,7 +83,11 @@ int main(int argc, char** argv) {
     });
     std::fprintf(stderr, "\n");
     const std::string json = scenarios::summaryJson(summary, cfg);
-    if (!summary_path.empty()) io::writeJsonFile(summary_path, nlohmann::json::parse(json));
+    if (!summary_path.empty()) {
+      nlohmann::json j = nlohmann::json::parse(json);
+      if (!sets.empty()) j["config_set"] = sets;
+      io::writeJsonFile(summary_path, j);
+    }
     const auto j = nlohmann::json::parse(json);
     std::printf("mobile_capture: %d runs, seed %llu, %.0f s wall\n", runs, static_cast<unsigned long long>(seed),
                 summary.wall_time);

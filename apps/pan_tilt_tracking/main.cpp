@@ -17,7 +17,7 @@
 #include <memory>
 
 #include "viewline/core/error.h"
-#include "viewline/io/config.h"
+#include "viewline/io/config_edit.h"
 #include "viewline/io/files.h"
 #include "viewline/io/log.h"
 #include "viewline/scenarios/pan_tilt_display.h"
@@ -28,12 +28,14 @@ using namespace viewline;
 int main(int argc, char** argv) {
   CLI::App app{"viewline pan-tilt tracking ([T]): predictive servo vs ViSP's point servo on a simulated FLIR PTU-D46"};
   std::string config_path, log_dir, summary_path, replay_path;
+  std::vector<std::string> sets;
   std::uint64_t seed = 1;
   double duration = -1.0;
   bool headless = false, display = false, no_baseline = false, oracle_corners = false, use_particles = false;
   std::size_t particles = 20000;
   app.add_option("--config", config_path, "scenario YAML (config/pan_tilt_*.yaml)")->required();
   app.add_option("--seed", seed, "random seed (path, sensor noise, [T] measurement noise)");
+  app.add_option("--set", sets, io::kSetOptionHelp)->take_all();
   app.add_option("--duration", duration, "simulated seconds (overrides run.duration)");
   app.add_flag("--headless", headless, "no window (default)");
   app.add_flag("--display", display, "show the image, target, prediction and error live (vpDisplayX)");
@@ -68,7 +70,7 @@ int main(int argc, char** argv) {
     return 2;
   }
   try {
-    scenarios::PanTiltScenarioConfig cfg = scenarios::loadPanTiltScenarioConfig(io::ConfigNode::loadFile(config_path));
+    scenarios::PanTiltScenarioConfig cfg = scenarios::loadPanTiltScenarioConfig(io::loadConfigWithValues(config_path, sets));
     if (duration > 0.0) {
       cfg.duration = duration;
       if (cfg.metrics_start >= duration) cfg.metrics_start = 0.5 * duration;
@@ -81,7 +83,9 @@ int main(int argc, char** argv) {
           scenarios::replayPanTiltFilter(cfg, seed, replay_path, estimator, replay_log.enabled() ? &replay_log : nullptr,
                                          particles);
       replay_log.flush();
-      if (!summary_path.empty()) io::writeJsonFile(summary_path, r.toJson());
+      nlohmann::json rj = r.toJson();
+      if (!sets.empty()) rj["config_set"] = sets;
+      if (!summary_path.empty()) io::writeJsonFile(summary_path, rj);
       if (oracle_corners)
         std::printf("replay of %s (seed %llu, oracle: constant-speed legs at the %zu true corners): %zu measurements\n",
                     replay_path.c_str(), static_cast<unsigned long long>(seed), r.jumps, r.measurements);
@@ -118,7 +122,8 @@ int main(int argc, char** argv) {
     const scenarios::PanTiltComparison result =
         scenarios::runPanTiltComparison(cfg, seed, sink, log.enabled() ? &log : nullptr, progress);
     log.flush();
-    const nlohmann::json j = result.toJson(cfg);
+    nlohmann::json j = result.toJson(cfg);
+    if (!sets.empty()) j["config_set"] = sets;
     if (!summary_path.empty()) io::writeJsonFile(summary_path, j);
 
     const auto& o = result.ours;

@@ -9,7 +9,7 @@
 #include <memory>
 
 #include "viewline/core/error.h"
-#include "viewline/io/config.h"
+#include "viewline/io/config_edit.h"
 #include "viewline/io/files.h"
 #include "viewline/io/log.h"
 #include "viewline/scenarios/table_ball.h"
@@ -24,7 +24,9 @@ int main(int argc, char** argv) {
   std::uint64_t seed = 1;
   double duration = -1.0;
   bool headless = false, display = false;
+  std::vector<std::string> sets;
   app.add_option("--config", config_path, "scenario YAML")->check(CLI::ExistingFile);
+  app.add_option("--set", sets, io::kSetOptionHelp)->take_all();
   app.add_option("--seed", seed, "random seed");
   app.add_option("--duration", duration, "simulated seconds (default: the config's duration)");
   app.add_flag("--headless", headless, "no display (never needs X)");
@@ -37,7 +39,7 @@ int main(int argc, char** argv) {
     return 2;
   }
   try {
-    scenarios::TableBallConfig cfg = scenarios::tableBallConfigFromYaml(io::ConfigNode::loadFile(config_path));
+    scenarios::TableBallConfig cfg = scenarios::tableBallConfigFromYaml(io::loadConfigWithValues(config_path, sets));
     if (duration > 0.0) cfg.duration = duration;
     io::LogDirectory log(log_dir);
     scenarios::TableBallHooks hooks;
@@ -59,6 +61,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "\n");
     nlohmann::json j = scenarios::toJson(r);
     j["rig"] = cfg.rig ? nlohmann::json(cfg.rig->folder) : nlohmann::json(nullptr);
+    if (!sets.empty()) j["config_set"] = sets;
     if (!summary_path.empty()) io::writeJsonFile(summary_path, j);
     std::printf("table_ball_balancing: %.1f s, seed %llu, %d frames (%d dropped), table found %d, ball found %d\n",
                 r.duration, static_cast<unsigned long long>(r.seed), r.frames, r.frames_dropped, r.table_detections,

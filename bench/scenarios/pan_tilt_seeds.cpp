@@ -35,7 +35,7 @@
 #include "viewline/io/log.h"
 #include "viewline/scenarios/pan_tilt_scenario.h"
 #include "viewline/tuning/sweep_runner.h"
-#include "viewline/tuning/yaml_edit.h"
+#include "viewline/io/config_edit.h"
 
 using namespace viewline;
 namespace fs = std::filesystem;
@@ -78,13 +78,13 @@ int main(int argc, char** argv) {
   app.add_option("--json", json_file, "write every seed's figures (JSON)");
   app.add_option("--particles", particles,
                  "random path with filter.region: particles of the reference replay (waypoint particle filter; 0: none)");
-  app.add_option("--set", sets, "KEY=VALUE: a config key changed for this study (dotted, e.g. camera.fps=60; repeatable)")
+  app.add_option("--set", sets, io::kSetOptionHelp)
       ->take_all();
   CLI11_PARSE(app, argc, argv);
 
   try {
     scenarios::PanTiltScenarioConfig cfg =
-        scenarios::loadPanTiltScenarioConfig(tuning::loadConfigWithValues(config_file, sets));
+        scenarios::loadPanTiltScenarioConfig(io::loadConfigWithValues(config_file, sets));
     if (duration > 0.0) cfg.duration = duration;
     cfg.run_baseline = true;
     cfg.validate();

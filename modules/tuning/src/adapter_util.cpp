@@ -11,7 +11,7 @@
 
 #include "viewline/core/error.h"
 #include "viewline/tracking/viewline.h"
-#include "viewline/tuning/yaml_edit.h"
+#include "viewline/io/config_edit.h"
 
 namespace viewline::tuning::detail {
 
@@ -153,7 +153,7 @@ public:
   std::vector<AdapterOption> options() const override { return info_.options; }
   std::unique_ptr<ScenarioInstance> load(const YAML::Node& scenario, const std::string& name,
                                          const AdapterOptions& options) const override {
-    return load_(emitYaml(scenario), name, options);
+    return load_(io::emitYaml(scenario), name, options);
   }
 
 private:

@@ -308,10 +308,10 @@ nlohmann::json runSweepSession(const AdapterRegistry& registry, const std::strin
   // Every setting must give a config the scenario accepts: errors name the sweep file's line and key.
   const std::vector<Setting> settings = generateSettings(spec);
   for (const SweepParameter& p : spec.parameters) {
-    if (!findKey(tree, p.key)) {
+    if (!io::findKey(tree, p.key)) {
       // Not in the file: accept it only when the scenario's loader knows it.
       try {
-        adapter.load(withValue(tree, p.key, p.values.empty() ? YAML::Node("0") : p.values.front()), config_path,
+        adapter.load(io::withValue(tree, p.key, p.values.empty() ? YAML::Node("0") : p.values.front()), config_path,
                      spec.adapter_options);
       } catch (const core::InvalidInput& e) {
         throw core::InvalidInput(p.location + ": parameter '" + p.key + "': not a key of the " + spec.scenario +
@@ -327,7 +327,7 @@ nlohmann::json runSweepSession(const AdapterRegistry& registry, const std::strin
       // Name the parameter whose value the scenario refuses (try them one at a time).
       for (std::size_t k = 0; k < spec.parameters.size(); ++k) {
         try {
-          adapter.load(withValue(tree, spec.parameters[k].key, s.values[k]), config_path, spec.adapter_options);
+          adapter.load(io::withValue(tree, spec.parameters[k].key, s.values[k]), config_path, spec.adapter_options);
         } catch (const core::InvalidInput& e1) {
           throw core::InvalidInput(spec.parameters[k].location + ": parameter '" + spec.parameters[k].key +
                                    "': value '" + scalarText(s.values[k]) + "' refused by the " + spec.scenario +

@@ -37,7 +37,7 @@ SweepParameter readParameter(const io::ConfigNode& p, SweepMode mode) {
   sp.key = p.get<std::string>("key");
   sp.location = p.location("key");
   try {
-    parseDottedKey(sp.key);
+    io::parseDottedKey(sp.key);
   } catch (const core::InvalidInput& e) {
     p.fail("key", std::string("a dotted scenario key (") + e.what() + ")");
   }
@@ -230,7 +230,7 @@ std::string Setting::label() const {
 YAML::Node applySetting(const YAML::Node& scenario, const SweepSpec& spec, const Setting& s) {
   std::vector<std::pair<std::string, YAML::Node>> kv;
   for (std::size_t k = 0; k < spec.parameters.size(); ++k) kv.emplace_back(spec.parameters[k].key, s.values[k]);
-  return withValues(scenario, kv);
+  return io::withValues(scenario, kv);
 }
 
 }  // namespace viewline::tuning

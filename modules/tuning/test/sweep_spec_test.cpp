@@ -1,7 +1,6 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
-#include <fstream>
 
 #include "toy_scenario.h"
 #include "viewline/core/error.h"
@@ -93,12 +92,6 @@ TEST(YamlEdit, RewriteKeepsCommentsAndReplacesInPlace) {
   const std::string out2 = rewriteYamlText(text, {{"steps", YAML::Node("50")}}, "x");
   EXPECT_EQ(YAML::Load(out2)["steps"].as<int>(), 50);
   EXPECT_EQ(YAML::Load(out2)["filter"]["r"].as<int>(), 2);
-  // Dotted keys with list indices.
-  const YAML::Node n = withValue(YAML::Load("cams:\n  - {f: 1}\n  - {f: 2}\n"), "cams[1].f", YAML::Node("7"));
-  EXPECT_EQ(n["cams"][1]["f"].as<int>(), 7);
-  EXPECT_EQ(n["cams"][0]["f"].as<int>(), 1);
-  EXPECT_THROW(parseDottedKey("a..b"), core::InvalidInput);
-  EXPECT_THROW(parseDottedKey("a[x]"), core::InvalidInput);
 }
 
 TEST(YamlEdit, RelativePathsAreRelocatedForACopyWrittenElsewhere) {
@@ -118,31 +111,5 @@ TEST(YamlEdit, RelativePathsAreRelocatedForACopyWrittenElsewhere) {
   EXPECT_EQ(moved[1].second.as<std::string>(), "../../calib");
   // Written into the same folder as the config: nothing to change.
   EXPECT_TRUE(relocatedPaths(tree, (root / "config").string(), (root / "config").string()).empty());
-  fs::remove_all(root);
-}
-
-TEST(YamlEdit, SetValuesOnAFileKeepItsFolderAndRejectBadText) {
-  namespace fs = std::filesystem;
-  const fs::path root = fs::temp_directory_path() / "viewline_set_values_test";
-  fs::remove_all(root);
-  fs::create_directories(root / "config");
-  fs::create_directories(root / "rigs/r");
-  {
-    std::ofstream f(root / "config/s.yaml");
-    f << "rig: ../rigs/r   # relative to this file\ncamera:\n  fps: 30\n  size: [640, 480]\nname: a\n";
-  }
-  const std::string file = (root / "config/s.yaml").string();
-  const io::ConfigNode c = loadConfigWithValues(file, {"camera.fps=60", "camera.size=[320, 240]", "noise=0.05"});
-  EXPECT_EQ(c.child("camera").get<int>("fps"), 60);
-  EXPECT_EQ(c.child("camera").get<std::vector<int>>("size"), (std::vector<int>{320, 240}));
-  EXPECT_DOUBLE_EQ(c.get<double>("noise"), 0.05);  // a key the file lacks is added
-  EXPECT_EQ(c.get<std::string>("name"), "a");      // the others as in the file
-  EXPECT_EQ(fs::weakly_canonical(c.getPath("rig")), fs::weakly_canonical(root / "rigs/r"));
-  EXPECT_NE(c.fileName().find("with --set"), std::string::npos);
-  // Nothing set: the file itself.
-  EXPECT_EQ(loadConfigWithValues(file, {}).child("camera").get<int>("fps"), 30);
-  for (const std::string bad : {"camera.fps", "=3", "camera.fps=", "camera..fps=3", "camera.fps=[1,"})
-    EXPECT_THROW(loadConfigWithValues(file, {bad}), core::InvalidInput) << bad;
-  EXPECT_THROW(loadConfigWithValues(file, {"camera.fps.x=1"}), core::InvalidInput);  // fps is not a map
   fs::remove_all(root);
 }

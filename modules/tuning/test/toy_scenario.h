@@ -8,9 +8,8 @@
 
 #include "viewline/core/error.h"
 #include "viewline/core/random.h"
-#include "viewline/io/config.h"
+#include "viewline/io/config_edit.h"
 #include "viewline/tuning/scenario.h"
-#include "viewline/tuning/yaml_edit.h"
 
 namespace toy {
 
@@ -119,7 +118,7 @@ public:
   std::vector<AdapterOption> options() const override { return {{"scale", "1", {}, "unused"}}; }
   std::unique_ptr<ScenarioInstance> load(const YAML::Node& n, const std::string& name,
                                          const AdapterOptions&) const override {
-    const io::ConfigNode root = io::ConfigNode::fromString(emitYaml(n), name);
+    const io::ConfigNode root = io::ConfigNode::fromString(io::emitYaml(n), name);
     Config c;
     c.q_true = root.getOr<double>("q_true", c.q_true);
     c.r_true = root.getOr<double>("r_true", c.r_true);

@@ -1,6 +1,7 @@
 #pragma once
-// Dotted config keys ("tracker.accel_psd", "cameras[1].hfov_deg") on YAML trees, and writing a
-// scenario file back with some values replaced.
+// Writing a scenario file back with some values replaced (the session's best_config.yaml). The
+// dotted-key edits of YAML trees it builds on (io::withValue, io::findKey, io::loadConfigWithValues
+// for --set) live in viewline/io/config_edit.h.
 //
 // rewriteYamlText() keeps the user's file as it is (comments, order, layout) and replaces only
 // the scalars of the given keys in place (found through the parser's line/column marks); when a
@@ -13,45 +14,12 @@
 #include <vector>
 #include <yaml-cpp/yaml.h>
 
-#include "viewline/io/config.h"
+#include "viewline/io/config_edit.h"
 
 namespace viewline::tuning {
 
-struct KeySegment {
-  std::string key;
-  int index = -1;  ///< list index when the segment is "name[i]"
-};
-
-/// "a.b[1].c" -> {a}, {b, 1}, {c}. Throws core::InvalidInput on an empty or malformed key.
-std::vector<KeySegment> parseDottedKey(const std::string& dotted);
-
-/// The node at a dotted key, or nullopt when any segment is missing.
-std::optional<YAML::Node> findKey(const YAML::Node& root, const std::string& dotted);
-
-/// A deep copy of `root` with `value` at the dotted key (maps are created as needed; list items
-/// must exist). Throws core::InvalidInput naming the key when a segment is not a map/list.
-YAML::Node withValue(const YAML::Node& root, const std::string& dotted, const YAML::Node& value);
-
-/// A deep copy with every (key, value) applied.
-YAML::Node withValues(const YAML::Node& root, const std::vector<std::pair<std::string, YAML::Node>>& values);
-
 /// The text of a scalar node ("0.5", "mahalanobis"); "[...]" rendering of sequences.
 std::string scalarText(const YAML::Node& value);
-
-/// YAML text of a node (block style).
-std::string emitYaml(const YAML::Node& node);
-
-/// "key=value" (a command line's --set): the dotted key and the value parsed as YAML ("0.3", "[1, 2]",
-/// "ct"). Throws core::InvalidInput naming the text when there is no '=', the key is malformed or the
-/// value is not YAML.
-std::pair<std::string, YAML::Node> parseKeyValue(const std::string& text);
-
-/// A scenario file with `key_values` ("key=value", as parseKeyValue) applied: io::ConfigNode::loadFile
-/// when there are none; otherwise the file's tree with the values set (maps created as needed), read
-/// back through io::ConfigNode, so the scenario's strict loader still rejects a key it does not know
-/// and a wrong type. Relative paths in the file resolve against its folder as with loadFile; messages
-/// name the file "with --set" (their line numbers are those of the edited tree).
-io::ConfigNode loadConfigWithValues(const std::string& path, const std::vector<std::string>& key_values);
 
 /// The scenario text with the values replaced (see the file comment). `header` is put in a
 /// comment at the top.
