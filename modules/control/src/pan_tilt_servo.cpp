@@ -70,8 +70,9 @@ TargetModel targetModelFromString(const std::string& name) {
   if (name == "singer") return TargetModel::Singer;
   if (name == "coordinated_turn" || name == "ct") return TargetModel::CoordinatedTurn;
   if (name == "imm") return TargetModel::Imm;
+  if (name == "waypoint_particles") return TargetModel::WaypointParticles;
   throw core::InvalidInput("target model: expected constant_velocity (cv), constant_acceleration (ca), singer, "
-                           "coordinated_turn (ct) or imm, got '" + name + "'");
+                           "coordinated_turn (ct), imm or waypoint_particles, got '" + name + "'");
 }
 
 const char* toString(TargetModel model) {
@@ -81,6 +82,7 @@ const char* toString(TargetModel model) {
     case TargetModel::Singer: return "singer";
     case TargetModel::CoordinatedTurn: return "coordinated_turn";
     case TargetModel::Imm: return "imm";
+    case TargetModel::WaypointParticles: return "waypoint_particles";
   }
   return "?";
 }
@@ -103,9 +105,6 @@ void TargetFilterConfig::validate() const {
   if (jump_min_samples < 2) throw core::InvalidInput("filter.jump_min_samples must be >= 2");
   if (!(constant_speed_sigma >= 0.0) || !std::isfinite(constant_speed_sigma))
     throw core::InvalidInput("filter.constant_speed_sigma must be >= 0");
-  if (constant_speed && (model != TargetModel::ConstantVelocity || !(jump_window > 0.0)))
-    throw core::InvalidInput("filter.constant_speed needs model constant_velocity and jump detection "
-                             "(filter.jump_window > 0): the speed is learnt from the legs between detected jumps");
   if (!(jump_rate >= 0.0) || !std::isfinite(jump_rate)) throw core::InvalidInput("filter.jump_rate must be >= 0");
   core::requirePositive(jump_prior_sigma, "filter.jump_prior_sigma");
   if (!(jump_corner_sigma >= 0.0) || !std::isfinite(jump_corner_sigma))
@@ -120,6 +119,19 @@ void TargetFilterConfig::validate() const {
     throw core::InvalidInput("filter.region: center and size must be finite, size >= 0");
   if ((region_size.x() > 0.0) != (region_size.y() > 0.0))
     throw core::InvalidInput("filter.region.size: both width and height > 0 (or both 0: no region)");
+  if (model == TargetModel::WaypointParticles) {  // the Kalman keys are not used: their interplay is not checked
+    if (!hasRegion())
+      throw core::InvalidInput("filter.model waypoint_particles needs filter.region (the box the waypoints are drawn in)");
+    if (particles < 100) throw core::InvalidInput("filter.particles must be >= 100");
+    if (!(particle_speed.x() > 0.0 && particle_speed.y() >= particle_speed.x() && std::isfinite(particle_speed.y())))
+      throw core::InvalidInput("filter.particle_speed: [min, max] with 0 < min <= max (m/s)");
+    if (!(particle_min_leg >= 0.0 && particle_min_leg < 0.5 * region_size.minCoeff()))
+      throw core::InvalidInput("filter.particle_min_leg must be in [0, half the region's smaller side)");
+    return;
+  }
+  if (constant_speed && (model != TargetModel::ConstantVelocity || !(jump_window > 0.0)))
+    throw core::InvalidInput("filter.constant_speed needs model constant_velocity and jump detection "
+                             "(filter.jump_window > 0): the speed is learnt from the legs between detected jumps");
   if (hasRegion() && !constant_speed)
     throw core::InvalidInput("filter.region needs filter.constant_speed (the region is where the legs' waypoints lie)");
   if (jump_decision != "test" && jump_decision != "posterior")
@@ -343,7 +355,8 @@ struct PlanarTargetFilter::Leg {
 
 int PlanarTargetFilter::stateDim() const {
   switch (config_.model) {
-    case TargetModel::ConstantVelocity: return 4;
+    case TargetModel::ConstantVelocity:
+    case TargetModel::WaypointParticles: return 4;
     case TargetModel::CoordinatedTurn:
     case TargetModel::Imm: return 5;
     default: return 6;
@@ -396,8 +409,41 @@ PlanarTargetFilter::PlanarTargetFilter(const TargetFilterConfig& config) : confi
   }
 }
 
+namespace {
+WaypointParticleConfig particleConfig(const TargetFilterConfig& c, std::uint64_t stream) {
+  WaypointParticleConfig w;
+  w.particles = c.particles;
+  w.region_center = c.region_center;
+  w.region_size = c.region_size;
+  w.min_leg = c.particle_min_leg;
+  w.speed_min = c.particle_speed.x();
+  w.speed_max = c.particle_speed.y();
+  w.reinit_after = c.reinit_after;
+  w.seed = core::deriveSeed(c.particle_seed, stream);
+  return w;
+}
+}  // namespace
+
+void PlanarTargetFilter::setParticleState() {
+  const WaypointParticleFilter::Moments m = particles_->moments(particles_->t());
+  Eigen::Vector4d x;
+  x << m.p, m.v;
+  Eigen::Matrix4d P = m.P;
+  P.diagonal().array() += 1e-12;
+  state_ = estimation::StateEstimate(Eigen::VectorXd(x), Eigen::MatrixXd(P), particles_->t());
+}
+
 void PlanarTargetFilter::reset(core::Timestamp t, const Eigen::Vector2d& z, const Eigen::Matrix2d& R) {
   core::requireFinite(z, "PlanarTargetFilter: z");
+  if (config_.model == TargetModel::WaypointParticles) {
+    particles_.emplace(particleConfig(config_, ++particle_resets_));
+    particles_->update(t, z, R);
+    setParticleState();
+    initialized_ = true;
+    rejected_in_a_row_ = 0;
+    output_.reset();
+    return;
+  }
   const int n = std::max(stateDim(), 4);  // (the max tells gcc n > 2: no false null-dereference warning)
   Eigen::VectorXd x = Eigen::VectorXd::Zero(n);
   x(0) = z(0);
@@ -421,6 +467,23 @@ void PlanarTargetFilter::reset(core::Timestamp t, const Eigen::Vector2d& z, cons
 PlanarTargetFilter::Update PlanarTargetFilter::update(core::Timestamp t, const Eigen::Vector2d& z,
                                                       const Eigen::Matrix2d& R) {
   output_.reset();
+  if (config_.model == TargetModel::WaypointParticles) {
+    Update out;
+    if (!initialized_) {
+      reset(t, z, R);
+      out.accepted = out.reinitialized = true;
+      return out;
+    }
+    const WaypointParticleFilter::Moments prior = particles_->moments(std::max(t, particles_->t()));
+    const Eigen::Vector2d e = z - prior.p;
+    out.nis = e.dot((prior.P.topLeftCorner<2, 2>() + R).ldlt().solve(e));
+    const std::size_t restarts = particles_->reinitialisations();
+    particles_->update(t, z, R);
+    setParticleState();
+    out.accepted = true;
+    out.reinitialized = particles_->reinitialisations() != restarts;
+    return out;
+  }
   Update out = step(t, z, R);
   if (out.accepted) checkRegion(z, R);
   // Gated-out measurements are kept for the jump test too: after a sharp corner the first
@@ -846,6 +909,7 @@ PlanarTargetFilter::Leg PlanarTargetFilter::makeLeg(core::Timestamp t_c, const E
 
 void PlanarTargetFilter::startLeg(core::Timestamp t_c) {
   if (!initialized_) throw core::Error("PlanarTargetFilter::startLeg: filter not initialised");
+  if (particles_) throw core::Error("PlanarTargetFilter::startLeg: not for waypoint_particles");
   if (!config_.constant_speed || !(speed_info_ > 0.0))
     throw core::Error("PlanarTargetFilter::startLeg: needs constant_speed and a known speed (setSpeed or a finished leg)");
   if (t_c < state_.t()) throw core::InvalidInput("PlanarTargetFilter::startLeg: t_c is before the last measurement");
@@ -1006,6 +1070,13 @@ void stopAtRegionBoundary(const Eigen::Vector2d& p0, const Eigen::Vector2d& cent
 PlanarTargetFilter::Kinematics PlanarTargetFilter::at(core::Timestamp t) const {
   if (!initialized_) throw core::Error("PlanarTargetFilter::at: filter not initialised");
   Kinematics k;
+  if (particles_) {
+    const WaypointParticleFilter::Moments m = particles_->moments(std::max(t, particles_->t()));
+    k.p = m.p;
+    k.v = m.v;
+    k.P_pos = m.P.topLeftCorner<2, 2>();
+    return k;
+  }
   const estimation::StateEstimate& est = estimate();
   const double dt = t - est.t();
   Eigen::VectorXd x = est.x();

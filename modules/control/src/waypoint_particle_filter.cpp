@@ -191,6 +191,32 @@ Vector2d WaypointParticleFilter::predict(double t) const {
   return sum / w_sum_;
 }
 
+WaypointParticleFilter::Moments WaypointParticleFilter::moments(double t) const {
+  if (!initialized_) throw core::InvalidInput("waypoint particle filter: moments before the first measurement");
+  if (!(t >= t_)) throw core::InvalidInput("waypoint particle filter: moments in the past");
+  core::Rng rng = core::makeRng(core::deriveSeed(cfg_.seed, 1000003 + updates_));  // as predict()
+  const double dt = t - t_;
+  Eigen::Vector4d sum = Eigen::Vector4d::Zero();
+  Eigen::Matrix4d second = Eigen::Matrix4d::Zero();
+  for (std::size_t i = 0; i < particles_.size(); ++i) {
+    Particle q = particles_[i];
+    if (dt > 0.0) advance(q, dt, rng);
+    const Vector2d to = q.w - q.p;
+    const double L = to.norm();
+    Eigen::Vector4d x;
+    x << q.p, (L > 1e-12 ? Vector2d(q.s / L * to) : Vector2d::Zero());
+    sum += w_[i] * x;
+    second.noalias() += w_[i] * x * x.transpose();
+  }
+  Moments m;
+  const Eigen::Vector4d mean = sum / w_sum_;
+  m.p = mean.head<2>();
+  m.v = mean.tail<2>();
+  m.P = second / w_sum_ - mean * mean.transpose();
+  m.P = 0.5 * (m.P + m.P.transpose()).eval();
+  return m;
+}
+
 double WaypointParticleFilter::speedMean() const {
   if (!initialized_) return std::nan("");
   double sum = 0.0;

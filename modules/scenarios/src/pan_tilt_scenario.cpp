@@ -178,7 +178,7 @@ PanTiltScenarioConfig loadPanTiltScenarioConfig(const io::ConfigNode& root) {
     const auto f = root.child("filter");
     c.control.filter.model = control::targetModelFromString(
         f.getChoice("model", {"constant_velocity", "cv", "constant_acceleration", "ca", "singer", "coordinated_turn",
-                              "ct", "imm"}));
+                              "ct", "imm", "waypoint_particles"}));
     c.control.filter.q = f.getOr<double>("q", c.control.filter.q);
     c.control.filter.singer_tau = f.getOr<double>("singer_tau", c.control.filter.singer_tau);
     c.control.filter.singer_sigma = f.getOr<double>("singer_sigma", c.control.filter.singer_sigma);
@@ -207,6 +207,11 @@ PanTiltScenarioConfig loadPanTiltScenarioConfig(const io::ConfigNode& root) {
     c.control.filter.turn_prior_sigma_deg =
         f.getOr<double>("turn_prior_sigma_deg", c.control.filter.turn_prior_sigma_deg);
     c.control.filter.imm_sojourn = f.getOr<Eigen::Vector3d>("imm_sojourn", c.control.filter.imm_sojourn);
+    const int particles = f.getOr<int>("particles", static_cast<int>(c.control.filter.particles));
+    if (particles < 100) f.fail("particles", "at least 100 particles");
+    c.control.filter.particles = static_cast<std::size_t>(particles);
+    c.control.filter.particle_speed = f.getOr<Eigen::Vector2d>("particle_speed", c.control.filter.particle_speed);
+    c.control.filter.particle_min_leg = f.getOr<double>("particle_min_leg", c.control.filter.particle_min_leg);
     if (f.has("region")) {
       const auto g = f.child("region");
       c.control.filter.region_center = g.get<Eigen::Vector2d>("center");
@@ -429,8 +434,9 @@ PanTiltRunMetrics runPanTilt(const PanTiltScenarioConfig& cfg, std::uint64_t see
   std::unique_ptr<control::PanTiltController> ctrl;
   control::PredictivePanTiltController* ours = nullptr;
   if (kind == PanTiltControllerKind::Predictive) {
-    auto p = std::make_unique<control::PredictivePanTiltController>(cfg.control, up.limits, up.latency, f_M_screen,
-                                                                     kin_model);
+    control::PredictiveConfig pc = cfg.control;
+    pc.filter.particle_seed = core::deriveSeed(seed, 78);  // (waypoint_particles; the replay uses the same)
+    auto p = std::make_unique<control::PredictivePanTiltController>(pc, up.limits, up.latency, f_M_screen, kin_model);
     ours = p.get();
     ctrl = std::move(p);
   } else {
@@ -655,7 +661,9 @@ PanTiltReplayMetrics replayPanTiltFilter(const PanTiltScenarioConfig& cfg, std::
   const bool check_truth = has("truth_x") && has("truth_y");
   const std::size_t ctx = check_truth ? col("truth_x") : 0, cty = check_truth ? col("truth_y") : 0;
 
-  control::PredictivePanTiltController ctrl(cfg.control, cfg.unit.limits, cfg.unit.latency, screenPose(cfg));
+  control::PredictiveConfig pc = cfg.control;
+  pc.filter.particle_seed = core::deriveSeed(seed, 78);  // as runPanTilt: a replay reproduces the run
+  control::PredictivePanTiltController ctrl(pc, cfg.unit.limits, cfg.unit.latency, screenPose(cfg));
   // Oracle (a bound, not a controller): constant-speed legs started at the path's true corner times with
   // the true speed; jump detection off. Only the leg directions, the corners' positions and the speed's
   // leg-to-leg variation (none) remain to be estimated from the measurements.

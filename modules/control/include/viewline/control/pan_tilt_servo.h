@@ -49,6 +49,7 @@
 // not detected, as the ViSP examples do.
 
 #include <Eigen/Geometry>
+#include <cstdint>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -57,6 +58,7 @@
 #include <visp3/core/vpMatrix.h>
 #include <visp3/core/vpVelocityTwistMatrix.h>
 
+#include "viewline/control/waypoint_particle_filter.h"
 #include "viewline/core/time.h"
 #include "viewline/estimation/discretization.h"
 #include "viewline/estimation/imm.h"
@@ -97,8 +99,9 @@ private:
 // ---------------------------------------------------------------------------------------------
 // The planar target filter.
 
-enum class TargetModel { ConstantVelocity, ConstantAcceleration, Singer, CoordinatedTurn, Imm };
-/// "constant_velocity" | "cv", "constant_acceleration" | "ca", "singer", "coordinated_turn" | "ct", "imm"
+enum class TargetModel { ConstantVelocity, ConstantAcceleration, Singer, CoordinatedTurn, Imm, WaypointParticles };
+/// "constant_velocity" | "cv", "constant_acceleration" | "ca", "singer", "coordinated_turn" | "ct", "imm",
+/// "waypoint_particles"
 TargetModel targetModelFromString(const std::string& name);
 const char* toString(TargetModel model);
 
@@ -132,6 +135,13 @@ struct TargetFilterConfig {
   Eigen::Vector2d region_center = Eigen::Vector2d::Zero();
   Eigen::Vector2d region_size = Eigen::Vector2d::Zero();  ///< (width, height), m
   bool hasRegion() const { return region_size.x() > 0.0 && region_size.y() > 0.0; }
+  /// waypoint_particles (not a Kalman filter; see "Waypoint particles" below): particle count, the uniform
+  /// prior of the target's one speed (m/s; equal ends: the speed is known), the generator's shortest leg
+  /// (m) and the particles' random stream.
+  std::size_t particles = 20000;
+  Eigen::Vector2d particle_speed{0.02, 0.5};
+  double particle_min_leg = 0.0;
+  std::uint64_t particle_seed = 1;
   double gate_probability = 0.9999;      ///< chi-square (2 dof) gate on the NIS
   int reinit_after = 3;                  ///< consecutive gated-out measurements that re-initialise
   void validate() const;
@@ -206,6 +216,13 @@ double waypointDirectionDensity(const Eigen::Vector2d& c, const Eigen::Vector2d&
 ///  dropped for good (regionDropped()): the filter goes on as without one (θ uniform, jump_rate odds). A
 ///  too small or shifted box would otherwise make every step near its edge look like a turn. (The
 ///  measurements, not the estimate: a turn at the edge is detected late, and the estimate overshoots.)
+/// Waypoint particles (model waypoint_particles; needs the region): instead of a Kalman filter, the
+/// waypoint particle filter (waypoint_particle_filter.h), the posterior of the random path's own
+/// generator (waypoints uniform in the region, one speed). state() and estimate() are its posterior
+/// moments of (p, v) at the last measurement, at() its moments run ahead; its outlier term replaces
+/// the gate (every measurement is accepted; NIS against the predicted moments), and a reset() draws
+/// a fresh cloud from the next stream. The Kalman keys (q, jumps, legs, turns) are not used. It is
+/// the Bayes reference of the replays put in the loop, for targets whose generator is known.
 class PlanarTargetFilter {
 public:
   explicit PlanarTargetFilter(const TargetFilterConfig& config = {});
@@ -298,6 +315,9 @@ private:
   bool usesImm() const { return config_.model == TargetModel::CoordinatedTurn || config_.model == TargetModel::Imm; }
   TargetFilterConfig config_;
   std::optional<estimation::Imm> imm_;
+  std::optional<WaypointParticleFilter> particles_;  ///< model waypoint_particles
+  std::uint64_t particle_resets_ = 0;
+  void setParticleState();  ///< state_ from the particles' moments at their time
   estimation::ContinuousLinearModel model_;
   estimation::StateEstimate state_;
   bool initialized_ = false;

@@ -19,8 +19,9 @@
 // Given the model and enough particles the weighted mean is the posterior mean E[p(t + h) | z_1..k]:
 // the predictor with the least expected squared error, which is what the image error measures. It is
 // used as a reference (pan_tilt_tracking --replay <log> --particles; bench/pan_tilt_seeds): what any
-// causal filter that knows the path's generator could reach at the law's horizon. It is not a Kalman filter and the
-// controllers do not use it.
+// causal filter that knows the path's generator could reach at the law's horizon. It is not a Kalman
+// filter; the controller can use it as its target filter (filter.model: waypoint_particles, through
+// PlanarTargetFilter) to check that bound in the closed loop.
 #include <Eigen/Core>
 #include <cstddef>
 #include <cstdint>
@@ -64,6 +65,13 @@ class WaypointParticleFilter {
   /// from a stream of its own, so the estimate does not change the filter).
   Eigen::Vector2d predict(double t) const;
   Eigen::Vector2d mean() const { return predict(t_); }
+  /// Posterior moments at t ≥ t() (particles run ahead as in predict()): the mean position and velocity
+  /// (a particle's velocity is s_i towards its waypoint) and their 4 x 4 covariance, order (p, v).
+  struct Moments {
+    Eigen::Vector2d p = Eigen::Vector2d::Zero(), v = Eigen::Vector2d::Zero();
+    Eigen::Matrix4d P = Eigen::Matrix4d::Zero();
+  };
+  Moments moments(double t) const;
   /// Posterior mean of the speed (m/s).
   double speedMean() const;
   double effectiveSampleSize() const { return ess_; }
