@@ -188,6 +188,10 @@ public:
   std::vector<NoiseParameter> noiseParameters() const override {
     // The IMM / CT filters have several process-noise densities (per mode); filter.q alone barely
     // changes their likelihood (measured: the search drifts to q -> 0), so they are not auto-tuned.
+    // The waypoint particle filter has no process noise at all (its model is the path's generator).
+    if (cfg_.control.filter.model == control::TargetModel::WaypointParticles)
+      throw core::InvalidInput("pan-tilt auto-tuning: filter.model waypoint_particles has no process noise to tune (its "
+                               "model is the random path's generator); sweeps work with every model");
     if (cfg_.control.filter.model == control::TargetModel::Imm ||
         cfg_.control.filter.model == control::TargetModel::CoordinatedTurn)
       throw core::InvalidInput(std::string("pan-tilt auto-tuning: filter.model ") + control::toString(cfg_.control.filter.model) +

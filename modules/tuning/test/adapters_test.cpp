@@ -1,7 +1,8 @@
 // The scenario adapters for table ball, ball catching and mobile capture (issue 10): a tiny sweep
 // of each (2 settings x 1 seed, short runs) through the full session, checking the report, the
 // summary and that the metrics a user optimises and the consistency statistics exist and are
-// finite; the adapters without noise auto-tuning must say so (not crash, not pretend).
+// finite; the adapters without noise auto-tuning must say so (not crash, not pretend), and so must
+// the pan-tilt adapter for a filter without process noise.
 // Runs from the source root (ctest's working directory), so config/ paths resolve.
 
 #include <gtest/gtest.h>
@@ -9,10 +10,12 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 
 #include "viewline/core/error.h"
 #include "viewline/tuning/scenario.h"
 #include "viewline/tuning/session.h"
+#include "viewline/tuning/yaml_edit.h"
 
 using namespace viewline;
 using namespace viewline::tuning;
@@ -134,4 +137,26 @@ TEST(ScenarioAdapters, AutotuneSaysWhenAnAdapterDoesNotSupportIt) {
     o.quiet = true;
     EXPECT_TRUE(hasInvalidInput([&] { runSweepSession(reg, sweep, o); }, "sweep.yaml: section 'autotune'")) << sc;
   }
+}
+
+TEST(ScenarioAdapters, PanTiltAutotuneRefusesTheParticleFilter) {
+  // filter.model waypoint_particles has no process noise: auto-tuning says so instead of "tuning" the
+  // unused filter.q. The config is the shipped random one with that model, written elsewhere with its
+  // relative rig path re-expressed (as the session's best_config.yaml is).
+  const AdapterRegistry reg = makeBuiltinAdapters();
+  if (!reg.has("pan_tilt")) GTEST_SKIP() << "no pan_tilt adapter in this build";
+  const fs::path dir = scratch("pan_tilt_particles");
+  const std::string shipped = configPath("pan_tilt_random.yaml");
+  std::ostringstream read;
+  read << std::ifstream(shipped).rdbuf();
+  const std::string text = read.str();
+  auto values = relocatedPaths(YAML::Load(text), fs::path(shipped).parent_path().string(), dir.string());
+  values.emplace_back("filter.model", YAML::Node("waypoint_particles"));
+  AutotuneSessionOptions a;
+  a.scenario = "pan_tilt";
+  a.config = (dir / "particles.yaml").string();
+  std::ofstream(a.config) << rewriteYamlText(text, values, "test: the random config with the particle filter");
+  a.out_dir = (dir / "out").string();
+  a.quiet = true;
+  EXPECT_TRUE(hasInvalidInput([&] { runAutotuneSession(reg, a); }, "waypoint_particles has no process noise"));
 }
