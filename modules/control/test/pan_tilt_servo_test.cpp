@@ -588,6 +588,16 @@ TEST(WaypointParticleFilter, TheReferenceBeatsTheLegFilterAtTheFramesHorizon) {
   EXPECT_GT(r_pf, 0.8 * r_legs);  // the leg filter is within 25 % of the reference
 }
 
+namespace {
+// `good` with one change must be refused by Filter's constructor (its config's validate()).
+template <class Filter, class Config, class Change>
+void expectRefused(const Config& good, Change change) {
+  Config bad = good;
+  change(bad);
+  EXPECT_THROW(Filter{bad}, core::InvalidInput);
+}
+}  // namespace
+
 TEST(PlanarTargetFilter, WaypointParticlesModelIsTheReferenceWithItsMoments) {
   // filter.model waypoint_particles: the controller's filter is the waypoint particle filter itself
   // (its first cloud from stream 1 of particle_seed), with the moments of (p, v) as its state.
@@ -647,18 +657,11 @@ TEST(PlanarTargetFilter, WaypointParticlesModelIsTheReferenceWithItsMoments) {
   EXPECT_TRUE(restarted);
   EXPECT_LT((f.estimate().x().head<2>() - Eigen::Vector2d(-0.3, 0.2)).norm(), 0.05);
   // Checked keys.
-  auto bad = c;
-  bad.region_size = Eigen::Vector2d::Zero();
-  EXPECT_THROW(control::PlanarTargetFilter{bad}, core::InvalidInput);  // the region is the model
-  bad = c;
-  bad.particle_speed = Eigen::Vector2d(0.2, 0.1);
-  EXPECT_THROW(control::PlanarTargetFilter{bad}, core::InvalidInput);
-  bad = c;
-  bad.particle_min_leg = 0.3;
-  EXPECT_THROW(control::PlanarTargetFilter{bad}, core::InvalidInput);
-  bad = c;
-  bad.particles = 10;
-  EXPECT_THROW(control::PlanarTargetFilter{bad}, core::InvalidInput);
+  using Config = control::TargetFilterConfig;
+  expectRefused<control::PlanarTargetFilter>(c, [](Config& w) { w.region_size.setZero(); });  // the region is the model
+  expectRefused<control::PlanarTargetFilter>(c, [](Config& w) { w.particle_speed = Eigen::Vector2d(0.2, 0.1); });
+  expectRefused<control::PlanarTargetFilter>(c, [](Config& w) { w.particle_min_leg = 0.3; });
+  expectRefused<control::PlanarTargetFilter>(c, [](Config& w) { w.particles = 10; });
   EXPECT_EQ(control::targetModelFromString("waypoint_particles"), control::TargetModel::WaypointParticles);
   EXPECT_STREQ(control::toString(control::TargetModel::WaypointParticles), "waypoint_particles");
 }
@@ -690,21 +693,13 @@ TEST(WaypointParticleFilter, IsDeterministicAndRejectsBadInput) {
   EXPECT_THROW(a.predict(1.0), core::InvalidInput);
   control::WaypointParticleFilter fresh(c);
   EXPECT_THROW(fresh.predict(0.0), core::InvalidInput);
-  auto bad = c;
-  bad.region_size = Eigen::Vector2d::Zero();
-  EXPECT_THROW(control::WaypointParticleFilter{bad}, core::InvalidInput);
-  bad = c;
-  bad.min_leg = 0.3;  // > half the smaller side: the rejection might never end
-  EXPECT_THROW(control::WaypointParticleFilter{bad}, core::InvalidInput);
-  bad = c;
-  bad.speed_max = 0.01;
-  EXPECT_THROW(control::WaypointParticleFilter{bad}, core::InvalidInput);
-  bad = c;
-  bad.reinit_after = 0;
-  EXPECT_THROW(control::WaypointParticleFilter{bad}, core::InvalidInput);
-  bad = c;
-  bad.particles = 3;
-  EXPECT_THROW(control::WaypointParticleFilter{bad}, core::InvalidInput);
+  using Config = control::WaypointParticleConfig;
+  expectRefused<control::WaypointParticleFilter>(c, [](Config& w) { w.region_size.setZero(); });
+  // min_leg > half the smaller side: the rejection might never end
+  expectRefused<control::WaypointParticleFilter>(c, [](Config& w) { w.min_leg = 0.3; });
+  expectRefused<control::WaypointParticleFilter>(c, [](Config& w) { w.speed_max = 0.01; });
+  expectRefused<control::WaypointParticleFilter>(c, [](Config& w) { w.reinit_after = 0; });
+  expectRefused<control::WaypointParticleFilter>(c, [](Config& w) { w.particles = 3; });
 }
 
 namespace {
