@@ -13,6 +13,7 @@
 #include <iostream>
 
 #include "viewline/core/error.h"
+#include "viewline/io/config_edit.h"
 #include "viewline/tuning/session.h"
 
 using namespace viewline;
@@ -56,6 +57,8 @@ int main(int argc, char** argv) {
   bool speedup = false, no_autotune = false;
   sweep->add_option("--sweep", sweep_file, "sweep YAML (config/sweeps/*.yaml)")->required();
   sweep->add_option("--config", config, "scenario config (instead of the sweep file's 'config')");
+  std::vector<std::string> sweep_set;
+  sweep->add_option("--set", sweep_set, io::kSetOptionHelp)->take_all();
   sweep->add_option("--out", out, "output folder (report.html, summary.json, results.jsonl, best_config.yaml)");
   sweep->add_option("--workers", workers, "threads (0: all cores)");
   sweep->add_option("--seeds", seeds, "seeds per setting (instead of the file's)");
@@ -68,6 +71,7 @@ int main(int argc, char** argv) {
   std::vector<std::string> run_opts;
   run->add_option("--scenario", ro.scenario, "scenario adapter (viewline_tune list)")->required();
   run->add_option("--config", ro.config, "scenario YAML")->required();
+  run->add_option("--set", ro.set, io::kSetOptionHelp)->take_all();
   run->add_option("--seed", ro.seed, "seed");
   run->add_option("--out", ro.out_dir, "output folder");
   run->add_option("--log", ro.log_dir, "CSV logs of the run (measurements, estimates, innovations and S)");
@@ -81,6 +85,7 @@ int main(int argc, char** argv) {
   std::vector<std::string> at_opts;
   at->add_option("--scenario", ao.scenario, "scenario adapter")->required();
   at->add_option("--config", ao.config, "scenario YAML")->required();
+  at->add_option("--set", ao.set, io::kSetOptionHelp)->take_all();
   at->add_option("--log", ao.log_dir, "the scenario app's --log folder (default: record a live run)");
   at->add_option("--record-seed", ao.record_seed, "seed of the live recording");
   at->add_option("--record-runs", ao.record_runs, "live runs recorded");
@@ -115,6 +120,7 @@ int main(int argc, char** argv) {
       tuning::SessionOptions so;
       so.out_dir = out;
       so.config_override = config;
+      so.set = sweep_set;
       so.workers = workers;
       so.seeds_override = seeds;
       so.measure_speedup = speedup;

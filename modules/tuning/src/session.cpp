@@ -42,6 +42,16 @@ std::string readText(const std::string& path) {
   return os.str();
 }
 
+// The scenario config's text with the command line's --set values written in (see SessionOptions::set).
+std::string configText(const std::string& path, const std::vector<std::string>& set) {
+  const std::string text = readText(path);
+  if (set.empty()) return text;
+  std::vector<std::pair<std::string, YAML::Node>> kv;
+  for (const std::string& s : set) kv.push_back(io::parseKeyValue(s));
+  // No header: edited in place, the lines keep their numbers, so messages point into the user's file.
+  return rewriteYamlText(text, kv, "");
+}
+
 YAML::Node parseYaml(const std::string& text, const std::string& path) {
   try {
     return YAML::Load(text);
@@ -294,7 +304,7 @@ nlohmann::json runSweepSession(const AdapterRegistry& registry, const std::strin
   const std::string config_path = !opt.config_override.empty() ? opt.config_override : spec.config_path;
   if (config_path.empty())
     throw core::InvalidInput(sweep_file + ": no scenario config (give 'config:' in the sweep file or --config)");
-  const std::string text = readText(config_path);
+  const std::string text = configText(config_path, opt.set);
   const YAML::Node tree = parseYaml(text, config_path);
   const std::unique_ptr<ScenarioInstance> base = adapter.load(tree, config_path, spec.adapter_options);
   if (spec.autotune.enabled && !opt.skip_autotune) {
@@ -358,6 +368,7 @@ nlohmann::json runSweepSession(const AdapterRegistry& registry, const std::strin
   j["scenario"] = spec.scenario;
   j["sweep_file"] = sweep_file;
   j["config"] = config_path;
+  if (!opt.set.empty()) j["config_set"] = opt.set;
   j["metric"] = spec.metric;
   j["direction"] = spec.minimize ? "minimize" : "maximize";
   j["settings"] = settings.size();
@@ -564,7 +575,7 @@ nlohmann::json runSweepSession(const AdapterRegistry& registry, const std::strin
 
 nlohmann::json runSingleSession(const AdapterRegistry& registry, const SingleRunOptions& o) {
   const ScenarioAdapter& adapter = registry.get(o.scenario);
-  const std::string text = readText(o.config);
+  const std::string text = configText(o.config, o.set);
   AdapterOptions ao = readAdapterOptions(adapter, nullptr);
   for (const auto& [k, v] : o.adapter_options) {
     if (!ao.count(k)) throw core::InvalidInput("--option " + k + ": not an option of scenario '" + o.scenario + "'");
@@ -599,6 +610,7 @@ nlohmann::json runSingleSession(const AdapterRegistry& registry, const SingleRun
   nlohmann::json j;
   j["scenario"] = o.scenario;
   j["config"] = o.config;
+  if (!o.set.empty()) j["config_set"] = o.set;
   j["seed"] = o.seed;
   nlohmann::json m = nlohmann::json::object();
   for (const auto& [k, v] : r.metrics) m[k] = num(v);
@@ -626,7 +638,7 @@ nlohmann::json runSingleSession(const AdapterRegistry& registry, const SingleRun
 
 nlohmann::json runAutotuneSession(const AdapterRegistry& registry, const AutotuneSessionOptions& o) {
   const ScenarioAdapter& adapter = registry.get(o.scenario);
-  const std::string text = readText(o.config);
+  const std::string text = configText(o.config, o.set);
   AdapterOptions aopt = readAdapterOptions(adapter, nullptr);
   for (const auto& [k, v] : o.adapter_options) {
     if (!aopt.count(k)) throw core::InvalidInput("--option " + k + ": not an option of scenario '" + o.scenario + "'");
@@ -649,6 +661,7 @@ nlohmann::json runAutotuneSession(const AdapterRegistry& registry, const Autotun
   nlohmann::json j = at.json;
   j["scenario"] = o.scenario;
   j["config"] = o.config;
+  if (!o.set.empty()) j["config_set"] = o.set;
   j["log_dir"] = o.log_dir;
   j["start_scale"] = o.start_scale;
   HtmlReport rep("viewline_tune: " + o.scenario + " noise auto-tuning", o.out_dir);

@@ -1,9 +1,12 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 
 #include "toy_scenario.h"
 #include "viewline/core/error.h"
+#include "viewline/tuning/session.h"
 #include "viewline/tuning/sweep_spec.h"
 #include "viewline/tuning/yaml_edit.h"
 
@@ -111,5 +114,40 @@ TEST(YamlEdit, RelativePathsAreRelocatedForACopyWrittenElsewhere) {
   EXPECT_EQ(moved[1].second.as<std::string>(), "../../calib");
   // Written into the same folder as the config: nothing to change.
   EXPECT_TRUE(relocatedPaths(tree, (root / "config").string(), (root / "config").string()).empty());
+  fs::remove_all(root);
+}
+
+TEST(YamlEdit, SetValuesReachTheRunsTheSummaryAndTheBestConfig) {
+  // --set on a sweep session: the edited config is what every setting runs, what the summary lists
+  // (config_set) and what best_config.yaml keeps, with the file's comments.
+  namespace fs = std::filesystem;
+  const fs::path root = fs::temp_directory_path() / "viewline_session_set_test";
+  fs::remove_all(root);
+  fs::create_directories(root);
+  std::ofstream(root / "toy.yaml") << "steps: 400   # samples\nfilter:\n  q: 0.01\n  r: 1.0\n";
+  std::ofstream(root / "sweep.yaml") << "scenario: toy\nconfig: toy.yaml\nseeds: 1\nparameters:\n"
+                                        "  - key: filter.q\n    values: [0.001, 0.1]\n";
+  SessionOptions o;
+  o.out_dir = (root / "out").string();
+  o.workers = 1;
+  o.quiet = true;
+  o.set = {"steps=60", "filter.r=2.5"};
+  const nlohmann::json j = runSweepSession(toy::registry(), (root / "sweep.yaml").string(), o);
+  EXPECT_EQ(j.at("config_set"), nlohmann::json({"steps=60", "filter.r=2.5"}));
+  std::ostringstream best;
+  best << std::ifstream(root / "out" / "best_config.yaml").rdbuf();
+  const YAML::Node b = YAML::Load(best.str());
+  EXPECT_EQ(b["steps"].as<int>(), 60);
+  EXPECT_DOUBLE_EQ(b["filter"]["r"].as<double>(), 2.5);
+  EXPECT_NE(best.str().find("# samples"), std::string::npos) << best.str();  // edited in place
+  // A mistyped key is refused by the scenario's strict loader, before any run.
+  o.set = {"filter.rr=2"};
+  o.out_dir = (root / "bad").string();
+  try {
+    runSweepSession(toy::registry(), (root / "sweep.yaml").string(), o);
+    ADD_FAILURE() << "filter.rr accepted";
+  } catch (const core::InvalidInput& e) {
+    EXPECT_NE(std::string(e.what()).find("filter.rr"), std::string::npos) << e.what();
+  }
   fs::remove_all(root);
 }

@@ -1,7 +1,8 @@
 #pragma once
 // Dotted config keys ("tracker.accel_psd", "cameras[1].hfov_deg") on YAML trees, and a scenario
 // file loaded with some of its values changed from the command line (the --set of every scenario
-// app and of bench/pan_tilt_seeds):
+// app and of bench/pan_tilt_seeds; viewline_tune's --set edits the text instead, so that the configs
+// it writes back keep the values: tuning::SessionOptions::set):
 //
 //   pan_tilt_tracking --config config/pan_tilt_random.yaml --set camera.fps=60 --set unit.latency=0.02
 //
@@ -55,7 +56,7 @@ std::pair<std::string, YAML::Node> parseKeyValue(const std::string& text);
 /// name the file "with --set" (their line numbers are those of the edited tree).
 ConfigNode loadConfigWithValues(const std::string& path, const std::vector<std::string>& key_values);
 
-/// The command-line help of the --set option of the scenario apps and benches.
+/// The command-line help of every --set option (scenario apps, viewline_tune, benches).
 inline constexpr const char* kSetOptionHelp =
     "KEY=VALUE: change one key of the --config file for this run (repeatable; dotted keys, list items as "
     "name[i], YAML values: --set camera.fps=60 --set filter.model=ct); unknown keys are refused";
