@@ -25,6 +25,21 @@ scenarios::PanTiltScenarioConfig shipped(const std::string& name) {
   // Tests run with the project root as working directory (viewline_add_test).
   return scenarios::loadPanTiltScenarioConfig(io::ConfigNode::loadFile("config/pan_tilt_" + name + ".yaml"));
 }
+
+// A closed-loop run of ours with --log into a fresh temporary folder (the caller removes it).
+struct LoggedRun {
+  scenarios::PanTiltRunMetrics metrics;
+  std::filesystem::path dir;
+  std::string frames() const { return (dir / "predictive_frames.csv").string(); }
+};
+LoggedRun loggedRun(const scenarios::PanTiltScenarioConfig& cfg, std::uint64_t seed, const std::string& tag) {
+  LoggedRun out;
+  out.dir = std::filesystem::temp_directory_path() / ("viewline_pt_" + tag + "_" + std::to_string(::getpid()));
+  io::LogDirectory log(out.dir.string());
+  out.metrics = scenarios::runPanTilt(cfg, seed, PanTiltControllerKind::Predictive, nullptr, &log);
+  log.flush();
+  return out;
+}
 }  // namespace
 
 TEST(PanTiltScenario, EachShippedPathTracksForAFewSeconds) {
@@ -174,13 +189,9 @@ TEST(PanTiltScenario, ReplayOfALoggedRunReproducesItsFilter) {
   cfg.duration = 6.0;  // the first corner is at 5.33 s
   cfg.metrics_start = 1.0;
   cfg.occlusion_start = -1.0;
-  const auto dir = std::filesystem::temp_directory_path() / ("viewline_pt_replay_" + std::to_string(::getpid()));
-  scenarios::PanTiltRunMetrics run;
-  {
-    io::LogDirectory log(dir.string());
-    run = scenarios::runPanTilt(cfg, 7, PanTiltControllerKind::Predictive, nullptr, &log);
-    log.flush();
-  }
+  const LoggedRun logged = loggedRun(cfg, 7, "replay");
+  const auto& dir = logged.dir;
+  const scenarios::PanTiltRunMetrics& run = logged.metrics;
   scenarios::PanTiltReplayMetrics r;
   std::size_t replay_rows = 0;
   {
@@ -264,13 +275,9 @@ TEST(PanTiltScenario, TheParticleReferenceReplaysARandomRun) {
   cfg.duration = 8.0;
   cfg.metrics_start = 2.0;
   cfg.occlusion_start = -1.0;
-  const auto dir = std::filesystem::temp_directory_path() / ("viewline_pt_particles_" + std::to_string(::getpid()));
-  {
-    io::LogDirectory log(dir.string());
-    scenarios::runPanTilt(cfg, 3, PanTiltControllerKind::Predictive, nullptr, &log);
-    log.flush();
-  }
-  const std::string frames = (dir / "predictive_frames.csv").string();
+  const LoggedRun logged = loggedRun(cfg, 3, "particles");
+  const auto& dir = logged.dir;
+  const std::string frames = logged.frames();
   const auto f = scenarios::replayPanTiltFilter(cfg, 3, frames, scenarios::PanTiltReplayEstimator::Filter);
   const auto p =
       scenarios::replayPanTiltFilter(cfg, 3, frames, scenarios::PanTiltReplayEstimator::WaypointParticles, nullptr, 5000);
@@ -308,15 +315,10 @@ TEST(PanTiltScenario, TheParticleFilterRunsInTheLoopAndItsReplayReproducesIt) {
   cfg.duration = 6.0;
   cfg.metrics_start = 2.0;
   cfg.occlusion_start = -1.0;
-  const auto dir = std::filesystem::temp_directory_path() / ("viewline_pt_pf_loop_" + std::to_string(::getpid()));
-  scenarios::PanTiltRunMetrics run;
-  {
-    io::LogDirectory log(dir.string());
-    run = scenarios::runPanTilt(cfg, 5, PanTiltControllerKind::Predictive, nullptr, &log);
-    log.flush();
-  }
-  const auto r = scenarios::replayPanTiltFilter(cfg, 5, (dir / "predictive_frames.csv").string());
-  std::filesystem::remove_all(dir);
+  const LoggedRun logged = loggedRun(cfg, 5, "pf_loop");
+  const scenarios::PanTiltRunMetrics& run = logged.metrics;
+  const auto r = scenarios::replayPanTiltFilter(cfg, 5, logged.frames());
+  std::filesystem::remove_all(logged.dir);
   EXPECT_EQ(run.unsafe_commands + run.rate_violations + run.limit_hits, 0u);
   EXPECT_LT(run.image_error_rms_px, 40.0);
   EXPECT_LT(run.rmse_filtered_cm.norm(), 0.5 * run.rmse_measured_cm.norm());
