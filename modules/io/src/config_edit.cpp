@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <filesystem>
+#include <fstream>
 #include <sstream>
 
 #include "viewline/core/error.h"
@@ -54,17 +55,8 @@ std::pair<std::string, YAML::Node> parseKeyValue(const std::string& text) {
 
 ConfigNode loadConfigWithValues(const std::string& path, const std::vector<std::string>& key_values) {
   if (key_values.empty()) return ConfigNode::loadFile(path);
-  std::vector<std::pair<std::string, YAML::Node>> kv;
-  for (const std::string& s : key_values) kv.push_back(parseKeyValue(s));
-  ConfigNode::loadFile(path);  // the file's own errors (syntax, duplicate keys) with its own line numbers
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path);
-  } catch (const YAML::Exception& e) {
-    throw InvalidInput(path + ": " + e.what());
-  }
   const std::string base = std::filesystem::absolute(path).parent_path().string();
-  return ConfigNode::fromString(emitYaml(withValues(root, kv)), path + " (with --set)", base);
+  return ConfigNode::fromString(configTextWithValues(path, key_values), path + " (with --set)", base);
 }
 
 std::optional<YAML::Node> findKey(const YAML::Node& root, const std::string& dotted) {
@@ -129,6 +121,71 @@ std::string emitYaml(const YAML::Node& node) {
   YAML::Emitter e;
   e << node;
   return std::string(e.c_str()) + "\n";
+}
+
+std::string rewriteYamlText(const std::string& original_text,
+                            const std::vector<std::pair<std::string, YAML::Node>>& values,
+                            const std::string& header) {
+  std::string head;
+  {
+    std::istringstream hs(header);
+    std::string l;
+    while (std::getline(hs, l)) head += "# " + l + "\n";
+  }
+  YAML::Node root = YAML::Load(original_text);
+  std::vector<std::string> lines;
+  {
+    std::istringstream is(original_text);
+    std::string l;
+    while (std::getline(is, l)) lines.push_back(l);
+  }
+  struct Edit {
+    int line, col;
+    std::size_t len;
+    std::string text;
+  };
+  std::vector<Edit> edits;
+  bool in_place = true;
+  for (const auto& [key, value] : values) {
+    const std::optional<YAML::Node> n = findKey(root, key);
+    if (!n || !n->IsScalar() || !value.IsScalar()) {
+      in_place = false;
+      break;
+    }
+    const YAML::Mark m = n->Mark();
+    const std::string raw = n->Scalar();
+    if (m.line < 0 || static_cast<std::size_t>(m.line) >= lines.size() || raw.empty() ||
+        lines[static_cast<std::size_t>(m.line)].compare(static_cast<std::size_t>(m.column), raw.size(), raw) != 0) {
+      in_place = false;
+      break;
+    }
+    std::string text = value.Scalar();
+    // Quote text that YAML would not read back as the same plain scalar.
+    if (text.empty() || text.find_first_of(":#{}[],&*!|>'\"%@`") != std::string::npos) text = "\"" + text + "\"";
+    edits.push_back({m.line, m.column, raw.size(), text});
+  }
+  if (in_place) {
+    std::sort(edits.begin(), edits.end(), [](const Edit& a, const Edit& b) {
+      return a.line != b.line ? a.line > b.line : a.col > b.col;
+    });
+    for (const Edit& e : edits)
+      lines[static_cast<std::size_t>(e.line)].replace(static_cast<std::size_t>(e.col), e.len, e.text);
+    std::string out = head;
+    for (const std::string& l : lines) out += l + "\n";
+    return out;
+  }
+  return head + "# (re-emitted: comments of the original file are not kept)\n" +
+         emitYaml(withValues(root, values));
+}
+
+std::string configTextWithValues(const std::string& path, const std::vector<std::string>& key_values) {
+  std::vector<std::pair<std::string, YAML::Node>> kv;
+  for (const std::string& s : key_values) kv.push_back(parseKeyValue(s));
+  ConfigNode::loadFile(path);  // the file's own errors (missing, syntax, duplicate keys) with its own line numbers
+  std::ifstream in(path);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return kv.empty() ? text.str() : rewriteYamlText(text.str(), kv, "");
 }
 
 }  // namespace viewline::io

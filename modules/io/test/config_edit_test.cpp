@@ -31,6 +31,18 @@ TEST(ConfigEdit, DottedKeysReachMapsAndListItems) {
   EXPECT_EQ(segs[1].index, 3);
 }
 
+TEST(ConfigEdit, RewriteKeepsCommentsAndReplacesInPlace) {
+  const std::string text = "# top\nq_true: 0.01   # truth\nfilter:\n  q: 0.5       # filter q\n  r: 2\n";
+  const std::string out = rewriteYamlText(text, {{"filter.q", YAML::Node("0.25")}}, "tuned");
+  EXPECT_NE(out.find("# tuned\n# top\n"), std::string::npos) << out;
+  EXPECT_NE(out.find("  q: 0.25       # filter q\n"), std::string::npos) << out;
+  EXPECT_EQ(YAML::Load(out)["filter"]["q"].as<double>(), 0.25);
+  // A key absent from the file: re-emitted with the value.
+  const std::string out2 = rewriteYamlText(text, {{"steps", YAML::Node("50")}}, "x");
+  EXPECT_EQ(YAML::Load(out2)["steps"].as<int>(), 50);
+  EXPECT_EQ(YAML::Load(out2)["filter"]["r"].as<int>(), 2);
+}
+
 TEST(ConfigEdit, SetValuesOnAFileKeepItsFolderAndRejectBadText) {
   namespace fs = std::filesystem;
   const test::TempDir dir;

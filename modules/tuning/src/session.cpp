@@ -34,24 +34,6 @@ std::string fmt(double v, int prec = 4) {
   return b;
 }
 
-std::string readText(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw core::InvalidInput(path + ": cannot read the scenario config");
-  std::ostringstream os;
-  os << in.rdbuf();
-  return os.str();
-}
-
-// The scenario config's text with the command line's --set values written in (see SessionOptions::set).
-std::string configText(const std::string& path, const std::vector<std::string>& set) {
-  const std::string text = readText(path);
-  if (set.empty()) return text;
-  std::vector<std::pair<std::string, YAML::Node>> kv;
-  for (const std::string& s : set) kv.push_back(io::parseKeyValue(s));
-  // No header: edited in place, the lines keep their numbers, so messages point into the user's file.
-  return rewriteYamlText(text, kv, "");
-}
-
 YAML::Node parseYaml(const std::string& text, const std::string& path) {
   try {
     return YAML::Load(text);
@@ -279,7 +261,7 @@ AutotuneOutcome doAutotune(const ScenarioInstance& base, const std::string& orig
               fmt(o.result.tuned[i]) + " " + params[i].unit + (params[i].config_key.empty() ? " (not written: no config key)" : "") + "\n";
   addRelocatedPaths(kv, original_text, source_name, out_dir);
   o.config_file = (fs::path(out_dir) / "autotuned_config.yaml").string();
-  io::writeTextFileAtomic(o.config_file, rewriteYamlText(original_text, kv, header));
+  io::writeTextFileAtomic(o.config_file, io::rewriteYamlText(original_text, kv, header));
   o.json["autotuned_config"] = o.config_file;
   return o;
 }
@@ -304,7 +286,7 @@ nlohmann::json runSweepSession(const AdapterRegistry& registry, const std::strin
   const std::string config_path = !opt.config_override.empty() ? opt.config_override : spec.config_path;
   if (config_path.empty())
     throw core::InvalidInput(sweep_file + ": no scenario config (give 'config:' in the sweep file or --config)");
-  const std::string text = configText(config_path, opt.set);
+  const std::string text = io::configTextWithValues(config_path, opt.set);
   const YAML::Node tree = parseYaml(text, config_path);
   const std::unique_ptr<ScenarioInstance> base = adapter.load(tree, config_path, spec.adapter_options);
   if (spec.autotune.enabled && !opt.skip_autotune) {
@@ -429,7 +411,7 @@ nlohmann::json runSweepSession(const AdapterRegistry& registry, const std::strin
                                (spec.minimize ? "minimised" : "maximised") + ": " + fmt(best_metric, 6) + " over " +
                                std::to_string(spec.seeds) + " seeds)\n" + settingLabel(spec, b.setting) +
                                "\nbased on " + config_path;
-    const std::string best_text = rewriteYamlText(text, kv, header);
+    const std::string best_text = io::rewriteYamlText(text, kv, header);
     io::writeTextFileAtomic(best_config, best_text);
     bool verified = true;
     try {
@@ -575,7 +557,7 @@ nlohmann::json runSweepSession(const AdapterRegistry& registry, const std::strin
 
 nlohmann::json runSingleSession(const AdapterRegistry& registry, const SingleRunOptions& o) {
   const ScenarioAdapter& adapter = registry.get(o.scenario);
-  const std::string text = configText(o.config, o.set);
+  const std::string text = io::configTextWithValues(o.config, o.set);
   AdapterOptions ao = readAdapterOptions(adapter, nullptr);
   for (const auto& [k, v] : o.adapter_options) {
     if (!ao.count(k)) throw core::InvalidInput("--option " + k + ": not an option of scenario '" + o.scenario + "'");
@@ -638,7 +620,7 @@ nlohmann::json runSingleSession(const AdapterRegistry& registry, const SingleRun
 
 nlohmann::json runAutotuneSession(const AdapterRegistry& registry, const AutotuneSessionOptions& o) {
   const ScenarioAdapter& adapter = registry.get(o.scenario);
-  const std::string text = configText(o.config, o.set);
+  const std::string text = io::configTextWithValues(o.config, o.set);
   AdapterOptions aopt = readAdapterOptions(adapter, nullptr);
   for (const auto& [k, v] : o.adapter_options) {
     if (!aopt.count(k)) throw core::InvalidInput("--option " + k + ": not an option of scenario '" + o.scenario + "'");

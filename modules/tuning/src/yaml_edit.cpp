@@ -13,61 +13,6 @@ std::string scalarText(const YAML::Node& value) {
   return e.c_str();
 }
 
-std::string rewriteYamlText(const std::string& original_text,
-                            const std::vector<std::pair<std::string, YAML::Node>>& values,
-                            const std::string& header) {
-  std::string head;
-  {
-    std::istringstream hs(header);
-    std::string l;
-    while (std::getline(hs, l)) head += "# " + l + "\n";
-  }
-  YAML::Node root = YAML::Load(original_text);
-  std::vector<std::string> lines;
-  {
-    std::istringstream is(original_text);
-    std::string l;
-    while (std::getline(is, l)) lines.push_back(l);
-  }
-  struct Edit {
-    int line, col;
-    std::size_t len;
-    std::string text;
-  };
-  std::vector<Edit> edits;
-  bool in_place = true;
-  for (const auto& [key, value] : values) {
-    const std::optional<YAML::Node> n = io::findKey(root, key);
-    if (!n || !n->IsScalar() || !value.IsScalar()) {
-      in_place = false;
-      break;
-    }
-    const YAML::Mark m = n->Mark();
-    const std::string raw = n->Scalar();
-    if (m.line < 0 || static_cast<std::size_t>(m.line) >= lines.size() || raw.empty() ||
-        lines[static_cast<std::size_t>(m.line)].compare(static_cast<std::size_t>(m.column), raw.size(), raw) != 0) {
-      in_place = false;
-      break;
-    }
-    std::string text = value.Scalar();
-    // Quote text that YAML would not read back as the same plain scalar.
-    if (text.empty() || text.find_first_of(":#{}[],&*!|>'\"%@`") != std::string::npos) text = "\"" + text + "\"";
-    edits.push_back({m.line, m.column, raw.size(), text});
-  }
-  if (in_place) {
-    std::sort(edits.begin(), edits.end(), [](const Edit& a, const Edit& b) {
-      return a.line != b.line ? a.line > b.line : a.col > b.col;
-    });
-    for (const Edit& e : edits)
-      lines[static_cast<std::size_t>(e.line)].replace(static_cast<std::size_t>(e.col), e.len, e.text);
-    std::string out = head;
-    for (const std::string& l : lines) out += l + "\n";
-    return out;
-  }
-  return head + "# (re-emitted by viewline_tune: comments of the original file are not kept)\n" +
-         io::emitYaml(io::withValues(root, values));
-}
-
 }  // namespace viewline::tuning
 
 namespace viewline::tuning {

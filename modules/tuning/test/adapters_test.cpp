@@ -155,7 +155,7 @@ TEST(ScenarioAdapters, PanTiltAutotuneRefusesTheParticleFilter) {
   AutotuneSessionOptions a;
   a.scenario = "pan_tilt";
   a.config = (dir / "particles.yaml").string();
-  std::ofstream(a.config) << rewriteYamlText(text, values, "test: the random config with the particle filter");
+  std::ofstream(a.config) << io::rewriteYamlText(text, values, "test: the random config with the particle filter");
   a.out_dir = (dir / "out").string();
   a.quiet = true;
   EXPECT_TRUE(hasInvalidInput([&] { runAutotuneSession(reg, a); }, "waypoint_particles has no process noise"));

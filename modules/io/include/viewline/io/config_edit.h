@@ -8,10 +8,11 @@
 //
 //   const io::ConfigNode cfg = io::loadConfigWithValues(path, sets);   // sets: {"camera.fps=60", ...}
 //
-// The edited tree is read back through io::ConfigNode, so the scenario's strict loader still
-// rejects a key it does not know (a mistyped --set key is named, not silently added) and a value
-// of the wrong type. Writing a file back with values replaced (keeping its comments) is
-// tuning::rewriteYamlText (viewline/tuning/yaml_edit.h).
+// The values are written into the file's text (rewriteYamlText: in place, so comments stay and the
+// lines keep their numbers, and messages point into the user's file) and read back through
+// io::ConfigNode, so the scenario's strict loader still rejects a key it does not know (a mistyped
+// --set key is named, not silently added) and a value of the wrong type. viewline_tune writes the
+// same text into the configs it saves (best_config.yaml, autotuned_config.yaml).
 
 #include <optional>
 #include <string>
@@ -49,11 +50,25 @@ std::string emitYaml(const YAML::Node& node);
 /// value is not YAML.
 std::pair<std::string, YAML::Node> parseKeyValue(const std::string& text);
 
-/// A scenario file with `key_values` ("key=value", as parseKeyValue) applied: ConfigNode::loadFile
-/// when there are none; otherwise the file's tree with the values set (maps created as needed), read
-/// back through ConfigNode, so the scenario's strict loader still rejects a key it does not know
-/// and a wrong type. Relative paths in the file resolve against its folder as with loadFile; messages
-/// name the file "with --set" (their line numbers are those of the edited tree).
+/// The scenario text with the values replaced. rewriteYamlText() keeps the file as it is (comments,
+/// order, layout) and replaces only the scalars of the given keys in place (found through the
+/// parser's line/column marks); when a key is missing from the file, or its value is not a plain
+/// one-line scalar, the whole tree is emitted instead (valid YAML with the same keys and the new
+/// values, comments lost) and a comment line says so. `header` (lines) is put in comments at the top.
+std::string rewriteYamlText(const std::string& original_text,
+                            const std::vector<std::pair<std::string, YAML::Node>>& values,
+                            const std::string& header);
+
+/// The text of the scenario file at `path` with `key_values` ("key=value", as parseKeyValue) written
+/// in (rewriteYamlText, no header). Throws core::InvalidInput naming the file when it cannot be read
+/// or parsed, and naming the text of a malformed key=value.
+std::string configTextWithValues(const std::string& path, const std::vector<std::string>& key_values);
+
+/// A scenario file with `key_values` applied: ConfigNode::loadFile when there are none; otherwise
+/// configTextWithValues() read through ConfigNode, so the scenario's strict loader still rejects a key
+/// it does not know and a wrong type. Relative paths in the file resolve against its folder as with
+/// loadFile; messages name the file "with --set" (their line numbers are the file's when the keys
+/// were edited in place).
 ConfigNode loadConfigWithValues(const std::string& path, const std::vector<std::string>& key_values);
 
 /// The command-line help of every --set option (scenario apps, viewline_tune, benches).

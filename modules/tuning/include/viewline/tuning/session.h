@@ -24,7 +24,7 @@ struct SessionOptions {
   std::string out_dir = "tune_out";
   std::string config_override;        ///< scenario config instead of the sweep file's `config`
   /// "key=value" edits of the scenario config (the command line's --set): applied to its text before
-  /// anything is loaded (tuning::rewriteYamlText, comments kept where the keys are plain scalars), so
+  /// anything is loaded (io::configTextWithValues, comments kept where the keys are plain scalars), so
   /// the runs, the summary's `config_set` and the configs written back (best_config.yaml,
   /// autotuned_config.yaml) all have them.
   std::vector<std::string> set;
@@ -47,11 +47,7 @@ struct SingleRunOptions {
   std::string out_dir = "tune_run";
   std::string log_dir;       ///< scenario logs (CSV) of the run, "" = none
   bool display = false;      ///< live curves (vpPlot) + the scenario's view
-  /// "key=value" edits of the scenario config (the command line's --set): applied to its text before
-  /// anything is loaded (tuning::rewriteYamlText, comments kept where the keys are plain scalars), so
-  /// the runs, the summary's `config_set` and the configs written back (best_config.yaml,
-  /// autotuned_config.yaml) all have them.
-  std::vector<std::string> set;
+  std::vector<std::string> set;  ///< --set edits of the config (see SessionOptions::set)
   AdapterOptions adapter_options;
   bool quiet = false;
 };
@@ -70,11 +66,7 @@ struct AutotuneSessionOptions {
   int verify_runs = 0;        ///< > 0: live runs of the tuned config for NEES/NIS (seeds 1..n)
   int workers = 0;
   std::string out_dir = "tune_autotune";
-  /// "key=value" edits of the scenario config (the command line's --set): applied to its text before
-  /// anything is loaded (tuning::rewriteYamlText, comments kept where the keys are plain scalars), so
-  /// the runs, the summary's `config_set` and the configs written back (best_config.yaml,
-  /// autotuned_config.yaml) all have them.
-  std::vector<std::string> set;
+  std::vector<std::string> set;  ///< --set edits of the config (see SessionOptions::set)
   AdapterOptions adapter_options;
   bool quiet = false;
 };

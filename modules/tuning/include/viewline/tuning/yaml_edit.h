@@ -1,12 +1,7 @@
 #pragma once
-// Writing a scenario file back with some values replaced (the session's best_config.yaml). The
-// dotted-key edits of YAML trees it builds on (io::withValue, io::findKey, io::loadConfigWithValues
-// for --set) live in viewline/io/config_edit.h.
-//
-// rewriteYamlText() keeps the user's file as it is (comments, order, layout) and replaces only
-// the scalars of the given keys in place (found through the parser's line/column marks); when a
-// key is missing from the file, or its value is not a plain one-line scalar, the whole tree is
-// emitted instead (valid YAML with the same keys, comments lost) and a header comment says so.
+// What the tuning sessions add to the config edits of viewline/io/config_edit.h (dotted keys,
+// io::rewriteYamlText, --set): values as table text, and the relative paths of a config re-expressed
+// for a copy written into another folder (the session's best_config.yaml).
 
 #include <optional>
 #include <string>
@@ -20,12 +15,6 @@ namespace viewline::tuning {
 
 /// The text of a scalar node ("0.5", "mahalanobis"); "[...]" rendering of sequences.
 std::string scalarText(const YAML::Node& value);
-
-/// The scenario text with the values replaced (see the file comment). `header` is put in a
-/// comment at the top.
-std::string rewriteYamlText(const std::string& original_text,
-                            const std::vector<std::pair<std::string, YAML::Node>>& values,
-                            const std::string& header);
 
 }  // namespace viewline::tuning
 
