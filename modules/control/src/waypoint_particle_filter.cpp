@@ -173,28 +173,13 @@ void WaypointParticleFilter::resetWeights() {
   w_sum_ = ess_ = static_cast<double>(particles_.size());
 }
 
-Vector2d WaypointParticleFilter::predict(double t) const {
-  if (!initialized_) throw core::InvalidInput("waypoint particle filter: predict before the first measurement");
-  if (!(t >= t_)) throw core::InvalidInput("waypoint particle filter: predict into the past");
-  core::Rng rng = core::makeRng(core::deriveSeed(cfg_.seed, 1000003 + updates_));
-  Vector2d sum = Vector2d::Zero();
-  const double dt = t - t_;
-  for (std::size_t i = 0; i < particles_.size(); ++i) {
-    if (dt <= 0.0) {
-      sum += w_[i] * particles_[i].p;
-      continue;
-    }
-    Particle q = particles_[i];
-    advance(q, dt, rng);
-    sum += w_[i] * q.p;
-  }
-  return sum / w_sum_;
-}
+Vector2d WaypointParticleFilter::predict(double t) const { return moments(t).p; }
 
 WaypointParticleFilter::Moments WaypointParticleFilter::moments(double t) const {
-  if (!initialized_) throw core::InvalidInput("waypoint particle filter: moments before the first measurement");
-  if (!(t >= t_)) throw core::InvalidInput("waypoint particle filter: moments in the past");
-  core::Rng rng = core::makeRng(core::deriveSeed(cfg_.seed, 1000003 + updates_));  // as predict()
+  if (!initialized_) throw core::InvalidInput("waypoint particle filter: predict before the first measurement");
+  if (!(t >= t_)) throw core::InvalidInput("waypoint particle filter: predict into the past");
+  // Fresh waypoints from a stream of the update count: the same cloud gives the same run-ahead.
+  core::Rng rng = core::makeRng(core::deriveSeed(cfg_.seed, 1000003 + updates_));
   const double dt = t - t_;
   Eigen::Vector4d sum = Eigen::Vector4d::Zero();
   Eigen::Matrix4d second = Eigen::Matrix4d::Zero();
