@@ -148,6 +148,14 @@ YAML::Node ConfigNode::valueNode(const std::string& key, const char* expected) c
   return node_[key];
 }
 
+bool ConfigNode::isWord(const std::string& key, const std::string& word) const {
+  if (!has(key)) return false;
+  const YAML::Node n = node_[key];
+  if (!n.IsScalar() || n.Scalar() != word) return false;
+  shared_->consumed.insert(keyPath(key));
+  return true;
+}
+
 void ConfigNode::ignore(const std::string& key) const { shared_->consumed.insert(keyPath(key)); }
 
 // ---- scalars ---------------------------------------------------------------------------------

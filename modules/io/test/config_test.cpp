@@ -157,3 +157,15 @@ TEST(Config, MatrixAndEmptySection) {
   EXPECT_EQ(e.getOr<int>("x", 3), 3);
   EXPECT_NO_THROW(cfg.finish());
 }
+
+TEST(Config, AValueOrAuto) {
+  const ConfigNode c = ConfigNode::fromString("samples: auto\nsigma: 0.01\nbad: atuo\nquoted: \"auto\"\n", "f.yaml");
+  EXPECT_EQ(c.getOrAuto<int>("samples", 4, "an integer"), std::nullopt);
+  EXPECT_EQ(c.getOrAuto<double>("sigma", std::nullopt, "a length"), 0.01);
+  EXPECT_EQ(c.getOrAuto<int>("absent", 4, "an integer"), 4);
+  EXPECT_EQ(c.getOrAuto<int>("quoted", 4, "an integer"), std::nullopt);
+  const std::string e = errorOf([&] { c.getOrAuto<int>("bad", 4, "an integer >= 2"); });
+  EXPECT_NE(e.find("f.yaml:3:"), std::string::npos) << e;
+  EXPECT_NE(e.find("expected an integer >= 2 or auto, got 'atuo'"), std::string::npos) << e;
+  c.finish();  // every key was read, "auto" ones included
+}

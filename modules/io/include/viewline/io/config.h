@@ -22,10 +22,13 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <set>
 #include <string>
 #include <vector>
 #include <yaml-cpp/yaml.h>
+
+#include "viewline/core/error.h"
 
 namespace viewline::io {
 
@@ -52,6 +55,22 @@ public:
   T getOr(const std::string& key, const T& fallback) const {
     return has(key) ? get<T>(key) : fallback;
   }
+
+  /// A value that may also be the word `auto` (chosen by the code that reads it): std::nullopt for
+  /// `auto`, `fallback` when the key is absent; anything else that is not a T is refused as
+  /// "expected <what> or auto".
+  template <class T>
+  std::optional<T> getOrAuto(const std::string& key, const std::optional<T>& fallback, const std::string& what) const {
+    if (!has(key)) return fallback;
+    if (isWord(key, "auto")) return std::nullopt;
+    try {
+      return get<T>(key);
+    } catch (const core::InvalidInput&) {
+      fail(key, what + " or auto");
+    }
+  }
+  /// True (and the key marked as read) when the key holds exactly this plain scalar word.
+  bool isWord(const std::string& key, const std::string& word) const;
 
   /// An angle: the key must end in "_deg"; the file holds degrees, the result is radians.
   double getAngle(const std::string& key) const;
