@@ -102,13 +102,14 @@ void TargetFilterConfig::validate() const {
   for (int i = 0; i < 3; ++i) core::requirePositive(imm_sojourn(i), "filter.imm_sojourn");
   if (!(jump_window >= 0.0) || !std::isfinite(jump_window)) throw core::InvalidInput("filter.jump_window must be >= 0");
   core::requirePositive(jump_threshold, "filter.jump_threshold");
-  if (jump_min_samples < 2) throw core::InvalidInput("filter.jump_min_samples must be >= 2");
+  if (jump_min_samples && *jump_min_samples < 2)
+    throw core::InvalidInput("filter.jump_min_samples must be >= 2 (or auto)");
   if (!(constant_speed_sigma >= 0.0) || !std::isfinite(constant_speed_sigma))
     throw core::InvalidInput("filter.constant_speed_sigma must be >= 0");
   if (!(jump_rate >= 0.0) || !std::isfinite(jump_rate)) throw core::InvalidInput("filter.jump_rate must be >= 0");
   core::requirePositive(jump_prior_sigma, "filter.jump_prior_sigma");
-  if (!(jump_corner_sigma >= 0.0) || !std::isfinite(jump_corner_sigma))
-    throw core::InvalidInput("filter.jump_corner_sigma must be >= 0");
+  if (jump_corner_sigma && (!(*jump_corner_sigma >= 0.0) || !std::isfinite(*jump_corner_sigma)))
+    throw core::InvalidInput("filter.jump_corner_sigma must be >= 0 (or auto)");
   if (!(turn_prior_weight >= 0.0 && turn_prior_weight < 1.0))
     throw core::InvalidInput("filter.turn_prior_weight must be in [0, 1) (1 would forbid any new turn angle)");
   if (!(turn_prior_sigma_deg > 0.0 && turn_prior_sigma_deg <= 45.0))
@@ -444,6 +445,7 @@ void PlanarTargetFilter::reset(core::Timestamp t, const Eigen::Vector2d& z, cons
     output_.reset();
     return;
   }
+  noteMeasurement(t, R);
   const int n = std::max(stateDim(), 4);  // (the max tells gcc n > 2: no false null-dereference warning)
   Eigen::VectorXd x = Eigen::VectorXd::Zero(n);
   x(0) = z(0);
@@ -484,6 +486,7 @@ PlanarTargetFilter::Update PlanarTargetFilter::update(core::Timestamp t, const E
     out.reinitialized = particles_->reinitialisations() != restarts;
     return out;
   }
+  noteMeasurement(t, R);
   Update out = step(t, z, R);
   if (out.accepted) checkRegion(z, R);
   // Gated-out measurements are kept for the jump test too: after a sharp corner the first
@@ -493,6 +496,41 @@ PlanarTargetFilter::Update PlanarTargetFilter::update(core::Timestamp t, const E
   while (history_.size() > 1 && history_.front().t < t - config_.jump_window) history_.erase(history_.begin());
   out.jump = detectJump();
   return out;
+}
+
+void PlanarTargetFilter::noteMeasurement(core::Timestamp t, const Eigen::Matrix2d& R) {
+  last_R_ = R;
+  if (std::isfinite(last_t_) && t > last_t_) {
+    intervals_.push_back(t - last_t_);
+    if (intervals_.size() > 16) intervals_.erase(intervals_.begin());
+  }
+  if (!std::isfinite(last_t_) || t > last_t_) last_t_ = t;
+}
+
+int PlanarTargetFilter::minSamples() const {
+  if (config_.jump_min_samples) return *config_.jump_min_samples;
+  // "auto": round(k ρ^(2/3)), ρ = σ / (ŝ Δt) (class comment, "Noise-scaled corner settings").
+  const double sigma = std::sqrt(0.5 * std::max(last_R_.trace(), 0.0));
+  double dt = 0.0;
+  if (!intervals_.empty()) {
+    std::vector<double> sorted = intervals_;
+    std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2), sorted.end());
+    dt = sorted[sorted.size() / 2];
+  }
+  double speed = speedEstimate();
+  if (!(speed_info_ > 0.0) && initialized_) {
+    const Eigen::Vector2d v = state_.x().segment<2>(2);
+    const double var_v = state_.P().block<2, 2>(2, 2).trace();
+    if (v.squaredNorm() > var_v) speed = v.norm();
+  }
+  if (!(speed > 0.0) || !(dt > 0.0) || !(sigma > 0.0)) return kAutoJumpSamplesMax;
+  const double m = std::round(kAutoJumpSamplesScale * std::cbrt(std::pow(sigma / (speed * dt), 2)));
+  return static_cast<int>(std::clamp(m, 2.0, static_cast<double>(kAutoJumpSamplesMax)));
+}
+
+double PlanarTargetFilter::cornerSigma() const {
+  if (config_.jump_corner_sigma) return *config_.jump_corner_sigma;
+  return kAutoCornerSigmaPerNoise * std::sqrt(0.5 * std::max(last_R_.trace(), 0.0));
 }
 
 PlanarTargetFilter::Snapshot PlanarTargetFilter::snapshot(core::Timestamp t, const Eigen::Vector2d& z,
@@ -539,7 +577,7 @@ bool PlanarTargetFilter::detectJump() {
   // the position kept, and the measurements after t_j are processed again. x(k|k) stays a filtered
   // estimate (it uses measurements up to t_k only).
   const int n = static_cast<int>(history_.size());
-  const int m = config_.jump_min_samples;
+  const int m = minSamples();
   const bool soft = config_.jump_rate > 0.0;
   output_.reset();
   // Hard test: m <= j < n - m. Soft mixture: every j with m measurements before and 2 after.
@@ -901,7 +939,7 @@ PlanarTargetFilter::Leg PlanarTargetFilter::makeLeg(core::Timestamp t_c, const E
   }
   leg.beta0 << c, speedEstimate();
   Eigen::Matrix3d P0 = Eigen::Matrix3d::Zero();
-  P0.topLeftCorner<2, 2>() = P_c + std::pow(config_.jump_corner_sigma, 2) * Eigen::Matrix2d::Identity();
+  P0.topLeftCorner<2, 2>() = P_c + std::pow(cornerSigma(), 2) * Eigen::Matrix2d::Identity();
   P0(2, 2) = speedVariance() + config_.constant_speed_sigma * config_.constant_speed_sigma;
   leg.P0_inv = P0.inverse();
   return leg;
@@ -939,7 +977,7 @@ void PlanarTargetFilter::learnSpeed(std::size_t end) {
   // ended at the detected jump, or its last jump_window s): var b = 1 / Σ w (t − t̄)², t̄ the weighted
   // mean time. s_k = |b|, var s_k = b̂ᵀ diag(var b) b̂ (b̂ = b / |b|). Segments under 0.5 s or with
   // fewer than 2 jump_min_samples measurements are skipped (their slope is mostly noise).
-  if (end + 1 < static_cast<std::size_t>(2 * config_.jump_min_samples)) return;
+  if (end + 1 < static_cast<std::size_t>(2 * minSamples())) return;
   if (history_[end].t - history_.front().t < 0.5) return;
   Eigen::Vector2d b, var_b;
   for (int a = 0; a < 2; ++a) {

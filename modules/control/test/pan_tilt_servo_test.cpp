@@ -282,11 +282,11 @@ control::TargetFilterConfig randomRegionFilter() {
   return c;
 }
 
-// Mean over the four random polylines (40 s, [T]'s 10 % noise σ 3.6 / 2.1 cm, scored after 8 s) of the
-// filter's RMS error; `check` (optional) sees each seed's filter once its track is done.
+// Mean over the four random polylines (40 s, [T]'s 10 % noise σ 3.6 / 2.1 cm unless `sigma` is given,
+// scored after 8 s) of the filter's RMS error; `check` (optional) sees each seed's filter once its track is done.
 double randomPolylineRms(const control::TargetFilterConfig& cfg, bool oracle = false,
-                         const std::function<void(std::uint64_t, const control::PlanarTargetFilter&)>& check = nullptr) {
-  const Eigen::Vector2d sigma(0.036, 0.021);
+                         const std::function<void(std::uint64_t, const control::PlanarTargetFilter&)>& check = nullptr,
+                         const Eigen::Vector2d& sigma = Eigen::Vector2d(0.036, 0.021)) {
   double rms = 0.0;
   for (std::uint64_t seed = 1; seed <= 4; ++seed) {
     std::vector<double> corners;
@@ -413,6 +413,54 @@ TEST(PlanarTargetFilter, LegEvidenceOnARandomPolyline) {
   // measured (mm): kinks 17.32, legs + leg evidence 13.99, oracle 10.17
   EXPECT_LT(r_legs, 0.9 * r_kinks);
   EXPECT_LT(r_oracle, r_legs);  // knowing the corners is a bound
+}
+
+TEST(PlanarTargetFilter, AutoCornerSettingsFollowTheNoiseAndTheStep) {
+  // "auto": jump_min_samples = round(2.44 ρ^(2/3)), ρ = σ / (ŝ Δt), and jump_corner_sigma = 0.34 σ, with σ
+  // the per-axis RMS of the measurement noise. On the app's random polyline at [T]'s 10 % noise and 30 Hz
+  // that is the pair the shipped config was tuned to (8, 0.01 m); at 60 Hz ρ doubles (12 or 13).
+  control::TargetFilterConfig autos = randomRegionFilter();
+  autos.jump_min_samples.reset();
+  autos.jump_corner_sigma.reset();
+  const Eigen::Vector2d sigma(0.036, 0.021);
+  const double sigma_rms = std::sqrt(0.5 * sigma.squaredNorm());
+  for (const double rate : {30.0, 60.0}) {
+    std::vector<double> corners;
+    const auto track = randomPolyline(1, 20.0, corners);
+    control::PlanarTargetFilter f(autos);
+    EXPECT_EQ(f.minSamples(), control::kAutoJumpSamplesMax);  // nothing known yet
+    core::Rng rng = core::makeRng(5);
+    for (int k = 0; k < static_cast<int>(20.0 * rate); ++k) {
+      const double t = k / rate;
+      f.update(t, track(t) + Eigen::Vector2d(core::gaussian(rng, sigma.x()), core::gaussian(rng, sigma.y())),
+               sigma.cwiseAbs2().asDiagonal());
+    }
+    ASSERT_GT(f.jumps(), 3u) << rate;
+    const double s = f.speedEstimate();
+    EXPECT_NEAR(s, 0.15, 0.01) << rate;
+    const double rho = sigma_rms / (s / rate);
+    EXPECT_EQ(f.minSamples(), static_cast<int>(std::lround(2.44 * std::pow(rho, 2.0 / 3.0)))) << rate;
+    EXPECT_NEAR(f.minSamples(), rate == 30.0 ? 8 : 12.7, 0.51) << rate;
+    EXPECT_NEAR(f.cornerSigma(), 0.34 * sigma_rms, 1e-12) << rate;
+  }
+  // Set values are used as they are.
+  const control::PlanarTargetFilter fixed(randomRegionFilter());
+  EXPECT_EQ(fixed.minSamples(), 8);
+  EXPECT_EQ(fixed.cornerSigma(), 0.01);
+  // At half [T]'s noise the 10 %-tuned pair waits too long at each corner; "auto" takes 4-5 measurements.
+  const Eigen::Vector2d half = 0.5 * sigma;
+  const double r_fixed = randomPolylineRms(randomRegionFilter(), false, nullptr, half);
+  const double r_auto = randomPolylineRms(autos, false, nullptr, half);
+  std::cout << "random polyline at 5 % noise, RMS (mm): fixed (8, 0.01 m) " << 1e3 * r_fixed << ", auto "
+            << 1e3 * r_auto << "\n";
+  // measured (mm): fixed 7.91, auto 6.76
+  EXPECT_LT(r_auto, 0.9 * r_fixed);
+  control::TargetFilterConfig bad = randomRegionFilter();
+  bad.jump_min_samples = 1;
+  EXPECT_THROW(control::PlanarTargetFilter{bad}, core::InvalidInput);
+  bad = randomRegionFilter();
+  bad.jump_corner_sigma = -0.01;
+  EXPECT_THROW(control::PlanarTargetFilter{bad}, core::InvalidInput);
 }
 
 TEST(PlanarTargetFilter, WaypointDirectionDensityAndNewKeys) {

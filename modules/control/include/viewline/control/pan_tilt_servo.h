@@ -119,10 +119,13 @@ struct TargetFilterConfig {
   Eigen::Vector3d imm_sojourn{5.0, 5.0, 0.2};  ///< IMM mean sojourn times (s) of the cv, ct, manoeuvre modes
   double jump_window = 0.0;              ///< s searched back for a velocity jump (GLR; 0: no jump detection)
   double jump_threshold = 20.0;          ///< GLR statistic (χ², 2 dof) that declares a jump
-  int jump_min_samples = 4;              ///< measurements after a candidate jump time before it is tested
+  /// Measurements after a candidate jump time before it is tested; nullopt: "auto", scaled to the
+  /// noise and the target's step per measurement (see "Noise-scaled corner settings" below).
+  std::optional<int> jump_min_samples = 4;
   bool constant_speed = false;           ///< constant-speed legs after each jump (cv; see PlanarTargetFilter)
   double constant_speed_sigma = 0.002;   ///< m/s, std of a leg's speed about the learnt ŝ (beside var ŝ)
-  double jump_corner_sigma = 0.0;        ///< m, added to the corner's position std when a leg starts
+  /// m, added to the corner's position std when a leg starts; nullopt: "auto" (noise-scaled, see below).
+  std::optional<double> jump_corner_sigma = 0.0;
   double turn_prior_weight = 0.0;        ///< constant-speed legs: prior mass on the learnt turn angles (0: θ uniform)
   double turn_prior_sigma_deg = 10.0;    ///< std (deg) of each learnt turn angle in that prior
   double jump_rate = 0.0;                ///< 1/s, prior rate of jumps; > 0: soft jump mixture (see below)
@@ -152,6 +155,12 @@ struct TargetFilterConfig {
 /// (cos θ, sin θ); c is clamped into the box. ∫ p dθ over [−π, π) = 1. (The waypoint-region prior.)
 double waypointDirectionDensity(const Eigen::Vector2d& c, const Eigen::Vector2d& center, const Eigen::Vector2d& size,
                                 double theta);
+
+/// "auto" corner settings (TargetFilterConfig::jump_min_samples / jump_corner_sigma unset; see the filter's
+/// comment "Noise-scaled corner settings").
+inline constexpr double kAutoJumpSamplesScale = 2.44;
+inline constexpr int kAutoJumpSamplesMax = 30;
+inline constexpr double kAutoCornerSigmaPerNoise = 0.34;
 
 /// Kalman filter of a target moving on a plane, state (p, v[, a]) in plane coordinates (m),
 /// models built as continuous-time systems and discretised exactly (estimation::discretize,
@@ -216,6 +225,19 @@ double waypointDirectionDensity(const Eigen::Vector2d& c, const Eigen::Vector2d&
 ///  dropped for good (regionDropped()): the filter goes on as without one (θ uniform, jump_rate odds). A
 ///  too small or shifted box would otherwise make every step near its edge look like a turn. (The
 ///  measurements, not the estimate: a turn at the edge is detected late, and the estimate overshoots.)
+/// Noise-scaled corner settings (jump_min_samples and/or jump_corner_sigma "auto", nullopt): with
+/// σ = √(tr R / 2) the measurement noise (its latest R, per-axis RMS), Δt the median of the last 16
+/// measurement intervals, ŝ the learnt speed (before the first leg has ended: |v̂| of the state once
+/// it exceeds its own std; until then jump_min_samples is kAutoJumpSamplesMax) and ρ = σ / (ŝ Δt),
+/// the noise in units of the target's step between measurements,
+///   jump_min_samples = clamp(round(kAutoJumpSamplesScale ρ^(2/3)), 2, kAutoJumpSamplesMax),
+///   jump_corner_sigma = kAutoCornerSigmaPerNoise σ.
+/// Why ρ^(2/3): n measurements after a turn that changes the velocity by Δv (∝ ŝ at constant speed)
+/// depart from straight on by Δv Δt k, k = 1..n, a log-likelihood ratio of about Δv² Δt² n³ / (3 σ²);
+/// the same evidence for every setting needs n ∝ ρ^(2/3). The two factors are the values tuned for [T]'s
+/// random path at 10 % noise (ρ = 5.9: 8 and 0.01 m), checked by grid search at 5-20 % noise, at
+/// 0.3 m/s and at 60 fps: "auto" is within 1.5 % of the best fixed pair of each setting, where the
+/// 10 %-tuned pair loses up to 12 % (docs/results.md, pan-tilt round 11).
 /// Waypoint particles (model waypoint_particles; needs the region): instead of a Kalman filter, the
 /// waypoint particle filter (waypoint_particle_filter.h), the posterior of the random path's own
 /// generator (waypoints uniform in the region, one speed). state() and estimate() are its posterior
@@ -262,6 +284,9 @@ public:
   void startLeg(core::Timestamp t_c);
   /// Sets ŝ and its variance (instead of learning them from the legs).
   void setSpeed(double speed, double variance);
+  /// The corner settings in force now: the configured values, or the "auto" ones (see the class comment).
+  int minSamples() const;
+  double cornerSigma() const;
   /// The learnt speed ŝ (m/s) and its variance; 0 / infinity before the first segment has ended.
   double speedEstimate() const { return speed_info_ > 0.0 ? speed_sum_ / speed_info_ : 0.0; }
   double speedVariance() const { return speed_info_ > 0.0 ? 1.0 / speed_info_ : 1e300; }
@@ -309,6 +334,10 @@ private:
   std::shared_ptr<const Leg> leg_;  ///< the current constant-speed leg (immutable: copies share it until it changes)
   std::optional<estimation::StateEstimate> output_;  ///< the soft mixture, when it differs from state_
   void learnSpeed(std::size_t end);  ///< s_k of the segment history_[0..end]
+  void noteMeasurement(core::Timestamp t, const Eigen::Matrix2d& R);  ///< for the "auto" corner settings
+  Eigen::Matrix2d last_R_ = Eigen::Matrix2d::Zero();
+  core::Timestamp last_t_ = std::numeric_limits<double>::quiet_NaN();
+  std::vector<double> intervals_;  ///< the last 16 measurement intervals (s)
   double speed_sum_ = 0.0, speed_info_ = 0.0;  ///< Σ s_k / var s_k, Σ 1 / var s_k
   std::vector<Snapshot> history_;  ///< accepted measurements of the last jump_window s (since the last jump)
   std::size_t jumps_ = 0;
