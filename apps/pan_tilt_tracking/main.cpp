@@ -15,6 +15,7 @@
 #include <cstdio>
 #include <iostream>
 #include <memory>
+#include <string>
 
 #include "viewline/core/error.h"
 #include "viewline/io/config_edit.h"
@@ -24,6 +25,16 @@
 #include "viewline/scenarios/pan_tilt_scenario.h"
 
 using namespace viewline;
+
+namespace {
+// " (auto)" when filter.jump_min_samples or jump_corner_sigma is "auto" (then chosen by the filter from
+// the noise and the target's step), else "".
+std::string cornerSettingsOrigin(const scenarios::PanTiltScenarioConfig& cfg) {
+  const auto& f = cfg.control.filter;
+  const bool m = !f.jump_min_samples, c = !f.jump_corner_sigma;
+  return m && c ? " (auto)" : m ? " (min samples auto)" : c ? " (corner sigma auto)" : "";
+}
+}  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"viewline pan-tilt tracking ([T]): predictive servo vs ViSP's point servo on a simulated FLIR PTU-D46"};
@@ -101,6 +112,9 @@ int main(int argc, char** argv) {
       std::printf("  rmse predicted %.4f s ahead (cm)  x %.4f  y %.4f  (%.2f px)\n", r.horizon_s, r.rmse_predicted_cm.x(),
                   r.rmse_predicted_cm.y(), r.predicted_error_px);
       std::printf("  predicted %.4f s ahead, what the frames see (px)  %.2f\n", r.frame_horizon_s, r.frame_predicted_error_px);
+      if (r.min_samples > 0)
+        std::printf("  corner settings%s at the end: %d measurements, %.4f m\n", cornerSettingsOrigin(cfg).c_str(),
+                    r.min_samples, r.corner_sigma);
       if (r.region_dropped)
         std::printf("  WARNING: the target left filter.region (measurements outside it): the region was dropped; "
                     "check its center and size\n");
@@ -161,7 +175,11 @@ int main(int argc, char** argv) {
       if (o.reacquired) std::printf(" %.3f s after it ended", o.reacquisition_delay_s);
       std::printf("\n");
     }
-    std::printf("  filter: %zu velocity jumps (corners) detected\n", o.filter_jumps);
+    std::printf("  filter: %zu velocity jumps (corners) detected", o.filter_jumps);
+    if (o.filter_min_samples > 0)
+      std::printf("; corner settings%s: %d measurements, %.4f m", cornerSettingsOrigin(cfg).c_str(),
+                  o.filter_min_samples, o.filter_corner_sigma);
+    std::printf("\n");
     if (o.filter_region_dropped)
       std::printf("  WARNING: the target left filter.region (measurements outside it): the region was dropped; "
                   "check its center and size\n");

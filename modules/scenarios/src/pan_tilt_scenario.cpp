@@ -8,6 +8,8 @@
 #include <fstream>
 #include <memory>
 #include <sstream>
+#include <tuple>
+#include <utility>
 
 #include "viewline/core/checks.h"
 #include "viewline/core/error.h"
@@ -27,6 +29,13 @@ using Eigen::Vector3d;
 
 namespace {
 constexpr const char* kRigCamera = "ptu_camera";  ///< the camera's name in a pan-tilt rig folder
+
+/// The filter's corner settings in force (its configured values or what "auto" made of them);
+/// (0, 0) for the particle filter and without jump detection, where they do not apply.
+std::pair<int, double> cornerSettings(const control::PlanarTargetFilter& f) {
+  if (f.config().model == control::TargetModel::WaypointParticles || !(f.config().jump_window > 0.0)) return {0, 0.0};
+  return {f.minSamples(), f.cornerSigma()};
+}
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------
@@ -193,11 +202,13 @@ PanTiltScenarioConfig loadPanTiltScenarioConfig(const io::ConfigNode& root) {
     c.control.filter.maneuver_q = f.getOr<double>("maneuver_q", c.control.filter.maneuver_q);
     c.control.filter.jump_window = f.getOr<double>("jump_window", c.control.filter.jump_window);
     c.control.filter.jump_threshold = f.getOr<double>("jump_threshold", c.control.filter.jump_threshold);
-    c.control.filter.jump_min_samples = f.getOr<int>("jump_min_samples", c.control.filter.jump_min_samples);
+    c.control.filter.jump_min_samples =
+        f.getOrAuto<int>("jump_min_samples", c.control.filter.jump_min_samples, "an integer >= 2");
     c.control.filter.constant_speed_sigma =
         f.getOr<double>("constant_speed_sigma", c.control.filter.constant_speed_sigma);
     c.control.filter.constant_speed = f.getOr<bool>("constant_speed", c.control.filter.constant_speed);
-    c.control.filter.jump_corner_sigma = f.getOr<double>("jump_corner_sigma", c.control.filter.jump_corner_sigma);
+    c.control.filter.jump_corner_sigma =
+        f.getOrAuto<double>("jump_corner_sigma", c.control.filter.jump_corner_sigma, "a length >= 0 (m)");
     c.control.filter.jump_rate = f.getOr<double>("jump_rate", c.control.filter.jump_rate);
     c.control.filter.jump_prior_sigma = f.getOr<double>("jump_prior_sigma", c.control.filter.jump_prior_sigma);
     c.control.filter.turn_prior_weight = f.getOr<double>("turn_prior_weight", c.control.filter.turn_prior_weight);
@@ -362,6 +373,7 @@ nlohmann::json PanTiltRunMetrics::toJson() const {
             {"frames_searching", frames_searching}}},
           {"filter_jumps", filter_jumps},
           {"filter_region_dropped", filter_region_dropped},
+          {"filter_corner_settings", {{"min_samples", filter_min_samples}, {"corner_sigma_m", filter_corner_sigma}}},
           {"wall_ms_per_frame", wall_ms_per_frame}};
 }
 
@@ -598,6 +610,7 @@ PanTiltRunMetrics runPanTilt(const PanTiltScenarioConfig& cfg, std::uint64_t see
     m.reacquisitions = ours->reacquisitions();
     m.filter_jumps = ours->filter().jumps();
     m.filter_region_dropped = ours->filter().regionDropped();
+    std::tie(m.filter_min_samples, m.filter_corner_sigma) = cornerSettings(ours->filter());
   }
   m.detection_pixel_rmse_px = det_px.rms();
   m.rate_violations = unit.rateViolations();
@@ -620,7 +633,8 @@ nlohmann::json PanTiltReplayMetrics::toJson() const {
           {"predicted_error_px", predicted_error_px},
           {"frame_horizon_s", frame_horizon_s},
           {"frame_predicted_error_px", frame_predicted_error_px},
-          {"region_dropped", region_dropped}};
+          {"region_dropped", region_dropped},
+          {"corner_settings", {{"min_samples", min_samples}, {"corner_sigma_m", corner_sigma}}}};
 }
 
 PanTiltReplayMetrics replayPanTiltFilter(const PanTiltScenarioConfig& cfg, std::uint64_t seed,
@@ -805,6 +819,7 @@ PanTiltReplayMetrics replayPanTiltFilter(const PanTiltScenarioConfig& cfg, std::
   }
   out.jumps = pf ? 0 : oracle ? corners.size() : ctrl.filter().jumps();
   out.region_dropped = pf ? false : oracle ? oracle->regionDropped() : ctrl.filter().regionDropped();
+  if (!pf && !oracle) std::tie(out.min_samples, out.corner_sigma) = cornerSettings(ctrl.filter());
   out.rmse_measured_cm = 100.0 * Vector2d(mx.rms(), my.rms());
   out.rmse_filtered_cm = 100.0 * Vector2d(fx_.rms(), fy_.rms());
   out.rmse_predicted_cm = 100.0 * Vector2d(px_.rms(), py_.rms());

@@ -152,6 +152,10 @@ struct PanTiltRunMetrics {
   std::size_t reacquisitions = 0;
   std::size_t frames_searching = 0;
   std::size_t filter_jumps = 0;              ///< velocity jumps (corners) the filter detected (ours)
+  /// Ours, Kalman models with jump detection: the corner settings in force at the end of the run (the
+  /// configured filter.jump_min_samples / jump_corner_sigma, or what "auto" made of them); 0 otherwise.
+  int filter_min_samples = 0;
+  double filter_corner_sigma = 0.0;
   bool filter_region_dropped = false;        ///< ours: filter.region was dropped (the target left it: a wrong box)
   double wall_ms_per_frame = 0.0;
 
@@ -197,6 +201,8 @@ struct PanTiltReplayMetrics {
   double frame_horizon_s = 0.0;
   double frame_predicted_error_px = 0.0;  ///< as predicted_error_px, at frame_horizon_s
   bool region_dropped = false;            ///< the filter dropped filter.region (the target left it)
+  int min_samples = 0;                    ///< the filter's corner settings at the end (see PanTiltRunMetrics)
+  double corner_sigma = 0.0;
   nlohmann::json toJson() const;
 };
 /// What a replay runs on the logged measurements.
