@@ -510,7 +510,7 @@ void PlanarTargetFilter::noteMeasurement(core::Timestamp t, const Eigen::Matrix2
 int PlanarTargetFilter::minSamples() const {
   if (config_.jump_min_samples) return *config_.jump_min_samples;
   // "auto": round(k ρ^(2/3)), ρ = σ / (ŝ Δt) (class comment, "Noise-scaled corner settings").
-  const double sigma = std::sqrt(0.5 * std::max(last_R_.trace(), 0.0));
+  const double sigma = noiseSigma();
   double dt = 0.0;
   if (!intervals_.empty()) {
     std::vector<double> sorted = intervals_;
@@ -530,8 +530,10 @@ int PlanarTargetFilter::minSamples() const {
 
 double PlanarTargetFilter::cornerSigma() const {
   if (config_.jump_corner_sigma) return *config_.jump_corner_sigma;
-  return kAutoCornerSigmaPerNoise * std::sqrt(0.5 * std::max(last_R_.trace(), 0.0));
+  return kAutoCornerSigmaPerNoise * noiseSigma();
 }
+
+double PlanarTargetFilter::noiseSigma() const { return std::sqrt(0.5 * std::max(last_R_.trace(), 0.0)); }
 
 PlanarTargetFilter::Snapshot PlanarTargetFilter::snapshot(core::Timestamp t, const Eigen::Vector2d& z,
                                                           const Eigen::Matrix2d& R) const {

@@ -336,6 +336,7 @@ private:
   void learnSpeed(std::size_t end);  ///< s_k of the segment history_[0..end]
   void noteMeasurement(core::Timestamp t, const Eigen::Matrix2d& R);  ///< for the "auto" corner settings
   Eigen::Matrix2d last_R_ = Eigen::Matrix2d::Zero();
+  double noiseSigma() const;  ///< √(tr R / 2) of the latest measurement: the per-axis RMS noise (m)
   core::Timestamp last_t_ = std::numeric_limits<double>::quiet_NaN();
   std::vector<double> intervals_;  ///< the last 16 measurement intervals (s)
   double speed_sum_ = 0.0, speed_info_ = 0.0;  ///< Σ s_k / var s_k, Σ 1 / var s_k
