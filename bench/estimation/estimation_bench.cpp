@@ -1,4 +1,4 @@
-// One predict + update of the 6-state ballistic filter (SPEC §1.1, issue 2)
+// One predict + update of the 6-state ballistic filter ([L] eqs 1-10, docs/methods.md)
 // with 2 and with 8 measurement rows, for our square-root filter and, in the
 // same run, for cv::KalmanFilter and ViSP's vpKalmanFilter doing the same work.
 //

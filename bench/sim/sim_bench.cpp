@@ -1,6 +1,6 @@
 // Rendering speed of the simulated worlds.
 //
-// Requirement (issue 4): a 10 s, 2-camera, 50 Hz ball scenario at 656x480 renders at least 10x
+// Requirement: a 10 s, 2-camera, 50 Hz ball scenario at 656x480 renders at least 10x
 // faster than real time, i.e. the 1000 frames in < 1 s. BM_BallScenario runs exactly that, with a
 // fresh rig each iteration (so the static-layer render of both cameras is included), and reports
 // the real-time factor (from the benchmark thread's CPU time; the static layers are rendered in

@@ -1,4 +1,4 @@
-// Prints the detector figures of issue 4 against module sim's ground truth:
+// Prints the detector figures against module sim's ground truth:
 //   - ball centre RMS at 656x480 (unoccluded),
 //   - [M]'s scene: table rotation/translation RMS, ball on the table (known and unknown radius),
 //     AprilTag table pose beside it,

@@ -1,4 +1,4 @@
-// Detectors against the ground truth of module sim's renders (issue 4 "must show").
+// Detectors against the ground truth of module sim's renders.
 // The full tables are printed by bench/vision/vision_figures; these tests keep them honest.
 
 #include <gtest/gtest.h>

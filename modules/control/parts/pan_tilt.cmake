@@ -1,4 +1,4 @@
-# Pan-tilt tracking ([T], issue 6): ViSP's point servo (baseline) and the predictive law with a
+# Pan-tilt tracking ([T]): ViSP's point servo (baseline) and the predictive law with a
 # planar target Kalman filter (CV / CA / Singer), latency compensation, search and reacquisition; the
 # waypoint particle filter (the random path's Bayes reference for replays).
 list(APPEND control_sources src/pan_tilt_servo.cpp src/waypoint_particle_filter.cpp)

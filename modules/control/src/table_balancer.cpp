@@ -16,10 +16,7 @@ namespace viewline::control {
 namespace {
 constexpr Eigen::Index kE = 0, kV = 1, kPhi = 2, kI = 3, kBuf = 4;
 
-void requireNonNegative(double v, const std::string& what) {
-  core::requireFinite(v, what);
-  if (v < 0.0) throw core::InvalidInput(what + ": expected >= 0, got " + std::to_string(v));
-}
+using core::requireNonNegative;
 }  // namespace
 
 void TableBalancerConfig::validate() const {

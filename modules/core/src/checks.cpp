@@ -35,6 +35,15 @@ void requirePositive(double value, const std::string& what) {
   }
 }
 
+void requireNonNegative(double value, const std::string& what) {
+  requireFinite(value, what);
+  if (value < 0.0) {
+    std::ostringstream s;
+    s << what << " = " << value << " (expected >= 0)";
+    throw InvalidInput(s.str());
+  }
+}
+
 void requireSize(const Eigen::Ref<const Eigen::MatrixXd>& m, Eigen::Index rows, Eigen::Index cols,
                  const std::string& what) {
   if (m.rows() != rows || m.cols() != cols) {

@@ -1,6 +1,9 @@
 #include "viewline/core/statistics.h"
 
+#include <algorithm>
 #include <boost/math/distributions/chi_squared.hpp>
+#include <cmath>
+#include <limits>
 #include <sstream>
 
 #include "viewline/core/checks.h"
@@ -28,6 +31,34 @@ Interval averagedChiSquareInterval(double dof, double samples, double confidence
   const double total = dof * samples;
   const double a = 0.5 * (1.0 - confidence);
   return {chiSquareQuantile(total, a) / samples, chiSquareQuantile(total, 1.0 - a) / samples};
+}
+
+namespace {
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+}
+
+double percentile(std::vector<double> v, double q) {
+  if (v.empty()) return kNaN;
+  std::sort(v.begin(), v.end());
+  const double pos = std::clamp(q, 0.0, 1.0) * static_cast<double>(v.size() - 1);
+  const auto lo = static_cast<std::size_t>(std::floor(pos));
+  const std::size_t hi = std::min(lo + 1, v.size() - 1);
+  return v[lo] + (pos - static_cast<double>(lo)) * (v[hi] - v[lo]);
+}
+
+double percentileNearestRank(std::vector<double> v, double q) {
+  if (v.empty()) return kNaN;
+  std::sort(v.begin(), v.end());
+  const auto k = static_cast<std::size_t>(std::ceil(std::clamp(q, 0.0, 1.0) * static_cast<double>(v.size())));
+  return v[std::min(v.size() - 1, k == 0 ? 0 : k - 1)];
+}
+
+double rmsFromSum(double sum_sq, long n) { return n > 0 ? std::sqrt(sum_sq / static_cast<double>(n)) : kNaN; }
+
+double rms(const std::vector<double>& v) {
+  double s = 0.0;
+  for (double x : v) s += x * x;
+  return rmsFromSum(s, static_cast<long>(v.size()));
 }
 
 }  // namespace viewline::core

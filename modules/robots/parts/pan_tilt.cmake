@@ -1,4 +1,4 @@
-# Pan-tilt tracking ([T], issue 6): PTU interface + limits, vpPtu46 kinematics, simulated
+# Pan-tilt tracking ([T]): PTU interface + limits, vpPtu46 kinematics, simulated
 # FLIR PTU-D46-17.5, hardware back ends (compiled in only where ViSP has their SDKs).
 list(APPEND robots_sources
   src/pan_tilt_unit.cpp

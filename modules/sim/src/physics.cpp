@@ -13,14 +13,7 @@ namespace viewline::sim {
 using core::InvalidInput;
 
 namespace {
-void requireNonNegative(double v, const std::string& what) {
-  core::requireFinite(v, what);
-  if (v < 0.0) {
-    std::ostringstream s;
-    s << what << " = " << v << " (expected >= 0)";
-    throw InvalidInput(s.str());
-  }
-}
+using core::requireNonNegative;
 }  // namespace
 
 double DragBody::dragPerMass() const {

@@ -8,14 +8,7 @@
 
 namespace viewline::estimation::detail {
 
-inline void requireNonNegative(double value, const std::string& what) {
-  core::requireFinite(value, what);
-  if (value < 0.0) {
-    std::ostringstream s;
-    s << what << " = " << value << " (expected >= 0)";
-    throw core::InvalidInput(s.str());
-  }
-}
+using core::requireNonNegative;
 
 inline void requireDim(int dim, const std::string& what) {
   if (dim < 1 || dim > 3) {

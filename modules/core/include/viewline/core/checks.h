@@ -17,6 +17,9 @@ void requireFinite(double value, const std::string& what);
 /// Throws unless value > 0 and finite.
 void requirePositive(double value, const std::string& what);
 
+/// Throws unless value >= 0 and finite.
+void requireNonNegative(double value, const std::string& what);
+
 /// Throws unless m is rows x cols.
 void requireSize(const Eigen::Ref<const Eigen::MatrixXd>& m, Eigen::Index rows, Eigen::Index cols,
                  const std::string& what);

@@ -21,7 +21,7 @@
 // is offset from the axes by L and h, so the direction alone is off by ~3°
 // at 1.3 m).
 //
-// Camera mount (issue 9): vpPtu46 carries a nominal camera mount e_M_c (translation
+// Camera mount: vpPtu46 carries a nominal camera mount e_M_c (translation
 // (h, −L, 0), rotation 90° about z). A real camera is mounted with errors, so the
 // model can be built with another e_M_c (the true one in the simulator, the
 // hand-eye calibration in the estimators): f_M_c(q) = f_M_e(q) e_M_c, with

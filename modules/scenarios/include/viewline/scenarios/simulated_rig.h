@@ -1,5 +1,5 @@
 #pragma once
-// A default simulated rig as a scenario uses it (issue 9): the simulator renders with the TRUE
+// A default simulated rig as a scenario uses it: the simulator renders with the TRUE
 // cameras (calib/rigs/<rig>/truth.yaml) and every estimator uses the CALIBRATED cameras
 // (calib/rigs/<rig>/rig.yaml, made by scripts/calibrate-default-rigs from rendered board images).
 // So every scenario runs on imperfect parameters, as a real rig does.

@@ -1,0 +1,63 @@
+#include "app_options.h"
+
+#include <cstdlib>
+#include <exception>
+#include <iostream>
+
+#include "viewline/core/error.h"
+#include "viewline/io/config_edit.h"
+
+namespace viewline::apps {
+
+runtime::Pacing CommonOptions::pacing() const {
+  if (realtime > 0.0) return {realtime};
+  if (realtime == 0.0) return {1.0};  // --realtime without a factor
+  if (display) return {1.0};
+  return {};
+}
+
+bool CommonOptions::wantDisplay(const std::string& app_name) const {
+  if (!display) return false;
+  const char* d = std::getenv("DISPLAY");
+  if (d == nullptr || *d == '\0') {
+    std::cerr << app_name << ": --display needs an X display (DISPLAY is not set); running headless\n";
+    return false;
+  }
+  return true;
+}
+
+void addCommonOptions(CLI::App& cli, CommonOptions& opt) {
+  auto* config = cli.add_option("--config", opt.config_path, "scenario YAML (unknown keys are refused)");
+  if (opt.config_path.empty()) config->required();
+  config->check(CLI::ExistingFile);
+  cli.add_option("--set", opt.sets, io::kSetOptionHelp)->take_all();
+  cli.add_option("--seed", opt.seed, "random seed (every run is reproducible from it)");
+  auto* headless = cli.add_flag("--headless", opt.headless, "no window (the default; never needs X)");
+  auto* display = cli.add_flag("--display", opt.display,
+                               "live window, paced to real time; keys: space pause, n step, q quit; "
+                               "stays open at the end until a click or key");
+  headless->excludes(display);
+  cli.add_option("--realtime", opt.realtime,
+                 "pace the run to the wall clock: FACTOR simulated seconds per second (default 1 when "
+                 "given without a value or with --display; otherwise as fast as possible)")
+      ->expected(0, 1)
+      ->default_str("1")
+      ->check(CLI::NonNegativeNumber);
+  cli.add_option("--log", opt.log_dir, "CSV logs of the run in this directory");
+  cli.add_option("--summary", opt.summary_path, "the metrics as JSON in this file (written atomically)");
+  cli.add_flag("--quiet", opt.quiet, "no progress output");
+}
+
+int runGuarded(const std::string& app_name, const std::function<int()>& body) {
+  try {
+    return body();
+  } catch (const core::Error& e) {
+    std::cerr << app_name << ": " << e.what() << "\n";
+    return 1;
+  } catch (const std::exception& e) {
+    std::cerr << app_name << ": error: " << e.what() << "\n";
+    return 1;
+  }
+}
+
+}  // namespace viewline::apps

@@ -1,0 +1,51 @@
+#pragma once
+// The command line every scenario app shares, so that the same flag means the same thing in
+// each of them (DESIGN "Running"): --config, --set KEY=VALUE, --seed, --headless / --display,
+// --realtime [FACTOR], --log DIR, --summary FILE, --quiet.
+//
+//   int main(int argc, char** argv) {
+//     CLI::App cli{"..."};
+//     apps::CommonOptions opt{"config/ball_catching.yaml"};
+//     apps::addCommonOptions(cli, opt);
+//     CLI11_PARSE(cli, argc, argv);
+//     return apps::runGuarded("ball_catching", [&] { ...; return 0; });
+//   }
+//
+// Exit status: 0 done, 1 runtime error (message names the file/key), 2 usage error.
+
+#include <CLI/CLI.hpp>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "viewline/runtime/scheduler.h"
+
+namespace viewline::apps {
+
+struct CommonOptions {
+  std::string config_path;        ///< --config
+  std::vector<std::string> sets;  ///< --set KEY=VALUE (repeatable)
+  std::uint64_t seed = 1;         ///< --seed
+  bool headless = false;          ///< --headless (the default)
+  bool display = false;           ///< --display: a live window, paced to real time
+  double realtime = -1.0;         ///< --realtime [FACTOR]: < 0 not given, 0 given without a value (1)
+  std::string log_dir;            ///< --log DIR
+  std::string summary_path;       ///< --summary FILE
+  bool quiet = false;             ///< --quiet: no progress lines
+
+  /// The pacing the flags ask for: --realtime F paces at F; --display alone paces at 1;
+  /// otherwise as fast as possible. Call after parsing.
+  runtime::Pacing pacing() const;
+  /// Whether a display is wanted and possible (an X display exists); prints why not.
+  bool wantDisplay(const std::string& app_name) const;
+};
+
+/// Adds the common flags to `cli` (with --headless/--display excluding each other).
+void addCommonOptions(CLI::App& cli, CommonOptions& opt);
+
+/// Runs `body` and maps exceptions to exit codes: viewline::core::InvalidInput and other
+/// core::Error → 1 with "<app>: <message>" on stderr; anything else → 1 with its what().
+int runGuarded(const std::string& app_name, const std::function<int()>& body);
+
+}  // namespace viewline::apps

@@ -1,0 +1,78 @@
+#include "viewline/tracking/track_gate.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <string>
+
+#include "viewline/core/error.h"
+#include "viewline/core/statistics.h"
+
+namespace viewline::tracking {
+
+const char* toString(GateDecision d) {
+  switch (d) {
+    case GateDecision::Start: return "start";
+    case GateDecision::Accept: return "accept";
+    case GateDecision::Reject: return "reject";
+    case GateDecision::Restart: return "restart";
+  }
+  return "?";
+}
+
+void TrackGateConfig::validate(const char* what) const {
+  const std::string w = what;
+  if (!(probability > 0.0 && probability < 1.0))
+    throw core::InvalidInput(w + ".probability: expected in (0, 1), got " + std::to_string(probability));
+  if (restart_after < 1) throw core::InvalidInput(w + ".restart_after: expected >= 1, got " + std::to_string(restart_after));
+  if (!(max_coast_s > 0.0)) throw core::InvalidInput(w + ".max_coast_s: expected > 0 (inf: no limit)");
+}
+
+TrackGate::TrackGate(Eigen::Index dof, TrackGateConfig config, std::size_t sources) : config_(config) {
+  config_.validate();
+  if (dof < 1) throw core::InvalidInput("TrackGate: dof must be >= 1");
+  if (sources < 1) throw core::InvalidInput("TrackGate: sources must be >= 1");
+  threshold_ = core::chiSquareQuantile(static_cast<double>(dof), config_.probability);
+  rejected_.assign(sources, 0);
+}
+
+void TrackGate::begin(double t) {
+  active_ = true;
+  last_used_t_ = t;
+  std::fill(rejected_.begin(), rejected_.end(), 0);
+}
+
+GateDecision TrackGate::decide(double t, double nis, std::size_t source) {
+  if (source >= rejected_.size()) {
+    std::ostringstream s;
+    s << "TrackGate::decide: source " << source << " (expected < " << rejected_.size() << ")";
+    throw core::InvalidInput(s.str());
+  }
+  if (!active_ || t - last_used_t_ > config_.max_coast_s) {
+    begin(t);
+    ++counts_.starts;
+    return GateDecision::Start;
+  }
+  if (nis <= threshold_) {
+    rejected_[source] = 0;
+    last_used_t_ = t;
+    ++counts_.accepted;
+    return GateDecision::Accept;
+  }
+  if (++rejected_[source] >= config_.restart_after) {
+    begin(t);
+    ++counts_.restarts;
+    return GateDecision::Restart;
+  }
+  ++counts_.rejected;
+  return GateDecision::Reject;
+}
+
+void TrackGate::drop() {
+  active_ = false;
+  std::fill(rejected_.begin(), rejected_.end(), 0);
+}
+
+int TrackGate::rejectedInARow() const { return *std::max_element(rejected_.begin(), rejected_.end()); }
+
+}  // namespace viewline::tracking

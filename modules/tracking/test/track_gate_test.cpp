@@ -1,0 +1,94 @@
+#include "viewline/tracking/track_gate.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "viewline/core/error.h"
+#include "viewline/core/random.h"
+#include "viewline/core/statistics.h"
+
+using namespace viewline;
+using tracking::GateDecision;
+using tracking::TrackGate;
+
+TEST(TrackGate, ThresholdIsTheChiSquareQuantileOfTheRows) {
+  const TrackGate g2(2, {0.99, 3});
+  EXPECT_NEAR(g2.threshold(), -2.0 * std::log(0.01), 1e-9);  // chi-square(2): q = -2 ln(1 - p)
+  const TrackGate g3(3, {0.999, 3});
+  EXPECT_NEAR(g3.threshold(), core::chiSquareQuantile(3.0, 0.999), 1e-12);
+}
+
+TEST(TrackGate, StartsAcceptsRejectsAndRestartsAfterNInARow) {
+  TrackGate g(2, {0.99, 3});
+  const double in = 1.0, out = 100.0;
+  EXPECT_EQ(g.decide(0.0, out), GateDecision::Start);  // no track: untested
+  EXPECT_EQ(g.decide(0.1, in), GateDecision::Accept);
+  EXPECT_EQ(g.decide(0.2, out), GateDecision::Reject);
+  EXPECT_EQ(g.decide(0.3, out), GateDecision::Reject);
+  EXPECT_EQ(g.rejectedInARow(), 2);
+  EXPECT_EQ(g.decide(0.4, out), GateDecision::Restart);
+  EXPECT_EQ(g.rejectedInARow(), 0);
+  EXPECT_EQ(g.decide(0.5, out), GateDecision::Reject);
+  EXPECT_EQ(g.decide(0.6, in), GateDecision::Accept);  // an acceptance ends the run
+  EXPECT_EQ(g.rejectedInARow(), 0);
+  const auto& c = g.counts();
+  EXPECT_EQ(c.starts, 1u);
+  EXPECT_EQ(c.accepted, 2u);
+  EXPECT_EQ(c.rejected, 3u);
+  EXPECT_EQ(c.restarts, 1u);
+  EXPECT_EQ(c.total(), 7u);
+}
+
+TEST(TrackGate, NanIsRejectedNeverFused) {
+  TrackGate g(2, {0.99, 5});
+  g.decide(0.0, 0.0);
+  EXPECT_EQ(g.decide(0.1, std::numeric_limits<double>::quiet_NaN()), GateDecision::Reject);
+}
+
+TEST(TrackGate, ACoastedTrackIsStaleAndTheNextMeasurementStartsANewOne) {
+  TrackGate g(2, {0.99, 3, 0.5});
+  EXPECT_EQ(g.decide(0.0, 0.0), GateDecision::Start);
+  EXPECT_EQ(g.decide(0.2, 100.0), GateDecision::Reject);  // rejections do not refresh the track
+  EXPECT_EQ(g.decide(0.5, 1.0), GateDecision::Accept);    // 0.5 s after the last use: still live
+  EXPECT_EQ(g.decide(1.01, 100.0), GateDecision::Start);  // 0.51 s: stale
+  g.drop();
+  EXPECT_FALSE(g.active());
+  EXPECT_EQ(g.decide(1.1, 1.0), GateDecision::Start);
+}
+
+TEST(TrackGate, RejectionsAreCountedPerSource) {
+  TrackGate g(2, {0.99, 2}, 2);
+  g.decide(0.0, 0.0, 0);
+  EXPECT_EQ(g.decide(0.1, 100.0, 1), GateDecision::Reject);
+  EXPECT_EQ(g.decide(0.2, 1.0, 0), GateDecision::Accept);   // source 0 agrees...
+  EXPECT_EQ(g.decide(0.3, 100.0, 1), GateDecision::Restart);  // ...source 1's run still counts
+  EXPECT_THROW(g.decide(0.4, 1.0, 2), core::InvalidInput);
+}
+
+TEST(TrackGate, AcceptanceRateOfConsistentInnovationsIsTheGateProbability) {
+  // Innovations drawn from N(0, I2) have NIS ~ chi-square(2): the gate accepts a fraction p.
+  TrackGate g(2, {0.95, 1000000});
+  core::Rng rng = core::makeRng(7);
+  g.decide(0.0, 0.0);
+  const int n = 40000;
+  for (int i = 0; i < n; ++i) {
+    const double a = core::gaussian(rng), b = core::gaussian(rng);
+    g.decide(1e-3 * (i + 1), a * a + b * b);
+  }
+  const double rate = static_cast<double>(g.counts().accepted) / n;
+  EXPECT_NEAR(rate, 0.95, 4.0 * std::sqrt(0.95 * 0.05 / n));
+}
+
+TEST(TrackGate, BadConfigIsRefusedWithItsName) {
+  try {
+    TrackGate g(2, {1.5, 3});
+    FAIL();
+  } catch (const core::InvalidInput& e) {
+    EXPECT_NE(std::string(e.what()).find("gate.probability"), std::string::npos);
+  }
+  EXPECT_THROW(TrackGate(2, {0.99, 0}), core::InvalidInput);
+  EXPECT_THROW(TrackGate(2, {0.99, 3, 0.0}), core::InvalidInput);
+  EXPECT_THROW(TrackGate(0, {0.99, 3}), core::InvalidInput);
+}
