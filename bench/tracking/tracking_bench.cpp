@@ -6,7 +6,7 @@
 
 #include "viewline/core/frames.h"
 #include "viewline/estimation/kalman_filter.h"
-#include "viewline/tracking/dart_scenario.h"
+#include "viewline/scenarios/dart/world.h"
 #include "viewline/tracking/tracker.h"
 
 using namespace viewline;
@@ -95,16 +95,17 @@ BENCHMARK(BM_UpdateCamerasStacked)->RangeMultiplier(2)->Range(1, 64)->Complexity
 // The whole tracker path (validation, buffer, snapshot, propagation, gate, update) per image, on
 // dart flights of the shipped scenario (alternating cameras); a new tracker per flight (untimed).
 void BM_TrackerSubmitDartFlight(benchmark::State& st) {
-  const DartScenarioConfig cfg = defaultDartScenario();
-  const std::vector<core::Camera> cams = makeDartCameras(cfg);
+  const scenarios::DartScenarioConfig cfg = scenarios::defaultDartScenario();
+  const std::vector<core::Camera> cams = scenarios::makeDartCameras(cfg);
   core::Rng rng = core::makeRng(1);
-  const SimFlight flight = simulateFlight(cfg, cams, ClockMode::Alternating, 0.0, rng);
+  const scenarios::DartFlight flight =
+      scenarios::simulateDartFlight(cfg, cams, scenarios::DartClockMode::Alternating, 0.0, rng);
   std::size_t i = 0;
-  ViewlineTracker tr(cams, cfg.tracker);
+  ViewlineTracker tr(cams, cfg.trackerConfig());
   for (auto _ : st) {
     if (i == flight.detections.size()) {
       st.PauseTiming();
-      tr = ViewlineTracker(cams, cfg.tracker);
+      tr.reset();
       i = 0;
       st.ResumeTiming();
     }

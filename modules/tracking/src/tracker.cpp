@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <tuple>
 
 #include "viewline/core/checks.h"
@@ -55,10 +56,12 @@ void TrackerConfig::validate() const {
     throw core::InvalidInput("tracker.gate.mahalanobis_alpha: expected in (0, 1)");
 }
 
-MeasurementOutcome fuseImage(estimation::StateEstimate& s, const core::Camera& camera,
-                             const ImageMeasurement& m, const BallisticModel& model,
-                             const GateConfig& gate, double dt_offset, double min_depth, bool force,
-                             bool depth_variance_in_noise) {
+namespace {
+
+// fuseImage, also handing out the innovation, S and R2 it formed (when `update` is not null).
+MeasurementOutcome fuse(estimation::StateEstimate& s, const core::Camera& camera, const ImageMeasurement& m,
+                        const BallisticModel& model, const GateConfig& gate, double dt_offset, double min_depth,
+                        bool force, bool depth_variance_in_noise, ImageUpdate* update) {
   MeasurementOutcome out;
   out.m = m;
   const Vector6 x = s.x();
@@ -69,6 +72,13 @@ MeasurementOutcome fuseImage(estimation::StateEstimate& s, const core::Camera& c
   const Eigen::VectorXd d = rows.y - rows.C * x;
   const Eigen::MatrixXd S = estimation::innovationCovariance(s, meas.C, meas.R);
   out.gate = evaluateGate(d, S, gate);
+  if (update != nullptr) {
+    update->m = m;
+    update->innovation = d;
+    update->S = S;
+    update->R = rows.R;
+    update->nis = out.gate.mahalanobis;
+  }
   if (force) out.gate.rejected = false;
   if (out.gate.rejected) {
     out.fate = Fate::Gated;
@@ -79,14 +89,36 @@ MeasurementOutcome fuseImage(estimation::StateEstimate& s, const core::Camera& c
   return out;
 }
 
-ViewlineTracker::ViewlineTracker(std::vector<core::Camera> cameras, TrackerConfig cfg)
-    : cameras_(std::move(cameras)), cfg_(std::move(cfg)) {
-  cfg_.validate();
-  if (cameras_.empty()) throw core::InvalidInput("tracker: at least one camera is needed");
+}  // namespace
+
+MeasurementOutcome fuseImage(estimation::StateEstimate& s, const core::Camera& camera,
+                             const ImageMeasurement& m, const BallisticModel& model,
+                             const GateConfig& gate, double dt_offset, double min_depth, bool force,
+                             bool depth_variance_in_noise) {
+  return fuse(s, camera, m, model, gate, dt_offset, min_depth, force, depth_variance_in_noise, nullptr);
 }
 
+TrackState ViewlineTracker::initialState(const TrackerConfig& cfg, std::size_t cameras) {
+  cfg.validate();
+  if (cameras == 0) throw core::InvalidInput("tracker: at least one camera is needed");
+  // The image gate (gates.h) decides accept / reject; the track gate keeps the life cycle, with
+  // one rejection count per camera. Its own chi-square threshold is that of the Mahalanobis gate.
+  TrackGateConfig life;
+  life.probability = 1.0 - cfg.gate.mahalanobis_alpha;
+  life.restart_after = cfg.restart_after_rejections;
+  life.max_coast_s = cfg.max_coast;
+  return TrackState(TrackGate(2, life, cameras));
+}
+
+ViewlineTracker::ViewlineTracker(std::vector<core::Camera> cameras, TrackerConfig cfg)
+    : cameras_(std::move(cameras)),
+      cfg_(std::move(cfg)),
+      fresh_(initialState(cfg_, cameras_.size())),
+      state_(fresh_) {}
+
 void ViewlineTracker::reset() {
-  state_ = TrackState{};
+  state_ = fresh_;
+  last_update_.reset();
   buffer_.clear();
   final_.clear();
   refusals_.fill(0);
@@ -124,44 +156,44 @@ void ViewlineTracker::startTrack(TrackState& ts, core::Timestamp t) {
   for (const MeasurementOutcome& o : ts.history) evict(o);
   ts.history.clear();
   ts.est = estimation::StateEstimate(cfg_.prior_mean, cfg_.prior_cov, sampleTime(t));
-  ts.active = true;
-  ts.consecutive_rejections = 0;
-  ts.camera_rejections.assign(cameras_.size(), 0);
   ts.fused_in_track = 0;
-  ts.last_fused_t = t;
   ts.track_start_t = ts.est.t();
   ++ts.tracks_started;
 }
 
-void ViewlineTracker::step(TrackState& ts, const ImageMeasurement& m) {
-  if (!ts.active || m.t - ts.last_fused_t > cfg_.max_coast) startTrack(ts, m.t);
+void ViewlineTracker::step(TrackState& ts, const ImageMeasurement& m, ImageUpdate* update) {
+  // No live track, or none fused for longer than max_coast: the image seeds a new one from the
+  // prior (the test TrackGate::decide makes below, where it answers Start).
+  const TrackGate& life = ts.gate;
+  const bool seed = !life.active() || m.t - life.lastUsedTime() > life.config().max_coast_s;
+  if (seed) startTrack(ts, m.t);
+  const int fused_before = ts.fused_in_track;
   const core::Timestamp ts_time = sampleTime(m.t);
   if (ts_time > ts.est.t()) {
     estimation::predict(ts.est, cfg_.model.transition(ts_time - ts.est.t()));
     ts.est.setTime(ts_time);
   }
   const double dt_offset = (cfg_.time_mode == TimeMode::Exact) ? 0.0 : m.t - ts.est.t();
-  const bool seed = ts.fused_in_track == 0;
-  MeasurementOutcome o = fuseImage(ts.est, cameras_[m.camera], m, cfg_.model, cfg_.gate, dt_offset,
-                                   cfg_.min_depth, seed, cfg_.depth_variance_in_noise);
+  MeasurementOutcome o = fuse(ts.est, cameras_[m.camera], m, cfg_.model, cfg_.gate, dt_offset, cfg_.min_depth, seed,
+                              cfg_.depth_variance_in_noise, update);
   o.seed = seed;
-  int& count = ts.camera_rejections[m.camera];
-  if (o.fate == Fate::Fused) {
-    count = 0;
-    ts.last_fused_t = m.t;
-    ++ts.fused_in_track;
-  } else {
-    ++count;
-  }
-  ts.consecutive_rejections = *std::max_element(ts.camera_rejections.begin(), ts.camera_rejections.end());
   const bool fused = o.fate == Fate::Fused;
+  // The image gate has judged the image; the track gate counts it (an accepted image resets its
+  // camera's run of rejections, a rejected one extends it) and says when the track restarts.
+  o.decision = ts.gate.decide(m.t, fused ? 0.0 : std::numeric_limits<double>::infinity(), m.camera);
+  if (update != nullptr) {
+    update->decision = o.decision;
+    update->fused_before = fused_before;
+  }
+  if (fused) ++ts.fused_in_track;
+  const GateDecision decision = o.decision;
   ts.history.push_back(std::move(o));
   if (fused && ts.fused_in_track >= 2 && ts.fused_in_track <= cfg_.refit_young_tracks) refit(ts);
   if (ts.history.size() > cfg_.history_capacity) {
     evict(ts.history.front());
     ts.history.erase(ts.history.begin());
   }
-  if (ts.consecutive_rejections >= cfg_.restart_after_rejections) restart(ts);
+  if (decision == GateDecision::Restart) restart(ts);
 }
 
 void ViewlineTracker::refit(TrackState& ts) const {
@@ -205,43 +237,46 @@ void ViewlineTracker::restart(TrackState& ts) {
   MeasurementOutcome dropped = items.front();
   dropped.fate = Fate::DroppedOnRestart;
   evict(dropped);
-  ts.active = false;
+  ts.gate.drop();
   ++ts.restarts;
-  for (std::size_t i = 1; i < items.size(); ++i) step(ts, items[i].m);
+  for (std::size_t i = 1; i < items.size(); ++i) step(ts, items[i].m, nullptr);
 }
 
 Refusal ViewlineTracker::submit(const ImageMeasurement& m) {
   const Refusal r = check(m);
+  last_update_.reset();
   if (r != Refusal::None) {
     ++refusals_[static_cast<std::size_t>(r)];
     return r;
   }
+  ImageUpdate update;
   auto key = [](const ImageMeasurement& a) { return std::make_tuple(a.t, a.camera, a.id); };
   const auto pos = std::upper_bound(buffer_.begin(), buffer_.end(), m,
                                     [&](const ImageMeasurement& a, const Entry& e) { return key(a) < key(e.m); });
   if (pos == buffer_.end()) {
     buffer_.push_back({m, state_});
-    step(state_, m);
+    step(state_, m, &update);
   } else {
     // Late: insert in order and re-process everything after it from the snapshot.
     const auto idx = static_cast<std::size_t>(pos - buffer_.begin());
     TrackState ts = pos->before;
-    buffer_.insert(pos, Entry{m, TrackState{}});
+    buffer_.insert(pos, Entry{m, ts});
     for (std::size_t j = idx; j < buffer_.size(); ++j) {
       buffer_[j].before = ts;
-      step(ts, buffer_[j].m);
+      step(ts, buffer_[j].m, j == idx ? &update : nullptr);
     }
     state_ = std::move(ts);
     ++late_inserted_;
   }
   newest_ = any_ ? std::max(newest_, m.t) : m.t;
   any_ = true;
+  last_update_ = std::move(update);
   while (!buffer_.empty() && buffer_.front().m.t < newest_ - cfg_.late_horizon) buffer_.pop_front();
   return Refusal::None;
 }
 
 estimation::StateEstimate ViewlineTracker::predictAt(core::Timestamp t) const {
-  if (!state_.active) throw core::InvalidInput("tracker: predictAt before any measurement");
+  if (!initialised()) throw core::InvalidInput("tracker: predictAt before any measurement");
   core::requireFinite(t, "tracker: predictAt time");
   if (t < state_.est.t()) throw core::InvalidInput("tracker: predictAt time is before the estimate's time");
   estimation::StateEstimate s = state_.est;

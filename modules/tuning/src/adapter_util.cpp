@@ -128,6 +128,18 @@ ViewlineInnovation viewlineInnovation(const tracking::ViewlineTracker& tracker, 
   return r;
 }
 
+ViewlineInnovation viewlineInnovation(const tracking::ImageUpdate& update, const core::Camera& camera, int burn_in) {
+  ViewlineInnovation r;
+  if (update.decision == tracking::GateDecision::Start || update.fused_before < burn_in) return r;
+  r.d = update.innovation;
+  r.S = update.S;
+  r.nis = update.nis;
+  const double sigma = update.m.sigma_px;
+  r.log_u = std::log(sigma * sigma / (static_cast<double>(camera.width) * camera.height * std::sqrt(update.R.determinant())));
+  r.valid = std::isfinite(r.nis) && std::isfinite(r.log_u);
+  return r;
+}
+
 ReplayResult replayResult(double cost, std::size_t terms, const Consistency& nis, std::shared_ptr<RunSeries> series) {
   ReplayResult r;
   r.cost = cost;
@@ -142,6 +154,7 @@ namespace {
 class InfoAdapter final : public ScenarioAdapter {
 public:
   InfoAdapter(AdapterInfo info, AdapterLoader load) : info_(std::move(info)), load_(std::move(load)) {}
+  InfoAdapter(AdapterInfo info, ConfigLoader load) : info_(std::move(info)), load_config_(std::move(load)) {}
   std::string name() const override { return info_.name; }
   std::string description() const override { return info_.description; }
   std::string appCommand(const std::string& config_path) const override {
@@ -153,17 +166,28 @@ public:
   std::vector<AdapterOption> options() const override { return info_.options; }
   std::unique_ptr<ScenarioInstance> load(const YAML::Node& scenario, const std::string& name,
                                          const AdapterOptions& options) const override {
+    // A tree edited by the caller (a sweep setting): its text is the only way to a fresh ConfigNode.
+    if (load_config_) return load_config_(scenarioConfig(io::emitYaml(scenario), name), options);
     return load_(io::emitYaml(scenario), name, options);
+  }
+  std::unique_ptr<ScenarioInstance> loadConfig(const io::ConfigNode& config, const AdapterOptions& options) const override {
+    if (load_config_) return load_config_(config, options);
+    return ScenarioAdapter::loadConfig(config, options);
   }
 
 private:
   AdapterInfo info_;
   AdapterLoader load_;
+  ConfigLoader load_config_;
 };
 
 }  // namespace
 
 std::unique_ptr<ScenarioAdapter> makeAdapter(AdapterInfo info, AdapterLoader load) {
+  return std::make_unique<InfoAdapter>(std::move(info), std::move(load));
+}
+
+std::unique_ptr<ScenarioAdapter> makeConfigAdapter(AdapterInfo info, ConfigLoader load) {
   return std::make_unique<InfoAdapter>(std::move(info), std::move(load));
 }
 

@@ -6,10 +6,10 @@
 //    through their --log CSV), removed on destruction;
 //  - innovationCost: the −2 log-likelihood term of one innovation under the outlier mixture of
 //    autotune.h;
-//  - viewlineInnovation: the innovation a tracking::ViewlineTracker is about to see for an image
-//    measurement (dart and ball-catching adapters);
-//  - makeAdapter: a ScenarioAdapter from its description (name, metrics, options) and a loader,
-//    so each adapter file holds only what is specific to its scenario.
+//  - viewlineInnovation: the innovation of an image measurement for a tracking::ViewlineTracker,
+//    read from the tracker's own update (or, for a tracker seen from outside, formed as it will);
+//  - makeAdapter / makeConfigAdapter: a ScenarioAdapter from its description (name, metrics,
+//    options) and a loader, so each adapter file holds only what is specific to its scenario.
 
 #include <Eigen/Core>
 #include <cstddef>
@@ -87,6 +87,10 @@ ViewlineInnovation viewlineInnovation(const tracking::ViewlineTracker& tracker, 
                                       const tracking::TrackerConfig& config, const tracking::ImageMeasurement& m,
                                       int burn_in);
 
+/// The same read from the tracker's own update of the image (ViewlineTracker::lastUpdate()):
+/// valid when the image was tested against a live track with at least `burn_in` fused images.
+ViewlineInnovation viewlineInnovation(const tracking::ImageUpdate& update, const core::Camera& camera, int burn_in);
+
 /// The checked input of a ScenarioInstance::replay: the data were recorded by this adapter (type
 /// D) and `noise` holds `count` values; throws core::InvalidInput naming `scenario` otherwise.
 template <class D>
@@ -118,6 +122,10 @@ struct AdapterInfo {
 using AdapterLoader =
     std::function<std::unique_ptr<ScenarioInstance>(const std::string& yaml, const std::string& name, const AdapterOptions&)>;
 std::unique_ptr<ScenarioAdapter> makeAdapter(AdapterInfo info, AdapterLoader load);
+/// The same with a loader that reads the parsed config (keys not yet read; the loader reads each,
+/// calls finish() and validates once): a session that parsed the file hands it over as it is.
+using ConfigLoader = std::function<std::unique_ptr<ScenarioInstance>(const io::ConfigNode& config, const AdapterOptions&)>;
+std::unique_ptr<ScenarioAdapter> makeConfigAdapter(AdapterInfo info, ConfigLoader load);
 
 /// The scenario tree for the scenario's own loader: `name` is the config file's path, so its
 /// relative paths (`rig: ../calib/rigs/<rig>`) resolve against the file's folder, as in the app.

@@ -1,12 +1,13 @@
-// Dart scenario adapter ([L] §VI, issue 3): runs flights of the measurement-level dart scenario
-// through the ViewlineTracker in-process (tracking::simulateFlight + ViewlineTracker), with the
-// scenario config read by the dart app's own loader (apps/dart_tracking/dart_config.h), so any
-// config the tuning tool accepts or writes is one dart_tracking reads.
+// Dart scenario adapter ([L] §VI): runs flights of the measurement-level dart scenario through the
+// ViewlineTracker in-process (scenarios::simulateDartFlight + ViewlineTracker), with the scenario
+// config read by the scenario's own reader (scenarios/dart/config.h), so any config the tuning
+// tool accepts or writes is one dart_tracking reads.
 //
-// One run = `flights` throws (adapter option), flight f drawn from deriveSeed(seed, f).
-// Per measurement (in capture order) the innovation is computed from the tracker's prediction
-// at the capture time, exactly as the tracker forms it (viewlineRows at the predicted state):
-//   d = y − C x̂(t|t−),  S = R2 + C P Cᵀ  (2 rows),  NIS = dᵀ S⁻¹ d (2 dof).
+// One run = `flights` throws (adapter option), flight f drawn from deriveSeed(seed, f); one tracker
+// per run, reset between flights. The innovations are the tracker's own (ViewlineTracker::
+// lastUpdate(): the two viewline rows of the image at the predicted state x̂(t|t−)):
+//   d = y − C x̂(t|t−),  S = R2 + C P Cᵀ  (2 rows),  NIS = dᵀ S⁻¹ d (2 dof),
+// read as the tracker formed them, never recomputed.
 // NIS samples: fused, non-seed measurements once the track has `burn_in` fused images (the prior
 // dominates before). NEES: one 6-dof sample per flight, after the measurement of index
 // `experiments.nees_index` (independent samples, the dart scenario's convention).
@@ -23,36 +24,34 @@
 // (viewline.h: R2 = E[Z²] σ² D J Jᵀ D), so its density in innovation space is
 // u = σ² / (W H sqrt(det R2)) (independent of σ).
 
-#include <Eigen/Cholesky>
 #include <Eigen/LU>
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <map>
-#include <sstream>
+#include <optional>
 
 #include "adapter_util.h"
-#include "dart_config.h"
 #include "viewline/core/error.h"
 #include "viewline/core/random.h"
 #include "viewline/estimation/consistency.h"
-#include "viewline/tracking/dart_scenario.h"
+#include "viewline/scenarios/dart/config.h"
+#include "viewline/scenarios/dart/world.h"
 #include "viewline/tracking/tracker.h"
-#include "viewline/tracking/viewline.h"
 #include "viewline/tuning/scenario.h"
 
 namespace viewline::tuning {
 
 namespace {
 
-using tracking::DartScenarioConfig;
+using scenarios::DartClockMode;
+using scenarios::DartDetection;
+using scenarios::DartScenarioConfig;
 using tracking::ImageMeasurement;
 
 struct DartOptions {
   int flights = 50;
-  tracking::ClockMode clock = tracking::ClockMode::FreeRunning;
+  DartClockMode clock = DartClockMode::FreeRunning;
   bool outliers = true;
   double assumed_sigma = 0.0;  ///< <= 0: the config's pixel_noise_px
   int burn_in = 4;
@@ -60,7 +59,7 @@ struct DartOptions {
 };
 
 struct Flight {
-  std::vector<tracking::SimDetection> dets;  ///< truth valid only when has_truth
+  std::vector<DartDetection> dets;  ///< truth valid only when has_truth
   bool has_truth = true;
 };
 
@@ -95,7 +94,7 @@ struct Accum {
 class DartInstance final : public ScenarioInstance {
 public:
   DartInstance(DartScenarioConfig cfg, DartOptions opt)
-      : cfg_(std::move(cfg)), opt_(std::move(opt)), cams_(tracking::makeDartCameras(cfg_)) {}
+      : cfg_(std::move(cfg)), opt_(std::move(opt)), cams_(scenarios::makeDartCameras(cfg_)) {}
 
   double confidence() const override { return cfg_.confidence; }
   double sigma() const { return opt_.assumed_sigma > 0.0 ? opt_.assumed_sigma : cfg_.pixel_noise_px; }
@@ -115,11 +114,12 @@ public:
                                                 "fused", "in_statistics"});
     }
     Accum a;
+    tracking::ViewlineTracker tracker(cams_, trackerConfig(cfg_.tracker.model.accel_psd));
     for (int f = 0; f < opt_.flights; ++f) {
       core::Rng rng = core::makeRng(core::deriveSeed(seed, static_cast<std::uint64_t>(f)));
       Flight fl;
-      fl.dets = tracking::simulateFlight(cfg_, cams_, opt_.clock, opt_.outliers ? cfg_.outlier_rate : 0.0, rng, 1).detections;
-      processFlight(fl, f, cfg_.tracker.model.accel_psd, sigma(), 0.0, a, series.get(), det_csv, inn_csv, ro);
+      fl.dets = simulate(rng);
+      processFlight(tracker, fl, f, sigma(), 0.0, a, series.get(), det_csv, inn_csv, ro);
       if (ro.progress) ro.progress(static_cast<double>(f + 1) / opt_.flights);
     }
     r.nees = a.nees;
@@ -152,7 +152,7 @@ public:
       for (int f = 0; f < opt_.flights; ++f) {
         core::Rng rng = core::makeRng(core::deriveSeed(s, static_cast<std::uint64_t>(f)));
         Flight fl;
-        fl.dets = tracking::simulateFlight(cfg_, cams_, opt_.clock, opt_.outliers ? cfg_.outlier_rate : 0.0, rng, 1).detections;
+        fl.dets = simulate(rng);
         d->flights.push_back(std::move(fl));
       }
     }
@@ -176,7 +176,7 @@ public:
         d->flights.emplace_back();
         d->flights.back().has_truth = false;
       }
-      tracking::SimDetection det;
+      DartDetection det;
       det.truth.setZero();
       det.m.id = static_cast<std::uint64_t>(csv.number(row, ci));
       det.m.camera = static_cast<std::size_t>(csv.number(row, cc));
@@ -200,8 +200,9 @@ public:
     std::shared_ptr<RunSeries> series;
     if (want_series) series = makeSeries();
     RunOptions ro;
+    tracking::ViewlineTracker tracker(cams_, trackerConfig(noise[0]));
     for (std::size_t f = 0; f < d.flights.size(); ++f)
-      processFlight(d.flights[f], static_cast<int>(f), noise[0], noise[1], outlier_prior, a, series.get(), nullptr,
+      processFlight(tracker, d.flights[f], static_cast<int>(f), noise[1], outlier_prior, a, series.get(), nullptr,
                     nullptr, ro);
     return detail::replayResult(a.cost, a.terms, a.nis, series);
   }
@@ -227,12 +228,23 @@ private:
     return s;
   }
 
-  void processFlight(const Flight& fl, int f, double q, double sigma, double eps, Accum& a, RunSeries* series,
-                     io::CsvWriter* det_csv, io::CsvWriter* inn_csv, const RunOptions& ro) const {
-    if (fl.dets.empty()) return;
-    tracking::TrackerConfig tc = cfg_.tracker;
+  std::vector<DartDetection> simulate(core::Rng& rng) const {
+    return scenarios::simulateDartFlight(cfg_, cams_, opt_.clock, opt_.outliers ? cfg_.outlier_rate : 0.0, rng, 1)
+        .detections;
+  }
+
+  tracking::TrackerConfig trackerConfig(double q) const {
+    tracking::TrackerConfig tc = cfg_.trackerConfig();
     tc.model.accel_psd = q;
-    tracking::ViewlineTracker tracker(cams_, tc);
+    return tc;
+  }
+
+  /// One flight through `tracker` (reset first), accumulating into `a`.
+  void processFlight(tracking::ViewlineTracker& tracker, const Flight& fl, int f, double sigma, double eps, Accum& a,
+                     RunSeries* series, io::CsvWriter* det_csv, io::CsvWriter* inn_csv, const RunOptions& ro) const {
+    if (fl.dets.empty()) return;
+    tracker.reset();
+    const tracking::BallisticModel& model = tracker.config().model;
     const bool keep = series != nullptr;
     const bool keep_traj = keep && f < 5;
     const bool keep_err = keep && f < 30;
@@ -242,16 +254,19 @@ private:
     std::optional<estimation::StateEstimate> half_state;
     double last_err = std::nan("");
     for (std::size_t k = 0; k < fl.dets.size(); ++k) {
-      const tracking::SimDetection& det = fl.dets[k];
+      const DartDetection& det = fl.dets[k];
       ImageMeasurement m = det.m;
       m.sigma_px = sigma;
-      // The innovation the tracker will see (prior at the capture time).
-      const detail::ViewlineInnovation inn = detail::viewlineInnovation(tracker, cams_, tc, m, opt_.burn_in);
+      // Only in-order images tested against a track with `burn_in` fused images count.
+      const bool in_order = !tracker.initialised() || m.t >= tracker.state().t();
+      tracker.submit(m);
+      const std::optional<tracking::ImageUpdate>& up = tracker.lastUpdate();
+      const detail::ViewlineInnovation inn =
+          up && in_order ? detail::viewlineInnovation(*up, cams_[m.camera], opt_.burn_in) : detail::ViewlineInnovation{};
       const bool have = inn.valid;
       const Eigen::Vector2d& dv = inn.d;
       const Eigen::Matrix2d& S = inn.S;
       const double nis = inn.nis;
-      tracker.submit(m);
       const auto out = tracker.outcome(m.id);
       const bool fused = out && out->fate == tracking::Fate::Fused;
       if (have) {
@@ -329,13 +344,13 @@ private:
       if (half_state && half_state->dim() == 6) {
         const tracking::Vector6 x0 = half_state->x();
         const double th = half_state->t();
-        const tracking::SimDetection& last = fl.dets.back();
+        const DartDetection& last = fl.dets.back();
         if (last.m.t > th) {
-          a.pred_err += (tc.model.propagate(x0, last.m.t - th).head<3>() - last.truth.head<3>()).norm();
+          a.pred_err += (model.propagate(x0, last.m.t - th).head<3>() - last.truth.head<3>()).norm();
           ++a.pred_n;
           if (keep_traj) {
             for (std::size_t k = half; k < fl.dets.size(); ++k) {
-              const tracking::Vector6 xp = tc.model.propagate(x0, std::max(0.0, fl.dets[k].m.t - th));
+              const tracking::Vector6 xp = model.propagate(x0, std::max(0.0, fl.dets[k].m.t - th));
               pre.x.push_back(xp(0));
               pre.y.push_back(xp(1));
             }
@@ -376,21 +391,21 @@ void registerDartAdapter(AdapterRegistry& registry) {
                   {"burn_in", "4", {}, "fused images of a track before its innovations count in NIS / likelihood"},
                   {"log_experiment", "A_alternating", {"A_alternating", "D_scenario"},
                    "which experiment of a dart_tracking --log folder the auto-tuner replays"}};
-  registry.add(detail::makeAdapter(std::move(info), [](const std::string& yaml, const std::string& name,
-                                                       const AdapterOptions& options) {
-    DartScenarioConfig cfg = apps::dartScenarioFromString(yaml, name);
+  registry.add(detail::makeConfigAdapter(std::move(info), [](const io::ConfigNode& config,
+                                                             const AdapterOptions& options) {
+    const std::string& name = config.fileName();
+    DartScenarioConfig cfg = scenarios::dartScenarioFromNode(config);
     DartOptions o;
     const double flights = optionNumber(options, "flights");
     if (!(flights >= 1.0 && flights <= 1e6)) throw core::InvalidInput("adapter option 'flights': expected 1 to 1e6");
     o.flights = static_cast<int>(flights);
-    o.clock = optionText(options, "clock") == "alternating" ? tracking::ClockMode::Alternating
-                                                            : tracking::ClockMode::FreeRunning;
+    o.clock = optionText(options, "clock") == "alternating" ? DartClockMode::Alternating : DartClockMode::FreeRunning;
     o.outliers = optionText(options, "outliers") == "config";
     o.assumed_sigma = optionNumber(options, "assumed_pixel_noise_px");
     o.burn_in = static_cast<int>(optionNumber(options, "burn_in"));
     if (o.burn_in < 1) throw core::InvalidInput("adapter option 'burn_in': expected >= 1");
     o.log_experiment = optionText(options, "log_experiment");
-    if (o.clock == tracking::ClockMode::Alternating && cfg.cameras.size() < 2)
+    if (o.clock == DartClockMode::Alternating && cfg.cameras.size() < 2)
       throw core::InvalidInput(name + ": adapter option clock: alternating needs two cameras");
     return std::unique_ptr<ScenarioInstance>(std::make_unique<DartInstance>(std::move(cfg), std::move(o)));
   }));

@@ -69,6 +69,11 @@ void ScenarioInstance::requireAutotune(const std::string& scenario) const {
   if (!why.empty()) throw core::InvalidInput(scenario + ": noise auto-tuning is not supported by this adapter: " + why);
 }
 
+std::unique_ptr<ScenarioInstance> ScenarioAdapter::loadConfig(const io::ConfigNode& config,
+                                                               const AdapterOptions& options) const {
+  return load(config.yaml(), config.fileName(), options);
+}
+
 void AdapterRegistry::add(std::unique_ptr<ScenarioAdapter> adapter) {
   if (has(adapter->name())) throw core::InvalidInput("adapter '" + adapter->name() + "' registered twice");
   adapters_.push_back(std::move(adapter));

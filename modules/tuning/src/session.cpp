@@ -9,11 +9,12 @@
 #include <set>
 #include <sstream>
 
+#include "adapter_util.h"
 #include "viewline/core/error.h"
 #include "viewline/core/random.h"
 #include "viewline/io/files.h"
+#include "viewline/runtime/progress.h"
 #include "viewline/tuning/autotune.h"
-#include "viewline/tuning/live_plot.h"
 #include "viewline/tuning/report.h"
 #include "viewline/tuning/sweep_runner.h"
 #include "viewline/tuning/sweep_spec.h"
@@ -34,20 +35,26 @@ std::string fmt(double v, int prec = 4) {
   return b;
 }
 
-YAML::Node parseYaml(const std::string& text, const std::string& path) {
-  try {
-    return YAML::Load(text);
-  } catch (const YAML::Exception& e) {
-    throw core::InvalidInput(path + ":" + std::to_string(e.mark.line + 1) + ":" + std::to_string(e.mark.column + 1) +
-                             ": YAML syntax error: " + e.msg);
-  }
+/// The scenario config of a session: its text (with the --set edits) parsed once. The adapter reads
+/// `node` (each key once, validated once); edits (sweep settings, relocated paths) start from `tree`.
+struct ScenarioFile {
+  std::string path, text;
+  io::ConfigNode node;
+  YAML::Node tree;
+};
+
+ScenarioFile readScenarioFile(const std::string& path, const std::vector<std::string>& set) {
+  std::string text = io::configTextWithValues(path, set);
+  io::ConfigNode node = detail::scenarioConfig(text, path);
+  YAML::Node tree = node.yaml();
+  return {path, std::move(text), std::move(node), std::move(tree)};
 }
 
 // `kv` plus the config's relative paths (rig folders, ...) re-expressed for a copy of the config
 // written into `out_dir`, so that the copy loads from there too (keys already in `kv` win).
-void addRelocatedPaths(std::vector<std::pair<std::string, YAML::Node>>& kv, const std::string& text,
-                       const std::string& config_path, const std::string& out_dir) {
-  for (auto& r : relocatedPaths(parseYaml(text, config_path), fs::path(config_path).parent_path().string(), out_dir)) {
+void addRelocatedPaths(std::vector<std::pair<std::string, YAML::Node>>& kv, const ScenarioFile& file,
+                       const std::string& out_dir) {
+  for (auto& r : relocatedPaths(file.tree, fs::path(file.path).parent_path().string(), out_dir)) {
     const bool swept = std::any_of(kv.begin(), kv.end(), [&](const auto& e) { return e.first == r.first; });
     if (!swept) kv.push_back(std::move(r));
   }
@@ -209,7 +216,7 @@ struct AutotuneOutcome {
   nlohmann::json json;
 };
 
-AutotuneOutcome doAutotune(const ScenarioInstance& base, const std::string& original_text, const std::string& out_dir,
+AutotuneOutcome doAutotune(const ScenarioInstance& base, const ScenarioFile& file, const std::string& out_dir,
                            double start_scale, const ReplayData* given_data, std::uint64_t record_seed, int record_runs,
                            const AutotuneOptions& ao, std::uint64_t verify_seed, int verify_runs, bool quiet,
                            const std::string& source_name) {
@@ -259,11 +266,21 @@ AutotuneOutcome doAutotune(const ScenarioInstance& base, const std::string& orig
   for (std::size_t i = 0; i < params.size(); ++i)
     header += params[i].name + " " + params[i].symbol + ": start " + fmt(start[i]) + " -> tuned " +
               fmt(o.result.tuned[i]) + " " + params[i].unit + (params[i].config_key.empty() ? " (not written: no config key)" : "") + "\n";
-  addRelocatedPaths(kv, original_text, source_name, out_dir);
+  addRelocatedPaths(kv, file, out_dir);
   o.config_file = (fs::path(out_dir) / "autotuned_config.yaml").string();
-  io::writeTextFileAtomic(o.config_file, io::rewriteYamlText(original_text, kv, header));
+  io::writeTextFileAtomic(o.config_file, io::rewriteYamlText(file.text, kv, header));
   o.json["autotuned_config"] = o.config_file;
   return o;
+}
+
+/// The adapter's options with the command line's `--option name=value` values.
+AdapterOptions withOptions(const ScenarioAdapter& adapter, const std::string& scenario, const AdapterOptions& given) {
+  AdapterOptions ao = readAdapterOptions(adapter, nullptr);
+  for (const auto& [k, v] : given) {
+    if (!ao.count(k)) throw core::InvalidInput("--option " + k + ": not an option of scenario '" + scenario + "'");
+    ao[k] = v;
+  }
+  return ao;
 }
 
 }  // namespace
@@ -286,9 +303,9 @@ nlohmann::json runSweepSession(const AdapterRegistry& registry, const std::strin
   const std::string config_path = !opt.config_override.empty() ? opt.config_override : spec.config_path;
   if (config_path.empty())
     throw core::InvalidInput(sweep_file + ": no scenario config (give 'config:' in the sweep file or --config)");
-  const std::string text = io::configTextWithValues(config_path, opt.set);
-  const YAML::Node tree = parseYaml(text, config_path);
-  const std::unique_ptr<ScenarioInstance> base = adapter.load(tree, config_path, spec.adapter_options);
+  const ScenarioFile file = readScenarioFile(config_path, opt.set);
+  const YAML::Node& tree = file.tree;
+  const std::unique_ptr<ScenarioInstance> base = adapter.loadConfig(file.node, spec.adapter_options);
   if (spec.autotune.enabled && !opt.skip_autotune) {
     try {
       base->requireAutotune(spec.scenario);
@@ -405,17 +422,17 @@ nlohmann::json runSweepSession(const AdapterRegistry& registry, const std::strin
     best_metric = b.metrics.at(spec.metric).mean;
     std::vector<std::pair<std::string, YAML::Node>> kv;
     for (std::size_t k = 0; k < spec.parameters.size(); ++k) kv.emplace_back(spec.parameters[k].key, b.setting.values[k]);
-    addRelocatedPaths(kv, text, config_path, opt.out_dir);
+    addRelocatedPaths(kv, file, opt.out_dir);
     best_config = (fs::path(opt.out_dir) / "best_config.yaml").string();
     const std::string header = "viewline_tune: best setting of " + sweep_file + " (" + spec.metric + " " +
                                (spec.minimize ? "minimised" : "maximised") + ": " + fmt(best_metric, 6) + " over " +
                                std::to_string(spec.seeds) + " seeds)\n" + settingLabel(spec, b.setting) +
                                "\nbased on " + config_path;
-    const std::string best_text = io::rewriteYamlText(text, kv, header);
+    const std::string best_text = io::rewriteYamlText(file.text, kv, header);
     io::writeTextFileAtomic(best_config, best_text);
     bool verified = true;
-    try {
-      adapter.load(parseYaml(best_text, best_config), best_config, spec.adapter_options);
+    try {  // the file as written loads (the app will read it)
+      adapter.loadConfig(detail::scenarioConfig(best_text, best_config), spec.adapter_options);
     } catch (const core::InvalidInput&) {
       verified = false;
     }
@@ -437,7 +454,7 @@ nlohmann::json runSweepSession(const AdapterRegistry& registry, const std::strin
     ao.workers = opt.workers;
     ao.confidence = spec.confidence;
     if (!opt.quiet) ao.progress = [](const std::string& s) { std::fprintf(stderr, "%s\n", s.c_str()); };
-    at = doAutotune(*base, text, opt.out_dir, spec.autotune.start_scale, nullptr, spec.autotune.record_seed,
+    at = doAutotune(*base, file, opt.out_dir, spec.autotune.start_scale, nullptr, spec.autotune.record_seed,
                     spec.autotune.record_runs, ao, spec.base_seed, spec.seeds, opt.quiet, config_path);
     nlohmann::json aj = at->json;
     aj["start_scale"] = spec.autotune.start_scale;
@@ -557,36 +574,22 @@ nlohmann::json runSweepSession(const AdapterRegistry& registry, const std::strin
 
 nlohmann::json runSingleSession(const AdapterRegistry& registry, const SingleRunOptions& o) {
   const ScenarioAdapter& adapter = registry.get(o.scenario);
-  const std::string text = io::configTextWithValues(o.config, o.set);
-  AdapterOptions ao = readAdapterOptions(adapter, nullptr);
-  for (const auto& [k, v] : o.adapter_options) {
-    if (!ao.count(k)) throw core::InvalidInput("--option " + k + ": not an option of scenario '" + o.scenario + "'");
-    ao[k] = v;
-  }
-  const std::unique_ptr<ScenarioInstance> inst = adapter.load(parseYaml(text, o.config), o.config, ao);
+  const AdapterOptions ao = withOptions(adapter, o.scenario, o.adapter_options);
+  const std::unique_ptr<ScenarioInstance> inst = adapter.loadConfig(readScenarioFile(o.config, o.set).node, ao);
   fs::create_directories(o.out_dir);
   io::LogDirectory log(o.log_dir);
   RunOptions ro;
   ro.series = true;
   ro.log = &log;
   ro.display = o.display;
-  std::unique_ptr<LivePlot> live;
   if (o.display) {
-    if (LivePlot::available()) {
-      live = std::make_unique<LivePlot>("viewline_tune: " + o.scenario, "error", 2.0, inst->confidence());
-      ro.live = [&live](const LiveSample& s) { live->add(s); };
-    } else {
-      say(o.quiet, "viewline_tune: --display ignored (no X display)");
-    }
+    if (o.live_view) ro.live = o.live_view("viewline_tune: " + o.scenario, inst->confidence());
+    if (!ro.live) say(o.quiet, "viewline_tune: --display: no live curves (no X display)");
   }
-  if (!o.quiet) {
-    ro.progress = [last = -1](double f) mutable {
-      const int pct = static_cast<int>(100.0 * f);
-      if (pct / 10 != last / 10) std::fprintf(stderr, "[run] %d%%\n", pct);
-      last = pct;
-    };
-  }
+  runtime::Progress progress = o.quiet ? runtime::Progress::quiet() : runtime::Progress("run (%)", 100);
+  ro.progress = [&progress](double f) { progress.update(static_cast<long>(100.0 * f)); };
   const RunResult r = inst->run(o.seed, ro);
+  progress.finish();
   log.flush();
   const double c = inst->confidence();
   nlohmann::json j;
@@ -620,13 +623,9 @@ nlohmann::json runSingleSession(const AdapterRegistry& registry, const SingleRun
 
 nlohmann::json runAutotuneSession(const AdapterRegistry& registry, const AutotuneSessionOptions& o) {
   const ScenarioAdapter& adapter = registry.get(o.scenario);
-  const std::string text = io::configTextWithValues(o.config, o.set);
-  AdapterOptions aopt = readAdapterOptions(adapter, nullptr);
-  for (const auto& [k, v] : o.adapter_options) {
-    if (!aopt.count(k)) throw core::InvalidInput("--option " + k + ": not an option of scenario '" + o.scenario + "'");
-    aopt[k] = v;
-  }
-  const std::unique_ptr<ScenarioInstance> base = adapter.load(parseYaml(text, o.config), o.config, aopt);
+  const ScenarioFile file = readScenarioFile(o.config, o.set);
+  const std::unique_ptr<ScenarioInstance> base =
+      adapter.loadConfig(file.node, withOptions(adapter, o.scenario, o.adapter_options));
   base->requireAutotune(o.scenario);
   fs::create_directories(o.out_dir);
   std::unique_ptr<ReplayData> data;
@@ -638,7 +637,7 @@ nlohmann::json runAutotuneSession(const AdapterRegistry& registry, const Autotun
   ao.workers = o.workers;
   ao.confidence = base->confidence();
   if (!o.quiet) ao.progress = [](const std::string& s) { std::fprintf(stderr, "%s\n", s.c_str()); };
-  const AutotuneOutcome at = doAutotune(*base, text, o.out_dir, o.start_scale, data.get(), o.record_seed, o.record_runs, ao,
+  const AutotuneOutcome at = doAutotune(*base, file, o.out_dir, o.start_scale, data.get(), o.record_seed, o.record_runs, ao,
                                         1, o.verify_runs, o.quiet, o.config);
   nlohmann::json j = at.json;
   j["scenario"] = o.scenario;

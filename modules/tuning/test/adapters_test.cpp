@@ -1,4 +1,4 @@
-// The scenario adapters for table ball, ball catching and mobile capture (issue 10): a tiny sweep
+// The scenario adapters for table ball, ball catching and mobile capture: a tiny sweep
 // of each (2 settings x 1 seed, short runs) through the full session, checking the report, the
 // summary and that the metrics a user optimises and the consistency statistics exist and are
 // finite; the adapters without noise auto-tuning must say so (not crash, not pretend), and so must

@@ -30,17 +30,20 @@
 // and stamp, or same id, within the buffer), older than newest − horizon
 // (backwards beyond the horizon), or further than max_forward_gap in the future.
 //
-// Track start and loss. The first measurement (and any after a gap of
-// max_coast without a fused image) starts a track from the configured prior
-// at its capture time and is fused without gating (nothing to gate against).
-// After `restart_after_rejections` consecutive gated images of one camera
-// (counted per camera: a track seeded by an outlier of camera A can keep
-// agreeing with A while B disagrees) the track is judged to have been seeded
-// by a bad measurement: its seed (oldest
-// measurement of the track history) is dropped and a new track is started
-// from the prior and re-fed with the rest of the history and the current
-// image (gated as usual). The state therefore depends only on past
-// measurements (causal), which keeps the late-data replay exact.
+// Track start and loss (the life cycle of tracking::TrackGate, one rejection count per camera).
+// The first measurement (and any after a gap of max_coast without a fused image) starts a track
+// from the configured prior at its capture time and is fused without gating (nothing to gate
+// against). After `restart_after_rejections` consecutive gated images of one camera (counted per
+// camera: a track seeded by an outlier of camera A can keep agreeing with A while B disagrees)
+// the track is judged to have been seeded by a bad measurement: its seed (oldest measurement of
+// the track history) is dropped and a new track is started from the prior and re-fed with the
+// rest of the history and the current image (gated as usual). The state therefore depends only
+// on past measurements (causal), which keeps the late-data replay exact.
+//
+// Each processed image reports what happened to it: its outcome carries the track gate's
+// decision (Start, Accept, Reject, Restart), and lastUpdate() gives the submitted image's
+// innovation, S and NIS as the tracker formed them, so a telemetry sink or a tuning tool reads
+// the tracker's own diagnostics instead of recomputing them.
 
 #include <array>
 #include <cstdint>
@@ -54,6 +57,7 @@
 #include "viewline/estimation/state.h"
 #include "viewline/tracking/ballistic.h"
 #include "viewline/tracking/gates.h"
+#include "viewline/tracking/track_gate.h"
 #include "viewline/tracking/viewline.h"
 
 namespace viewline::tracking {
@@ -91,6 +95,22 @@ struct MeasurementOutcome {
   Fate fate = Fate::Fused;
   GateReport gate;
   bool seed = false;   ///< started a track (fused without gating)
+  /// The track gate's decision when the image was processed: Start for a seed, Accept / Reject
+  /// for a fused / gated image, Restart for the rejection that restarted the track (a restart
+  /// re-feeds the history, so the outcomes then hold the decisions of the new track).
+  GateDecision decision = GateDecision::Start;
+};
+
+/// The update's own diagnostics for one submitted image, as the tracker formed them when the
+/// image was processed (for the new track's prior when the decision is Start).
+struct ImageUpdate {
+  ImageMeasurement m;
+  GateDecision decision = GateDecision::Start;
+  Eigen::Vector2d innovation = Eigen::Vector2d::Zero();  ///< d = y − C x̂(t|t−) of the image's two viewline rows
+  Eigen::Matrix2d S = Eigen::Matrix2d::Identity();       ///< R2 + C P Cᵀ
+  Eigen::Matrix2d R = Eigen::Matrix2d::Identity();       ///< R2, the rows' own noise (viewline.h)
+  double nis = 0.0;                                      ///< dᵀ S⁻¹ d (GateReport::mahalanobis)
+  int fused_before = 0;  ///< fused images of the track the image was tested against (0 for Start)
 };
 
 struct TrackerConfig {
@@ -122,12 +142,11 @@ struct TrackerConfig {
 
 /// Track state: what a snapshot holds (the estimate and the track bookkeeping).
 struct TrackState {
+  explicit TrackState(TrackGate g) : gate(std::move(g)) {}
   estimation::StateEstimate est;
-  bool active = false;
-  int consecutive_rejections = 0;                ///< max over cameras of the per-camera count
-  std::vector<int> camera_rejections;            ///< consecutive gated images per camera
+  /// Life cycle: live track, time of the last fused image, rejections in a row per camera.
+  TrackGate gate;
   int fused_in_track = 0;
-  core::Timestamp last_fused_t = 0.0;
   core::Timestamp track_start_t = 0.0;      ///< sample time of the track's prior
   std::vector<MeasurementOutcome> history;  ///< since the track's seed (capped)
   int tracks_started = 0;
@@ -148,7 +167,7 @@ public:
   /// Validates, buffers and fuses one measurement (re-processing later ones when it is late).
   Refusal submit(const ImageMeasurement& m);
 
-  bool initialised() const { return state_.active; }
+  bool initialised() const { return state_.gate.active(); }
   /// The estimate after the newest processed measurement (time = its capture time, or its grid
   /// instant in DtOffset mode).
   const estimation::StateEstimate& state() const { return state_.est; }
@@ -159,6 +178,9 @@ public:
   std::size_t refusalCount(Refusal r) const { return refusals_[static_cast<std::size_t>(r)]; }
   std::size_t lateInserted() const { return late_inserted_; }
   std::size_t bufferSize() const { return buffer_.size(); }
+  /// The update of the image the last submit() processed (as it was processed then: a later
+  /// restart or late insertion may change its outcome); empty when that image was refused.
+  const std::optional<ImageUpdate>& lastUpdate() const { return last_update_; }
 
   /// Current outcome of a processed measurement (it can change while the measurement is within
   /// the horizon or in the current track's history).
@@ -178,7 +200,8 @@ private:
     TrackState before;
   };
   Refusal check(const ImageMeasurement& m) const;
-  void step(TrackState& ts, const ImageMeasurement& m);
+  static TrackState initialState(const TrackerConfig& cfg, std::size_t cameras);
+  void step(TrackState& ts, const ImageMeasurement& m, ImageUpdate* update);
   void startTrack(TrackState& ts, core::Timestamp t);
   void restart(TrackState& ts);
   void refit(TrackState& ts) const;
@@ -187,7 +210,9 @@ private:
 
   std::vector<core::Camera> cameras_;
   TrackerConfig cfg_;
+  TrackState fresh_;  ///< no track yet (what reset() returns to)
   TrackState state_;
+  std::optional<ImageUpdate> last_update_;
   std::deque<Entry> buffer_;
   std::unordered_map<std::uint64_t, MeasurementOutcome> final_;
   std::array<std::size_t, static_cast<std::size_t>(Refusal::kCount)> refusals_{};

@@ -176,6 +176,10 @@ public:
   /// errors). Throws core::InvalidInput.
   virtual std::unique_ptr<ScenarioInstance> load(const YAML::Node& scenario, const std::string& name,
                                                  const AdapterOptions& options) const = 0;
+  /// The same from a config parsed once (io::ConfigNode, its keys not yet read; its file name names
+  /// the file in errors): sessions load their scenario this way, so the text is parsed once. The
+  /// default hands the tree to load(); an adapter whose reader takes a ConfigNode reads it directly.
+  virtual std::unique_ptr<ScenarioInstance> loadConfig(const io::ConfigNode& config, const AdapterOptions& options) const;
 };
 
 class AdapterRegistry {

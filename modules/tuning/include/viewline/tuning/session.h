@@ -12,6 +12,7 @@
 // Auto-tune (runAutotuneSession): from the scenario app's --log folder or a live recording.
 
 #include <atomic>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -40,13 +41,20 @@ struct SessionOptions {
 nlohmann::json runSweepSession(const AdapterRegistry& registry, const std::string& sweep_file,
                                const SessionOptions& options);
 
+/// Live curves of a single run (--display): given the window title and the run's confidence level,
+/// returns where the samples go, or an empty function when no window can open. The app supplies it
+/// (viz::LivePlot): the tuning library opens no window.
+using LiveViewFactory =
+    std::function<std::function<void(const LiveSample&)>(const std::string& title, double confidence)>;
+
 struct SingleRunOptions {
   std::string scenario;      ///< adapter name
   std::string config;        ///< scenario YAML
   std::uint64_t seed = 1;
   std::string out_dir = "tune_run";
   std::string log_dir;       ///< scenario logs (CSV) of the run, "" = none
-  bool display = false;      ///< live curves (vpPlot) + the scenario's view
+  bool display = false;      ///< live curves (live_view) + the scenario's view
+  LiveViewFactory live_view;
   std::vector<std::string> set;  ///< --set edits of the config (see SessionOptions::set)
   AdapterOptions adapter_options;
   bool quiet = false;

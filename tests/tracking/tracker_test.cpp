@@ -3,21 +3,29 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 
+// The viewline tracker on generated dart flights (the dart scenario's world is the fixture).
 #include "viewline/core/random.h"
-#include "viewline/tracking/dart_scenario.h"
+#include "viewline/scenarios/dart/world.h"
 #include "viewline/tracking/image_ekf.h"
 #include "viewline/tracking/tracker.h"
 
 using namespace viewline;
 using namespace viewline::tracking;
+using scenarios::DartClockMode;
 
 namespace {
 
 struct Fixture {
-  DartScenarioConfig cfg = defaultDartScenario();
-  std::vector<core::Camera> cams = makeDartCameras(cfg);
+  scenarios::DartScenarioConfig cfg = scenarios::defaultDartScenario();
+  std::vector<core::Camera> cams = scenarios::makeDartCameras(cfg);
 };
+
+scenarios::DartFlight simulateFlight(const scenarios::DartScenarioConfig& cfg, const std::vector<core::Camera>& cams,
+                                     DartClockMode mode, double outlier_rate, core::Rng& rng) {
+  return scenarios::simulateDartFlight(cfg, cams, mode, outlier_rate, rng);
+}
 
 ImageMeasurement inlier(const core::Camera& cam, std::size_t ci, std::uint64_t id, double t, const Eigen::Vector3d& p) {
   const Eigen::Vector3d pc = cam.c_M_w * p;
@@ -62,7 +70,7 @@ TEST(Tracker, LateArrivalsGiveExactlyTheInOrderResult) {
   core::Rng rng = core::makeRng(11);
   int compared = 0;
   for (int run = 0; run < 20; ++run) {
-    const SimFlight fl = simulateFlight(f.cfg, f.cams, ClockMode::FreeRunning, 0.1, rng);
+    const scenarios::DartFlight fl = simulateFlight(f.cfg, f.cams, DartClockMode::FreeRunning, 0.1, rng);
     ViewlineTracker in_order(f.cams, f.cfg.tracker), late(f.cams, f.cfg.tracker);
     std::vector<std::pair<double, std::size_t>> arrival;
     for (std::size_t i = 0; i < fl.detections.size(); ++i) {
@@ -75,7 +83,7 @@ TEST(Tracker, LateArrivalsGiveExactlyTheInOrderResult) {
     EXPECT_GT(late.lateInserted(), 0u);
     EXPECT_LE((in_order.state().x() - late.state().x()).cwiseAbs().maxCoeff(), 1e-12);
     EXPECT_LE((in_order.state().P() - late.state().P()).cwiseAbs().maxCoeff(), 1e-12);
-    for (const SimDetection& d : fl.detections) {
+    for (const scenarios::DartDetection& d : fl.detections) {
       const auto a = in_order.outcome(d.m.id), b = late.outcome(d.m.id);
       ASSERT_TRUE(a && b);
       EXPECT_EQ(a->fate, b->fate);
@@ -88,10 +96,10 @@ TEST(Tracker, LateArrivalsGiveExactlyTheInOrderResult) {
 TEST(Tracker, OneBadCameraDoesNotVetoTheOthers) {
   Fixture f;
   core::Rng rng = core::makeRng(5);
-  const SimFlight fl = simulateFlight(f.cfg, f.cams, ClockMode::Alternating, 0.0, rng);
+  const scenarios::DartFlight fl = simulateFlight(f.cfg, f.cams, DartClockMode::Alternating, 0.0, rng);
   ViewlineTracker tr(f.cams, f.cfg.tracker);
   for (std::size_t i = 0; i + 1 < fl.detections.size(); ++i) tr.submit(fl.detections[i].m);
-  const SimDetection& last = fl.detections.back();
+  const scenarios::DartDetection& last = fl.detections.back();
   const double t = last.m.t;
   const Eigen::Vector3d p = last.truth.head<3>();
   ImageMeasurement bad = inlier(f.cams[0], 0, 1000, t, p);
@@ -110,32 +118,32 @@ TEST(Tracker, OneBadCameraDoesNotVetoTheOthers) {
 TEST(Tracker, TrackSeededByAnOutlierIsRestartedAndTheOutlierDropped) {
   Fixture f;
   core::Rng rng = core::makeRng(9);
-  const SimFlight fl = simulateFlight(f.cfg, f.cams, ClockMode::Alternating, 0.0, rng);
+  const scenarios::DartFlight fl = simulateFlight(f.cfg, f.cams, DartClockMode::Alternating, 0.0, rng);
   ViewlineTracker tr(f.cams, f.cfg.tracker);
   ImageMeasurement seed = fl.detections.front().m;
   seed.id = 999;
   seed.t -= 0.005;
   seed.uv = {600.0, 40.0};  // far from the dart
   ASSERT_EQ(tr.submit(seed), Refusal::None);
-  for (const SimDetection& d : fl.detections) tr.submit(d.m);
+  for (const scenarios::DartDetection& d : fl.detections) tr.submit(d.m);
   EXPECT_GE(tr.trackState().restarts, 1);
   ASSERT_TRUE(tr.outcome(999).has_value());
   EXPECT_EQ(tr.outcome(999)->fate, Fate::DroppedOnRestart);
   EXPECT_LT((tr.state().x().head<3>() - fl.detections.back().truth.head<3>()).norm(), 0.02);
   std::size_t inliers_rejected = 0;
-  for (const SimDetection& d : fl.detections) inliers_rejected += tr.outcome(d.m.id)->fate != Fate::Fused;
+  for (const scenarios::DartDetection& d : fl.detections) inliers_rejected += tr.outcome(d.m.id)->fate != Fate::Fused;
   EXPECT_LE(inliers_rejected, 1u);  // the re-fed history recovers the inliers the bad track had gated
 }
 
 TEST(Tracker, DtOffsetRowsEqualExactPropagationForImagesOnTheGrid) {
   Fixture f;
   core::Rng rng = core::makeRng(3);
-  const SimFlight fl = simulateFlight(f.cfg, f.cams, ClockMode::Alternating, 0.0, rng);  // t = k * 10 ms
+  const scenarios::DartFlight fl = simulateFlight(f.cfg, f.cams, DartClockMode::Alternating, 0.0, rng);  // t = k * 10 ms
   TrackerConfig exact = f.cfg.tracker, offset = f.cfg.tracker;
   offset.time_mode = TimeMode::DtOffset;
   offset.sample_period = 0.01;
   ViewlineTracker a(f.cams, exact), b(f.cams, offset);
-  for (const SimDetection& d : fl.detections) {
+  for (const scenarios::DartDetection& d : fl.detections) {
     a.submit(d.m);
     b.submit(d.m);
   }
@@ -144,20 +152,20 @@ TEST(Tracker, DtOffsetRowsEqualExactPropagationForImagesOnTheGrid) {
   // ½ g Δt² term the rows are still exact, so the estimates agree closely.
   offset.sample_period = 0.02;
   ViewlineTracker c(f.cams, offset);
-  for (const SimDetection& d : fl.detections) c.submit(d.m);
+  for (const scenarios::DartDetection& d : fl.detections) c.submit(d.m);
   EXPECT_LT((c.predictAt(a.state().t()).x().head<3>() - a.state().x().head<3>()).norm(), 1e-4);
 }
 
 TEST(ImageEkf, TracksCleanDataFromANearPrior) {
   Fixture f;
   core::Rng rng = core::makeRng(21);
-  const SimFlight fl = simulateFlight(f.cfg, f.cams, ClockMode::Alternating, 0.0, rng);
+  const scenarios::DartFlight fl = simulateFlight(f.cfg, f.cams, DartClockMode::Alternating, 0.0, rng);
   TrackerConfig cfg = f.cfg.tracker;
   cfg.prior_mean = fl.detections.front().truth;
   cfg.prior_mean.head<3>() += Eigen::Vector3d(0.1, -0.1, 0.05);
   cfg.prior_cov = 0.5 * Matrix6::Identity();
   ImageSpaceEkf ekf(f.cams, cfg);
-  for (const SimDetection& d : fl.detections) EXPECT_EQ(ekf.submit(d.m), Refusal::None);
+  for (const scenarios::DartDetection& d : fl.detections) EXPECT_EQ(ekf.submit(d.m), Refusal::None);
   EXPECT_LT((ekf.state().x().head<3>() - fl.detections.back().truth.head<3>()).norm(), 0.02);
   ImageMeasurement old = fl.detections.front().m;
   EXPECT_EQ(ekf.submit(old), Refusal::TooOld);
@@ -172,4 +180,57 @@ TEST(TrackerConfig, InvalidFieldsAreNamed) {
   } catch (const core::InvalidInput& e) {
     EXPECT_NE(std::string(e.what()).find("restart_after_rejections"), std::string::npos);
   }
+}
+
+TEST(Tracker, ReportsEachImagesGateDecisionAndItsOwnInnovation) {
+  Fixture f;
+  core::Rng rng = core::makeRng(9);
+  const scenarios::DartFlight fl = simulateFlight(f.cfg, f.cams, DartClockMode::Alternating, 0.0, rng);
+  ViewlineTracker tr(f.cams, f.cfg.tracker);
+  ImageMeasurement seed = fl.detections.front().m;
+  seed.id = 999;
+  seed.t -= 0.005;
+  seed.uv = {600.0, 40.0};  // far from the dart: the track it seeds rejects the next images
+  ASSERT_EQ(tr.submit(seed), Refusal::None);
+  ASSERT_TRUE(tr.lastUpdate());
+  EXPECT_EQ(tr.lastUpdate()->decision, GateDecision::Start);
+  EXPECT_EQ(tr.lastUpdate()->fused_before, 0);
+  std::map<GateDecision, int> seen;
+  for (const scenarios::DartDetection& d : fl.detections) {
+    ASSERT_EQ(tr.submit(d.m), Refusal::None);
+    ASSERT_TRUE(tr.lastUpdate());
+    const ImageUpdate& u = *tr.lastUpdate();
+    EXPECT_EQ(u.m.id, d.m.id);
+    ++seen[u.decision];
+    if (u.decision == GateDecision::Accept) {
+      // The reported NIS is the one the gate tested: dᵀ S⁻¹ d within the chi-square threshold.
+      EXPECT_NEAR(u.nis, u.innovation.dot(u.S.ldlt().solve(u.innovation)), 1e-9 * (1.0 + u.nis));
+      EXPECT_EQ(tr.outcome(d.m.id)->decision, GateDecision::Accept);
+    }
+  }
+  // restart_after_rejections = 3 rejections of one camera in a row restart the track once.
+  EXPECT_LE(seen[GateDecision::Restart], tr.trackState().restarts);  // re-fed images may restart too
+  EXPECT_GE(seen[GateDecision::Restart], 1);
+  EXPECT_GE(seen[GateDecision::Reject], 1);
+  EXPECT_GT(seen[GateDecision::Accept], 5);
+  ImageMeasurement bad = fl.detections.back().m;
+  bad.uv = {-50.0, 10.0};
+  EXPECT_EQ(tr.submit(bad), Refusal::OutsideImage);
+  EXPECT_FALSE(tr.lastUpdate());  // a refused image is not processed
+}
+
+TEST(Tracker, ResetForgetsTheTrackAndTheLastUpdate) {
+  Fixture f;
+  core::Rng rng = core::makeRng(4);
+  const scenarios::DartFlight fl = simulateFlight(f.cfg, f.cams, DartClockMode::Alternating, 0.0, rng);
+  ViewlineTracker a(f.cams, f.cfg.tracker), b(f.cams, f.cfg.tracker);
+  for (const scenarios::DartDetection& d : fl.detections) a.submit(d.m);
+  a.reset();
+  EXPECT_FALSE(a.initialised());
+  EXPECT_FALSE(a.lastUpdate());
+  for (const scenarios::DartDetection& d : fl.detections) {
+    a.submit(d.m);
+    b.submit(d.m);
+  }
+  EXPECT_EQ((a.state().x() - b.state().x()).cwiseAbs().maxCoeff(), 0.0);  // a reset tracker is a new one
 }

@@ -1,5 +1,6 @@
-#include "viewline/tuning/live_plot.h"
+#include "viewline/viz/live_plot.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <visp3/core/vpConfig.h>
@@ -8,7 +9,7 @@
 #include "viewline/core/error.h"
 #include "viewline/core/statistics.h"
 
-namespace viewline::tuning {
+namespace viewline::viz {
 
 struct LivePlot::Impl {
 #if defined(VISP_HAVE_X11) || defined(VISP_HAVE_OPENCV)
@@ -51,27 +52,34 @@ LivePlot::LivePlot(const std::string& title, const std::string& error_label, dou
   impl_->plot->setColor(1, 1, vpColor::blue);
   impl_->plot->setColor(1, 2, vpColor::red);
   impl_->plot->setColor(1, 3, vpColor::red);
+#else
+  (void)title;
+  (void)error_label;
+  (void)nis_dof;
+  (void)confidence;
 #endif
 }
 
 LivePlot::~LivePlot() = default;
 
-void LivePlot::add(const LiveSample& s) {
+void LivePlot::add(double t, double error, double nis) {
 #if defined(VISP_HAVE_X11)
   if (!impl_->plot) return;
-  if (std::isfinite(s.error)) impl_->plot->plot(0, 0, s.t, s.error);
-  if (s.nis >= 0.0) {
+  if (std::isfinite(error)) impl_->plot->plot(0, 0, t, error);
+  if (nis >= 0.0) {
     ++impl_->n;
     const double w = static_cast<double>(std::min<std::size_t>(impl_->n, 20));
-    impl_->ma += (s.nis - impl_->ma) / w;
-    impl_->plot->plot(1, 0, s.t, s.nis);
-    impl_->plot->plot(1, 1, s.t, impl_->ma);
-    impl_->plot->plot(1, 2, s.t, impl_->lo);
-    impl_->plot->plot(1, 3, s.t, impl_->hi);
+    impl_->ma += (nis - impl_->ma) / w;
+    impl_->plot->plot(1, 0, t, nis);
+    impl_->plot->plot(1, 1, t, impl_->ma);
+    impl_->plot->plot(1, 2, t, impl_->lo);
+    impl_->plot->plot(1, 3, t, impl_->hi);
   }
 #else
-  (void)s;
+  (void)t;
+  (void)error;
+  (void)nis;
 #endif
 }
 
-}  // namespace viewline::tuning
+}  // namespace viewline::viz

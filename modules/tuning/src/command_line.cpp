@@ -1,0 +1,168 @@
+#include "viewline/tuning/command_line.h"
+
+#include <cmath>
+#include <cstdio>
+
+#include "viewline/core/error.h"
+#include "viewline/io/config_edit.h"
+
+namespace viewline::tuning {
+
+namespace {
+
+double get(const nlohmann::json& j, const char* k) {
+  return j.contains(k) && j[k].is_number() ? j[k].get<double>() : std::nan("");
+}
+
+}  // namespace
+
+AdapterOptions parseAdapterOptions(const std::vector<std::string>& items) {
+  AdapterOptions o;
+  for (const std::string& s : items) {
+    const auto eq = s.find('=');
+    if (eq == std::string::npos || eq == 0) throw core::InvalidInput("--option '" + s + "': expected name=value");
+    o[s.substr(0, eq)] = s.substr(eq + 1);
+  }
+  return o;
+}
+
+TuneCommandLine::TuneCommandLine(CLI::App& app) {
+  app.require_subcommand(1);
+
+  sweep_ = app.add_subcommand("sweep", "run a sweep file (and its autotune section), write the report");
+  SessionOptions& so = sweep_options_;
+  sweep_->add_option("--sweep", sweep_file_, "sweep YAML (config/sweeps/*.yaml)")->required();
+  sweep_->add_option("--config", so.config_override, "scenario config (instead of the sweep file's 'config')");
+  sweep_->add_option("--set", so.set, io::kSetOptionHelp)->take_all();
+  sweep_->add_option("--out", so.out_dir, "output folder (report.html, summary.json, results.jsonl, best_config.yaml)");
+  sweep_->add_option("--workers", workers_, "threads (0: all cores)");
+  sweep_->add_option("--seeds", so.seeds_override, "seeds per setting (instead of the file's)");
+  sweep_->add_flag("--speedup", so.measure_speedup, "also run the sweep on one worker: parallel_speedup, same results");
+  sweep_->add_flag("--no-autotune", so.skip_autotune, "skip the sweep file's autotune section");
+  sweep_->add_flag("--quiet", quiet_, "no progress output");
+
+  run_ = app.add_subcommand("run", "one seeded run: metrics, NEES/NIS verdict, plots");
+  SingleRunOptions& ro = run_options_;
+  ro.out_dir = "tune_run";
+  run_->add_option("--scenario", ro.scenario, "scenario adapter (viewline_tune list)")->required();
+  run_->add_option("--config", ro.config, "scenario YAML")->required();
+  run_->add_option("--set", ro.set, io::kSetOptionHelp)->take_all();
+  run_->add_option("--seed", ro.seed, "seed");
+  run_->add_option("--out", ro.out_dir, "output folder");
+  run_->add_option("--log", ro.log_dir, "CSV logs of the run (measurements, estimates, innovations and S)");
+  run_->add_option("--option", run_adapter_options_, "adapter option name=value (viewline_tune list)");
+  run_->add_flag("--display", ro.display, "live curves (vpPlot) and the scenario's camera view, when an X display exists");
+  run_->add_flag("--headless", "no display (the default)");
+  run_->add_flag("--quiet", quiet_, "no progress output");
+
+  autotune_ = app.add_subcommand("autotune", "estimate process and measurement noise from a log or a live run");
+  AutotuneSessionOptions& ao = autotune_options_;
+  autotune_->add_option("--scenario", ao.scenario, "scenario adapter")->required();
+  autotune_->add_option("--config", ao.config, "scenario YAML")->required();
+  autotune_->add_option("--set", ao.set, io::kSetOptionHelp)->take_all();
+  autotune_->add_option("--log", ao.log_dir, "the scenario app's --log folder (default: record a live run)");
+  autotune_->add_option("--record-seed", ao.record_seed, "seed of the live recording");
+  autotune_->add_option("--record-runs", ao.record_runs, "live runs recorded");
+  autotune_->add_option("--start-scale", ao.start_scale, "start from the config's noise values times this");
+  autotune_->add_option("--outlier-prior", ao.outlier_prior, "prior outlier probability in the likelihood");
+  autotune_->add_option("--span-decades", ao.span_decades, "grid half-width in decades");
+  autotune_->add_option("--grid-points", ao.grid_points, "grid points per parameter");
+  autotune_->add_option("--verify-runs", ao.verify_runs, "live runs with the start and the tuned noise (NEES/NIS)");
+  autotune_->add_option("--out", ao.out_dir, "output folder");
+  autotune_->add_option("--option", autotune_adapter_options_, "adapter option name=value");
+  autotune_->add_option("--workers", workers_, "threads (0: all cores)");
+  autotune_->add_flag("--quiet", quiet_, "no progress output");
+
+  list_ = app.add_subcommand("list", "the scenarios of this build, their metrics and options");
+}
+
+int TuneCommandLine::run(const AdapterRegistry& registry, const std::atomic<bool>* stop,
+                         const LiveViewFactory& live_view) {
+  if (list_->parsed()) {
+    list(registry);
+    return 0;
+  }
+  if (sweep_->parsed()) return runSweep(registry, stop);
+  if (run_->parsed()) return runSingle(registry, live_view);
+  if (autotune_->parsed()) return runAutotune(registry);
+  return 0;
+}
+
+void TuneCommandLine::list(const AdapterRegistry& registry) {
+  for (const std::string& n : registry.names()) {
+    const auto& a = registry.get(n);
+    std::printf("%s: %s\n  metrics:", n.c_str(), a.description().c_str());
+    for (const auto& m : a.metricNames()) std::printf(" %s", m.c_str());
+    std::printf("\n  options (sweep file 'adapter:' map or --option name=value):\n");
+    for (const auto& o : a.options())
+      std::printf("    %-24s default %-14s %s\n", o.name.c_str(), o.default_value.c_str(), o.doc.c_str());
+  }
+}
+
+int TuneCommandLine::runSweep(const AdapterRegistry& registry, const std::atomic<bool>* stop) {
+  SessionOptions so = sweep_options_;
+  so.workers = workers_;
+  so.stop = stop;
+  so.quiet = quiet_;
+  const nlohmann::json j = runSweepSession(registry, sweep_file_, so);
+  std::printf("viewline_tune sweep: %s, %zu/%zu runs%s, %.1f s on %d workers (load %s)\n",
+              j["scenario"].get<std::string>().c_str(), j["jobs_done"].get<std::size_t>(),
+              j["jobs_total"].get<std::size_t>(), j["interrupted"].get<bool>() ? " (INTERRUPTED)" : "",
+              get(j, "sweep_wall_s"), j["workers"].get<int>(), j["load_average_before"].get<std::string>().c_str());
+  if (j.contains("best_label"))
+    std::printf("  best: %s  %s = %.6g  (%s)\n  config: %s\n", j["best_label"].get<std::string>().c_str(),
+                j["metric"].get<std::string>().c_str(), get(j, "best_metric"),
+                j["best"]["verdict"].get<std::string>().c_str(), j["best_config"].get<std::string>().c_str());
+  if (j.contains("parallel_speedup"))
+    std::printf("  parallel_speedup %.3f (%d workers vs 1), same results: %s\n", get(j, "parallel_speedup"),
+                j["parallel_workers"].get<int>(), j["parallel_same_results"].get<bool>() ? "yes" : "NO");
+  if (j.contains("autotune_nis_mean")) {
+    std::printf("  autotune: NIS %.3f in [%.3f, %.3f] (before %.3f)", get(j, "autotune_nis_mean"),
+                j["autotune_nis_bounds"][0].get<double>(), j["autotune_nis_bounds"][1].get<double>(),
+                get(j, "autotune_nis_mean_before"));
+    if (j.contains("autotune_metric_ratio_to_best_grid"))
+      std::printf(", metric ratio to best grid %.3f", get(j, "autotune_metric_ratio_to_best_grid"));
+    std::printf("\n  autotuned config: %s\n", j["autotuned_config"].get<std::string>().c_str());
+  }
+  std::printf("  report: %s (%zu plots)\n", j["report"].get<std::string>().c_str(), j["report_plots"].get<std::size_t>());
+  return j["interrupted"].get<bool>() ? 130 : 0;
+}
+
+int TuneCommandLine::runSingle(const AdapterRegistry& registry, const LiveViewFactory& live_view) {
+  SingleRunOptions ro = run_options_;
+  ro.adapter_options = parseAdapterOptions(run_adapter_options_);
+  ro.quiet = quiet_;
+  ro.live_view = live_view;
+  const nlohmann::json j = runSingleSession(registry, ro);
+  std::printf("viewline_tune run: %s seed %llu: verdict %s (NEES %s, NIS %s)\n", ro.scenario.c_str(),
+              static_cast<unsigned long long>(ro.seed), j["verdict"].get<std::string>().c_str(),
+              j["nees"]["verdict"].get<std::string>().c_str(), j["nis"]["verdict"].get<std::string>().c_str());
+  for (const auto& [k, v] : j["metrics"].items()) std::printf("  %-28s %s\n", k.c_str(), v.dump().c_str());
+  std::printf("  report: %s\n", j["report"].get<std::string>().c_str());
+  return 0;
+}
+
+int TuneCommandLine::runAutotune(const AdapterRegistry& registry) {
+  AutotuneSessionOptions ao = autotune_options_;
+  ao.adapter_options = parseAdapterOptions(autotune_adapter_options_);
+  ao.workers = workers_;
+  ao.quiet = quiet_;
+  const nlohmann::json j = runAutotuneSession(registry, ao);
+  std::printf("viewline_tune autotune: %s\n", j["data"].get<std::string>().c_str());
+  for (const auto& [k, v] : j["parameters"].items())
+    std::printf("  %-12s %-10s start %-12.5g tuned %.5g %s\n", k.c_str(), v["symbol"].get<std::string>().c_str(),
+                v["start"].get<double>(), v["tuned"].get<double>(), v["unit"].get<std::string>().c_str());
+  std::printf("  NIS before %.3f (%s), after %.3f in [%.3f, %.3f] (%s)\n", get(j, "autotune_nis_mean_before"),
+              j["autotune_nis_verdict_before"].get<std::string>().c_str(), get(j, "autotune_nis_mean"),
+              j["autotune_nis_bounds"][0].get<double>(), j["autotune_nis_bounds"][1].get<double>(),
+              j["autotune_nis_verdict"].get<std::string>().c_str());
+  if (j.contains("autotune_nees_mean"))
+    std::printf("  live NEES with the tuned noise %.3f in [%.3f, %.3f]: %s\n", get(j, "autotune_nees_mean"),
+                j["autotune_nees_bounds"][0].get<double>(), j["autotune_nees_bounds"][1].get<double>(),
+                j["autotune_nees_inside"].get<bool>() ? "inside" : "OUTSIDE");
+  std::printf("  tuned config: %s\n  report: %s\n", j["autotuned_config"].get<std::string>().c_str(),
+              j["report"].get<std::string>().c_str());
+  return 0;
+}
+
+}  // namespace viewline::tuning
