@@ -17,12 +17,13 @@ int main(int argc, char** argv) {
       "dart_tracking: Monte Carlo of the multi-view viewline tracker on thrown darts ([L] section VI).\n"
       "MEASUREMENT-LEVEL scenario: detected pixels are generated from the true ballistic flights plus\n"
       "pixel noise and gross outliers (no images are rendered or detected)."};
-  apps::CommonOptions opt{"config/dart_tracking.yaml"};
+  apps::CommonOptions opt;
+  opt.config_path = "config/dart_tracking.yaml";  // the shipped scenario (--config optional)
   apps::addCommonOptions(cli, opt);
   int runs = 500;
   cli.add_option("--runs", runs, "number of Monte-Carlo runs (run r uses deriveSeed(seed, r))")
       ->check(CLI::PositiveNumber);
-  CLI11_PARSE(cli, argc, argv);
+  if (const auto code = apps::parseCommandLine(cli, argc, argv)) return *code;
   return apps::runGuarded("dart_tracking", [&] {
     if (opt.display || opt.realtime >= 0.0)
       std::fprintf(stderr, "dart_tracking: no live view (generated detections, no images): runs headless, unpaced\n");

@@ -36,7 +36,7 @@ int main(int argc, char** argv) {
   CLI::App app{"viewline_tune: parameter sweeps, NEES/NIS consistency, noise auto-tuning and HTML reports for the\n"
                "viewline scenarios (run in-process, in parallel). See tutorials/tune_tracking_loop/README.md."};
   tuning::TuneCommandLine command_line(app);
-  CLI11_PARSE(app, argc, argv);
+  if (const auto code = apps::parseCommandLine(app, argc, argv)) return *code;
   std::signal(SIGINT, onSigint);
   return apps::runGuarded("viewline_tune",
                           [&] { return command_line.run(tuning::makeBuiltinAdapters(), &g_stop, livePlot); });
