@@ -25,14 +25,14 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber);
   if (const auto code = apps::parseCommandLine(cli, argc, argv)) return *code;
   return apps::runGuarded("dart_tracking", [&] {
-    if (opt.display || opt.realtime >= 0.0)
-      std::fprintf(stderr, "dart_tracking: no live view (generated detections, no images): runs headless, unpaced\n");
+    if (opt.display) std::fprintf(stderr, "dart_tracking: no live view (generated detections, no images)\n");
     const scenarios::DartScenarioConfig cfg = scenarios::loadDartScenario(opt.config_path, opt.sets);
     io::LogDirectory log(opt.log_dir);
     runtime::CsvSink telemetry(log);
     runtime::Progress progress = opt.quiet ? runtime::Progress::quiet() : runtime::Progress("dart_tracking runs", runs);
     scenarios::DartRunCallbacks cb;
     cb.progress = [&](int done, int) { progress.update(done); };
+    cb.pacing = opt.pacing();  // --realtime F: the late deliveries at F simulated seconds per second
     if (log.enabled()) {
       io::CsvWriter& csv = log.stream("detections", scenarios::dartLogColumns());
       cb.log = [&csv](const scenarios::DartLogRow& r) { csv.rowText(scenarios::dartLogRow(r)); };

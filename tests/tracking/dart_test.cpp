@@ -1,6 +1,8 @@
 // Short seeded run of the dart scenario library (the long Monte Carlo is apps/dart_tracking).
 #include <gtest/gtest.h>
 
+#include <chrono>
+
 #include "viewline/core/error.h"
 #include "viewline/runtime/telemetry.h"
 #include "viewline/scenarios/dart/config.h"
@@ -56,4 +58,23 @@ TEST(DartScenario, TheTelemetrySinkSeesEveryGateDecisionOfTheFullScenario) {
   // Telemetry only observes: the figures are those of a run without it.
   EXPECT_EQ(s.scenario_gate.rmse_position, plain.scenario_gate.rmse_position);
   EXPECT_EQ(s.nees_mean, plain.nees_mean);
+}
+
+TEST(DartScenario, PacedToTheWallClockTheFiguresAreTheSame) {
+  const scenarios::DartScenarioConfig cfg = scenarios::defaultDartScenario();
+  cfg.validate();
+  scenarios::DartRunCallbacks paced;
+  paced.pacing = runtime::Pacing{20.0};  // --realtime 20: about 15 ms of wall time per flight
+  const auto t0 = std::chrono::steady_clock::now();
+  const scenarios::DartSummary a = scenarios::runDartExperiments(cfg, 7, 3, paced);
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const scenarios::DartSummary b = scenarios::runDartExperiments(cfg, 7, 3);
+  nlohmann::json ja = scenarios::summaryToJson(a, cfg), jb = scenarios::summaryToJson(b, cfg);
+  for (auto* j : {&ja, &jb}) {  // wall-clock figures
+    j->erase("runtime_s");
+    (*j)["async"].erase("update_time_us");
+  }
+  EXPECT_EQ(ja.dump(), jb.dump());
+  EXPECT_GT(a.late_inserted, 0u);
+  EXPECT_GT(wall, 3 * 0.05 / 20.0);  // the deliveries of each flight span more than 0.05 s of simulated time
 }

@@ -7,6 +7,7 @@
 #include "viewline/core/error.h"
 #include "viewline/core/random.h"
 #include "viewline/estimation/consistency.h"
+#include "viewline/runtime/scheduler.h"
 #include "viewline/tracking/image_ekf.h"
 
 namespace viewline::scenarios {
@@ -188,13 +189,20 @@ private:
       if (cb_.telemetry != nullptr) publish(*cb_.telemetry, tr_exact, d);
     }
     countGate(sum_.scenario_gate, tr_exact, f);
-    std::vector<std::pair<double, std::size_t>> arrival;
-    for (std::size_t i = 0; i < f.detections.size(); ++i)
-      arrival.emplace_back(f.detections[i].m.t + core::uniform(rng, 0.0, cfg_.late_max_delay), i);
-    std::sort(arrival.begin(), arrival.end());
+    // The same detections as a network delivers them: each arrives U(0, late_max_delay) after its
+    // capture, and the clock hands them to the tracker in arrival order (ties: capture order).
     ViewlineTracker tr_late(cams_, exact_);
-    for (const auto& a : arrival)
-      if (tr_late.submit(f.detections[a.second].m) != Refusal::None) ++sum_.late_refused;
+    runtime::Scheduler clock(0.0);
+    clock.setPacing(cb_.pacing);
+    double last_arrival = 0.0;
+    for (std::size_t i = 0; i < f.detections.size(); ++i) {
+      const double arrival = f.detections[i].m.t + core::uniform(rng, 0.0, cfg_.late_max_delay);
+      last_arrival = std::max(last_arrival, arrival);
+      clock.at(arrival, runtime::priority::Delivery, [this, &tr_late, &d = f.detections[i]](double) {
+        if (tr_late.submit(d.m) != Refusal::None) ++sum_.late_refused;
+      });
+    }
+    clock.runUntil(last_arrival);
     sum_.late_inserted += tr_late.lateInserted();
     if (tr_exact.initialised() && tr_late.initialised()) {
       const double dx = (tr_exact.state().x() - tr_late.state().x()).cwiseAbs().maxCoeff();

@@ -11,8 +11,9 @@
 //  C async        free-running unsynchronised clocks (drift, phase, jitter), no outliers: exact
 //                 propagation vs Δt-offset rows vs image EKF.
 //  D scenario     the full scenario (free-running clocks, jitter, outliers) with the configured
-//                 gate, in capture order and in arrival order (capture + U(0, max delay)): maximum
-//                 difference of the final states and of the per-measurement decisions.
+//                 gate, in capture order and in arrival order (capture + U(0, max delay), delivered
+//                 by the scenario clock, runtime::Scheduler): maximum difference of the final
+//                 states and of the per-measurement decisions.
 //  E single cam   one camera, priors up to `single_offset_max` off (position and velocity),
 //                 P0 = std² I, vs a filter started at the truth.
 //
@@ -24,6 +25,7 @@
 #include <string>
 #include <vector>
 
+#include "viewline/runtime/scheduler.h"
 #include "viewline/runtime/telemetry.h"
 #include "viewline/scenarios/dart/config.h"
 #include "viewline/scenarios/dart/metrics.h"
@@ -50,6 +52,10 @@ struct DartRunCallbacks {
   /// The full scenario's (D, capture order) detections, the tracker's updates (innovation, S,
   /// NIS, gate decision; channel "dart") and estimates, as they happen (optional).
   runtime::TelemetrySink* telemetry = nullptr;
+  /// The full scenario's deliveries in arrival order run on a runtime::Scheduler: paced to the
+  /// wall clock with factor > 0 (the app's --realtime), as fast as possible by default. Pacing
+  /// changes when, never what: the figures are the same.
+  runtime::Pacing pacing;
 };
 
 /// Runs experiments A-E for `runs` seeded runs of a validated config (loadDartScenario validates;
