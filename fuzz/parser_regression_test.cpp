@@ -6,7 +6,9 @@
 #include <string>
 
 #include "viewline/core/error.h"
+#include "viewline/io/camera_io.h"
 #include "viewline/io/config_edit.h"
+#include "viewline/io/rig.h"
 
 namespace io = viewline::io;
 
@@ -28,4 +30,18 @@ TEST(FuzzRegression, ListIndexBeyondIntIsInvalidInput) {
   EXPECT_NE(msg.find("cameras[99999999999].sigma_px"), std::string::npos) << msg;
   EXPECT_NE(msg.find("too large"), std::string::npos) << msg;
   EXPECT_NO_THROW(io::parseDottedKey("cameras[999999999].sigma_px"));  // 9 digits: still an index
+}
+
+// F3: a file name the file system refuses (a component over NAME_MAX: ENAMETOOLONG) made the
+// throwing std::filesystem queries raise filesystem_error instead of "does not exist".
+TEST(FuzzRegression, FileNameTooLongIsInvalidInput) {
+  const std::string name(300, 'x');
+  EXPECT_THROW(io::loadVispCameraXml(name + ".xml", "cam", io::Projection::WithDistortion), viewline::core::InvalidInput);
+  EXPECT_THROW(io::loadOpenCvIntrinsics(name + ".yaml"), viewline::core::InvalidInput);
+  EXPECT_THROW(io::ConfigNode::loadFile(name + ".yaml"), viewline::core::InvalidInput);
+  const io::ConfigNode rig = io::ConfigNode::fromString(
+      "cameras:\n  - name: a\n    intrinsics: " + name + ".xml\n    c_M_w: {translation: [0, 0, 1], theta_u_deg: [0, 0, 0]}\n",
+      "rig.yaml", "/tmp");
+  const std::string msg = invalidInputMessage([&] { io::loadRig(rig); });
+  EXPECT_NE(msg.find("rig.yaml:3:"), std::string::npos) << msg;  // names the line of the intrinsics key
 }

@@ -59,7 +59,8 @@ Projection projectionFromString(const std::string& s) {
 
 CameraXml loadVispCameraXml(const std::string& path, const std::string& camera_name, Projection projection,
                             unsigned width, unsigned height) {
-  if (!fs::is_regular_file(path)) throw core::InvalidInput(path + ": camera XML file does not exist");
+  std::error_code ec;  // the throwing overload raised filesystem_error on e.g. a name too long (found by fuzz_rig)
+  if (!fs::is_regular_file(path, ec)) throw core::InvalidInput(path + ": camera XML file does not exist");
   vpXmlParserCamera parser;
   vpCameraParameters cam;
   int status = vpXmlParserCamera::SEQUENCE_ERROR;
@@ -119,7 +120,8 @@ void saveVispCameraXml(const std::string& path, const std::string& camera_name,
 }
 
 OpenCvIntrinsics loadOpenCvIntrinsics(const std::string& path) {
-  if (!fs::is_regular_file(path)) throw core::InvalidInput(path + ": OpenCV intrinsics file does not exist");
+  std::error_code ec;  // (as loadVispCameraXml: no filesystem_error on a bad name)
+  if (!fs::is_regular_file(path, ec)) throw core::InvalidInput(path + ": OpenCV intrinsics file does not exist");
   cv::FileStorage fsr;
   try {
     fsr.open(path, cv::FileStorage::READ);

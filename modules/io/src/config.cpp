@@ -75,7 +75,8 @@ ConfigNode::ConfigNode(std::shared_ptr<Shared> shared, YAML::Node node, std::str
     : shared_(std::move(shared)), node_(std::move(node)), path_(std::move(path)) {}
 
 ConfigNode ConfigNode::loadFile(const std::string& path) {
-  if (!std::filesystem::exists(path)) throw InvalidInput(path + ": config file does not exist");
+  std::error_code ec;  // the throwing overload raised filesystem_error on e.g. a name too long
+  if (!std::filesystem::exists(path, ec)) throw InvalidInput(path + ": config file does not exist");
   YAML::Node root;
   try {
     root = YAML::LoadFile(path);
