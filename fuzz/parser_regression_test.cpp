@@ -45,3 +45,14 @@ TEST(FuzzRegression, FileNameTooLongIsInvalidInput) {
   const std::string msg = invalidInputMessage([&] { io::loadRig(rig); });
   EXPECT_NE(msg.find("rig.yaml:3:"), std::string::npos) << msg;  // names the line of the intrinsics key
 }
+
+// F5: a matrix header whose rows is not a plain integer ("rows:(5") made cv::read allocate and clear
+// gigabytes (a 10 s timeout under the fuzzer); the header is now checked before OpenCV reads it.
+TEST(FuzzRegression, OpenCvMatrixHeaderIsCheckedBeforeReading) {
+  const std::string path = std::string(VIEWLINE_SOURCE_DIR) + "/fuzz/corpus/opencv_yaml/regression_rows_not_an_integer.yaml";
+  const std::string msg = invalidInputMessage([&] { io::loadOpenCvIntrinsics(path); });
+  EXPECT_NE(msg.find("distortion_coefficients"), std::string::npos) << msg;
+  // A good file still reads.
+  EXPECT_NO_THROW(io::loadOpenCvIntrinsics(std::string(VIEWLINE_SOURCE_DIR) + "/fuzz/corpus/opencv_yaml/side.yaml"));
+  EXPECT_NO_THROW(io::loadOpenCvIntrinsics(std::string(VIEWLINE_SOURCE_DIR) + "/fuzz/corpus/opencv_yaml/zero_distortion.xml"));
+}

@@ -45,6 +45,20 @@ std::string extensionOf(const std::string& path) {
   for (auto& c : e) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   return e;
 }
+// cv::read(FileNode, Mat) sizes the matrix from the node's rows/cols before it looks at the data: a
+// 'rows' that is not a plain integer (e.g. "rows:(5") made OpenCV 4.6 allocate and clear gigabytes
+// (found by fuzz_opencv_yaml). Our matrices are small: check the header first.
+void checkMatrixNode(const cv::FileNode& n, const std::string& path, const char* key) {
+  if (n.empty() || n.isNone()) return;  // absent: the caller's checks name it
+  const std::string what = path + ": '" + key + "': ";
+  if (!n.isMap()) throw core::InvalidInput(what + "expected an OpenCV matrix (rows, cols, dt, data)");
+  const cv::FileNode r = n["rows"], c = n["cols"], d = n["data"];
+  if (!r.isInt() || !c.isInt() || static_cast<int>(r) < 1 || static_cast<int>(c) < 1 || static_cast<int>(r) > 16 ||
+      static_cast<int>(c) > 16)
+    throw core::InvalidInput(what + "rows and cols must be integers from 1 to 16");
+  if (!d.isSeq() || d.size() != static_cast<std::size_t>(static_cast<int>(r) * static_cast<int>(c)))
+    throw core::InvalidInput(what + "data must be a list of rows x cols numbers");
+}
 }  // namespace
 
 std::string toString(Projection p) {
@@ -132,6 +146,8 @@ OpenCvIntrinsics loadOpenCvIntrinsics(const std::string& path) {
   cv::Mat K, D;
   OpenCvIntrinsics out;
   try {
+    checkMatrixNode(fsr["camera_matrix"], path, "camera_matrix");
+    checkMatrixNode(fsr["distortion_coefficients"], path, "distortion_coefficients");
     fsr["camera_matrix"] >> K;
     fsr["distortion_coefficients"] >> D;
     int w = 0, h = 0;
