@@ -64,3 +64,9 @@ TEST(FuzzRegression, NestedAliasesAreCheckedOnce) {
   EXPECT_NO_THROW(io::ConfigNode::loadFile(path));  // seconds before the fix: the test's timeout catches it
   EXPECT_THROW(io::ConfigNode::fromString("a: &a {x: 1}\nb: [*a, {y: 1, y: 2}]\n"), viewline::core::InvalidInput);
 }
+
+// F7: cv::FileStorage::open let a std::length_error (not a cv::Exception) out of a malformed file.
+TEST(FuzzRegression, OpenCvStandardExceptionsBecomeInvalidInput) {
+  const std::string path = std::string(VIEWLINE_SOURCE_DIR) + "/fuzz/corpus/opencv_yaml/regression_length_error.yaml";
+  EXPECT_THROW(io::loadOpenCvIntrinsics(path), viewline::core::InvalidInput);
+}

@@ -141,6 +141,8 @@ OpenCvIntrinsics loadOpenCvIntrinsics(const std::string& path) {
     fsr.open(path, cv::FileStorage::READ);
   } catch (const cv::Exception& e) {
     throw core::InvalidInput(path + ": cannot parse as OpenCV FileStorage: " + e.what());
+  } catch (const std::exception& e) {  // OpenCV 4.6 lets std::length_error out of a bad file (fuzz_opencv_yaml)
+    throw core::InvalidInput(path + ": cannot parse as OpenCV FileStorage: " + e.what());
   }
   if (!fsr.isOpened()) throw core::InvalidInput(path + ": cannot open as OpenCV FileStorage");
   cv::Mat K, D;
@@ -158,6 +160,10 @@ OpenCvIntrinsics loadOpenCvIntrinsics(const std::string& path) {
     out.height = static_cast<unsigned>(h);
     if (!fsr["avg_reprojection_error"].empty()) fsr["avg_reprojection_error"] >> out.rms_px;
   } catch (const cv::Exception& e) {
+    throw core::InvalidInput(path + ": bad OpenCV intrinsics: " + e.what());
+  } catch (const core::InvalidInput&) {
+    throw;
+  } catch (const std::exception& e) {  // (as open: not only cv::Exception comes out of FileStorage)
     throw core::InvalidInput(path + ": bad OpenCV intrinsics: " + e.what());
   }
   if (K.rows != 3 || K.cols != 3)
