@@ -1,13 +1,16 @@
 // viewline_tune: tuning sessions for the scenarios (sweeps, NEES/NIS consistency, noise
 // auto-tuning, HTML reports). Thin main: the command line and the sessions are in modules/tuning
-// (command_line.h, session.h); the app adds the live curves (viz::LivePlot) and Ctrl-C.
+// (command_line.h, session.h); the app adds the live curves (viz::LivePlot), Ctrl-C and exit codes.
 // See tutorials/tune_tracking_loop/README.md.
 #include <CLI/CLI.hpp>
 #include <atomic>
 #include <csignal>
+#include <cstdio>
+#include <exception>
 #include <memory>
 
 #include "app_options.h"
+#include "viewline/core/error.h"
 #include "viewline/tuning/command_line.h"
 #include "viewline/viz/live_plot.h"
 
@@ -38,6 +41,15 @@ int main(int argc, char** argv) {
   tuning::TuneCommandLine command_line(app);
   if (const auto code = apps::parseCommandLine(app, argc, argv)) return *code;
   std::signal(SIGINT, onSigint);
-  return apps::runGuarded("viewline_tune",
-                          [&] { return command_line.run(tuning::makeBuiltinAdapters(), &g_stop, livePlot); });
+  // Bad input (a sweep file's key, a scenario refusing a value) is a usage error here: exit 2, as
+  // tutorials/tune_tracking_loop documents; anything else is a runtime error (1).
+  try {
+    return command_line.run(tuning::makeBuiltinAdapters(), &g_stop, livePlot);
+  } catch (const core::Error& e) {
+    std::fprintf(stderr, "viewline_tune: error: %s\n", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "viewline_tune: error: %s\n", e.what());
+    return 1;
+  }
 }

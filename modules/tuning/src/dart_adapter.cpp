@@ -36,6 +36,7 @@
 #include "viewline/core/random.h"
 #include "viewline/estimation/consistency.h"
 #include "viewline/scenarios/dart/config.h"
+#include "viewline/scenarios/dart/loop.h"
 #include "viewline/scenarios/dart/world.h"
 #include "viewline/tracking/tracker.h"
 #include "viewline/tuning/scenario.h"
@@ -107,9 +108,7 @@ public:
     io::CsvWriter* det_csv = nullptr;
     io::CsvWriter* inn_csv = nullptr;
     if (ro.log != nullptr && ro.log->enabled()) {
-      det_csv = &ro.log->stream("detections", {"experiment", "run", "id", "camera", "t", "u", "v", "outlier", "fate",
-                                               "true_x", "true_y", "true_z", "est_x", "est_y", "est_z", "est_vx",
-                                               "est_vy", "est_vz"});
+      det_csv = &ro.log->stream("detections", scenarios::dartLogColumns());  // as dart_tracking --log writes it
       inn_csv = &ro.log->stream("innovations", {"flight", "id", "camera", "t", "d0", "d1", "S00", "S01", "S11", "nis",
                                                 "fused", "in_statistics"});
     }
