@@ -7,6 +7,12 @@ include(CMakePackageConfigHelpers)
 set(VIEWLINE_CMAKE_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/viewline)
 get_property(VIEWLINE_MODULE_LIST GLOBAL PROPERTY VIEWLINE_MODULES)
 
+# The sanitizer interface (empty unless VIEWLINE_SANITIZE is set) is linked by every target of an
+# instrumented build, so it travels with the export set.
+if(TARGET viewline_sanitizers)
+  set_target_properties(viewline_sanitizers PROPERTIES EXPORT_NAME sanitizers)
+  install(TARGETS viewline_sanitizers EXPORT viewlineTargets)
+endif()
 install(EXPORT viewlineTargets NAMESPACE viewline:: DESTINATION ${VIEWLINE_CMAKE_DIR})
 configure_package_config_file(${CMAKE_CURRENT_LIST_DIR}/viewlineConfig.cmake.in
   ${PROJECT_BINARY_DIR}/viewlineConfig.cmake INSTALL_DESTINATION ${VIEWLINE_CMAKE_DIR})
