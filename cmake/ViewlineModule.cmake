@@ -10,20 +10,35 @@ if(NOT TARGET viewline_warnings)
   endif()
   target_compile_features(viewline_warnings INTERFACE cxx_std_17)
   add_library(viewline::warnings ALIAS viewline_warnings)
+  # Static modules list it as a link-only dependency: it must be in the export set too.
+  set_target_properties(viewline_warnings PROPERTIES EXPORT_NAME warnings)
+  install(TARGETS viewline_warnings EXPORT viewlineTargets)
 endif()
+
+include(GNUInstallDirs)
 
 # viewline_add_module(<name> SOURCES a.cpp ... DEPENDS <targets>... [PRIVATE_DEPENDS ...])
 # Creates target viewline_<name>, alias viewline::<name>, headers under include/viewline/<name>.
 function(viewline_add_module name)
   cmake_parse_arguments(ARG "" "" "SOURCES;DEPENDS;PRIVATE_DEPENDS" ${ARGN})
   set(target viewline_${name})
-  add_library(${target} STATIC ${ARG_SOURCES})
+  # Static unless BUILD_SHARED_LIBS is ON.
+  add_library(${target} ${ARG_SOURCES})
   add_library(viewline::${name} ALIAS ${target})
   target_include_directories(${target} PUBLIC
-    $<BUILD_INTERFACE:${CMAKE_CURRENT_SOURCE_DIR}/include>)
+    $<BUILD_INTERFACE:${CMAKE_CURRENT_SOURCE_DIR}/include>
+    $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>)
   target_link_libraries(${target} PUBLIC ${ARG_DEPENDS} PRIVATE viewline::warnings ${ARG_PRIVATE_DEPENDS})
   target_compile_features(${target} PUBLIC cxx_std_17)
-  set_target_properties(${target} PROPERTIES CXX_EXTENSIONS OFF POSITION_INDEPENDENT_CODE ON)
+  set_target_properties(${target} PROPERTIES CXX_EXTENSIONS OFF POSITION_INDEPENDENT_CODE ON
+    EXPORT_NAME ${name} VERSION ${PROJECT_VERSION} SOVERSION ${PROJECT_VERSION_MAJOR}.${PROJECT_VERSION_MINOR})
+  # Installed as viewline::<name> (cmake/ViewlinePackage.cmake writes the package config).
+  install(TARGETS ${target} EXPORT viewlineTargets
+    ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
+    LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
+    RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+  install(DIRECTORY ${CMAKE_CURRENT_SOURCE_DIR}/include/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+  set_property(GLOBAL APPEND PROPERTY VIEWLINE_MODULES ${name})
 endfunction()
 
 # viewline_add_test(<name> SOURCES ... DEPENDS ... [LABELS ...] [TIMEOUT s])
@@ -61,5 +76,7 @@ function(viewline_add_app name)
   cmake_parse_arguments(ARG "" "" "SOURCES;DEPENDS" ${ARGN})
   add_executable(${name} ${ARG_SOURCES})
   target_link_libraries(${name} PRIVATE ${ARG_DEPENDS} viewline::warnings)
-  set_target_properties(${name} PROPERTIES CXX_EXTENSIONS OFF RUNTIME_OUTPUT_DIRECTORY ${PROJECT_BINARY_DIR}/bin)
+  set_target_properties(${name} PROPERTIES CXX_EXTENSIONS OFF RUNTIME_OUTPUT_DIRECTORY ${PROJECT_BINARY_DIR}/bin
+    INSTALL_RPATH "$ORIGIN/../${CMAKE_INSTALL_LIBDIR}")
+  install(TARGETS ${name} RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
 endfunction()

@@ -5,6 +5,7 @@
 #include <iostream>
 
 #include "viewline/core/error.h"
+#include "viewline/core/version.h"
 #include "viewline/io/config_edit.h"
 
 namespace viewline::apps {
@@ -46,6 +47,7 @@ void addCommonOptions(CLI::App& cli, CommonOptions& opt) {
   cli.add_option("--log", opt.log_dir, "CSV logs of the run in this directory");
   cli.add_option("--summary", opt.summary_path, "the metrics as JSON in this file (written atomically)");
   cli.add_flag("--quiet", opt.quiet, "no progress output");
+  cli.set_version_flag("--version", std::string("viewline ") + core::kVersion);
 }
 
 std::optional<int> parseCommandLine(CLI::App& cli, int argc, char** argv) {

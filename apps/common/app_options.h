@@ -1,7 +1,7 @@
 #pragma once
 // The command line every scenario app shares, so that the same flag means the same thing in
 // each of them (DESIGN "Running"): --config, --set KEY=VALUE, --seed, --headless / --display,
-// --realtime [FACTOR], --log DIR, --summary FILE, --quiet.
+// --realtime [FACTOR], --log DIR, --summary FILE, --quiet, --version.
 //
 //   int main(int argc, char** argv) {
 //     CLI::App cli{"..."};

@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include "viewline/core/error.h"
+#include "viewline/core/version.h"
 
 namespace fs = std::filesystem;
 
@@ -42,6 +43,11 @@ void writeTextFileAtomic(const std::string& path, const std::string& content) {
     if (!f) throw core::InvalidInput(path + ": write failed");
   }
   out.commit();
+}
+
+void writeSummaryFile(const std::string& path, nlohmann::json j) {
+  if (j.is_object()) j["viewline_version"] = core::kVersion;
+  writeJsonFile(path, j);
 }
 
 void writeJsonFile(const std::string& path, const nlohmann::json& j, int indent) {

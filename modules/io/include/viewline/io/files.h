@@ -16,6 +16,9 @@ void writeTextFileAtomic(const std::string& path, const std::string& content);
 
 /// nlohmann::json to a file, atomically (e.g. an app's --summary FILE).
 void writeJsonFile(const std::string& path, const nlohmann::json& j, int indent = 2);
+/// An app's --summary FILE: `j` with "viewline_version" (core::kVersion) added, written atomically,
+/// so every summary says which version produced it.
+void writeSummaryFile(const std::string& path, nlohmann::json j);
 /// Reads a JSON file; errors name the file and the parse position.
 nlohmann::json readJsonFile(const std::string& path);
 
