@@ -53,12 +53,12 @@ int main(int argc, char** argv) {
     run.log_dir = opt.log_dir;
     run.summary_path = opt.summary_path;
     run.quiet = opt.quiet;
-    run.pacing = opt.pacing();
     run.estimator = oracle_corners ? scenarios::PanTiltReplayEstimator::OracleCorners
                     : particles    ? scenarios::PanTiltReplayEstimator::WaypointParticles
                                    : scenarios::PanTiltReplayEstimator::Filter;
     std::unique_ptr<viz::PanTiltDisplay> view;
     if (run.replay.empty() && opt.wantDisplay("pan_tilt_tracking")) view = std::make_unique<viz::PanTiltDisplay>();
+    run.pacing = view || opt.realtime >= 0.0 ? opt.pacing() : runtime::Pacing{};  // no window: no reason to wait
     const int status = scenarios::pan_tilt::runCommand(run, view.get());
     if (view) view->close();
     return status;

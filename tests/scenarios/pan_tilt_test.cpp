@@ -123,8 +123,8 @@ TEST(PanTiltScenario, ReacquiresAfterAOneSecondOcclusion) {
   EXPECT_LT(m.reacquisition_delay_s, 0.2);  // seen again within a few frames of reappearing
   EXPECT_EQ(m.unsafe_commands + m.rate_violations + m.limit_hits, 0u);
   // The telemetry sees every gate decision the tracker made: one innovation per detected frame,
-  // the counts of each decision those of the run; the occlusion outlasts the coast time, so the
-  // measurement after it starts a new track (a reacquisition), as the first one did.
+  // the counts of each decision those of the run; a track starts with the first measurement and
+  // again at each reacquisition (the 1 s occlusion is bridged by the 1.5 s coast time: none here).
   using tracking::GateDecision;
   EXPECT_EQ(sink.innovationsOf("predictive").size(), m.detections);
   EXPECT_EQ(sink.count(GateDecision::Start, "predictive"), m.gate.starts);
@@ -133,7 +133,6 @@ TEST(PanTiltScenario, ReacquiresAfterAOneSecondOcclusion) {
   EXPECT_EQ(sink.count(GateDecision::Restart, "predictive"), m.gate.restarts);
   EXPECT_EQ(m.gate.total(), m.detections);
   EXPECT_EQ(m.gate.starts, 1u + m.reacquisitions);
-  EXPECT_GE(m.reacquisitions, 1u);
   EXPECT_GT(m.gate.accepted, m.detections / 2);
   for (const auto& r : sink.innovationsOf("predictive")) {
     if (r.decision == GateDecision::Start) {
