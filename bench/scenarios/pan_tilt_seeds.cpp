@@ -1,4 +1,4 @@
-// pan_tilt_seeds: the issue-6 seed tables of docs/results.md ("Pan-tilt tracking", rounds 4-8) in one
+// pan_tilt_seeds: the seed tables of docs/results.md ("Pan-tilt tracking") in one
 // command. For every seed, the closed loop of apps/pan_tilt_tracking (ours, then ViSP's law on the same
 // seed: scenarios::runPanTiltComparison), then filter-only replays of its logged measurements
 // (scenarios::replayPanTiltFilter): the config's filter, for its prediction error at the law's horizon
@@ -12,7 +12,7 @@
 // --set camera.fps=60 or --set measurement_noise_fraction=0.05 (the scenario loader still checks it).
 //
 // Prints two markdown tables (filtered RMSE; image error and predictions) and a summary against the
-// issue's targets; progress on stderr. --log-dir DIR keeps each seed's logs (DIR/log_<path>_s<seed>,
+// scenario's targets; progress on stderr. --log-dir DIR keeps each seed's logs (DIR/log_<path>_s<seed>,
 // replayable with pan_tilt_tracking --replay); --json FILE writes every seed's figures.
 // A 60 s seed renders 2 x 1800 frames: about 1-2 CPU-minutes.
 #include <CLI/CLI.hpp>
@@ -62,7 +62,7 @@ std::string pair(double x, double y) { return num(x, 3) + " / " + num(y, 3); }
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"Issue-6 seed tables: closed loop (ours and ViSP's law), the filter's prediction and the oracle bound."};
+  CLI::App app{"Pan-tilt seed tables: closed loop (ours and ViSP's law), the filter's prediction and the oracle bound."};
   std::string config_file, log_dir, json_file;
   std::vector<std::string> sets;
   int seeds = 5, jobs = 2;
@@ -108,7 +108,10 @@ int main(int argc, char** argv) {
         const fs::path dir = logs / ("log_" + path + "_s" + std::to_string(r.seed));
         {
           io::LogDirectory log(dir.string());
-          r.run = scenarios::runPanTiltComparison(cfg, r.seed, nullptr, &log);
+          scenarios::pan_tilt::FrameCsvSink frames(log);  // what the replays read
+          scenarios::PanTiltRunIo io;
+          io.frames = &frames;
+          r.run = scenarios::runPanTiltComparison(cfg, r.seed, io);
           log.flush();
         }
         const std::string frames = (dir / "predictive_frames.csv").string();
@@ -137,7 +140,7 @@ int main(int argc, char** argv) {
     if (stop) throw core::Error("stopped before every seed ran");
 
     const scenarios::TTable1Row t = scenarios::tTable1(cfg.path.shape);
-    const bool ratio_target = cfg.path.shape != sim::PathShape::Rectangle;  // issue 6: circle and random
+    const bool ratio_target = cfg.path.shape != sim::PathShape::Rectangle;  // the ratio target: circle and random
     std::cout << "Pan-tilt " << path << ", " << cfg.duration << " s, seeds " << first_seed << "-"
               << first_seed + results.size() - 1 << " (" << config_file;
     for (const std::string& kv : sets) std::cout << ", --set " << kv;

@@ -1,7 +1,9 @@
 // Short seeded runs of the pan-tilt scenario library (the same code the app runs): each shipped
-// path for a few seconds, no command outside the limits, reacquisition after a 1 s occlusion.
+// path for a few seconds, no command outside the limits, reacquisition after a 1 s occlusion (and
+// the telemetry sees every gate decision), the same run as fast as possible and paced.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -15,6 +17,7 @@
 #include "viewline/core/frames.h"
 #include "viewline/io/config_edit.h"
 #include "viewline/io/log.h"
+#include "viewline/runtime/telemetry.h"
 #include "viewline/scenarios/pan_tilt_scenario.h"
 
 using namespace viewline;
@@ -36,7 +39,10 @@ LoggedRun loggedRun(const scenarios::PanTiltScenarioConfig& cfg, std::uint64_t s
   LoggedRun out;
   out.dir = std::filesystem::temp_directory_path() / ("viewline_pt_" + tag + "_" + std::to_string(::getpid()));
   io::LogDirectory log(out.dir.string());
-  out.metrics = scenarios::runPanTilt(cfg, seed, PanTiltControllerKind::Predictive, nullptr, &log);
+  scenarios::pan_tilt::FrameCsvSink csv(log);
+  scenarios::PanTiltRunIo io;
+  io.frames = &csv;
+  out.metrics = scenarios::runPanTilt(cfg, seed, PanTiltControllerKind::Predictive, io);
   log.flush();
   return out;
 }
@@ -108,11 +114,73 @@ TEST(PanTiltScenario, ReacquiresAfterAOneSecondOcclusion) {
   cfg.occlusion_start = 2.0;
   cfg.occlusion_duration = 1.0;
   cfg.run_baseline = false;
-  const auto m = scenarios::runPanTilt(cfg, 3, PanTiltControllerKind::Predictive);
+  runtime::MemorySink sink;
+  scenarios::PanTiltRunIo io;
+  io.telemetry = &sink;
+  const auto m = scenarios::runPanTilt(cfg, 3, PanTiltControllerKind::Predictive, io);
   ASSERT_TRUE(m.occlusion);
   EXPECT_TRUE(m.reacquired);
   EXPECT_LT(m.reacquisition_delay_s, 0.2);  // seen again within a few frames of reappearing
   EXPECT_EQ(m.unsafe_commands + m.rate_violations + m.limit_hits, 0u);
+  // The telemetry sees every gate decision the tracker made: one innovation per detected frame,
+  // the counts of each decision those of the run; a track starts with the first measurement and
+  // again at each reacquisition (the 1 s occlusion is bridged by the 1.5 s coast time: none here).
+  using tracking::GateDecision;
+  EXPECT_EQ(sink.innovationsOf("predictive").size(), m.detections);
+  EXPECT_EQ(sink.count(GateDecision::Start, "predictive"), m.gate.starts);
+  EXPECT_EQ(sink.count(GateDecision::Accept, "predictive"), m.gate.accepted);
+  EXPECT_EQ(sink.count(GateDecision::Reject, "predictive"), m.gate.rejected);
+  EXPECT_EQ(sink.count(GateDecision::Restart, "predictive"), m.gate.restarts);
+  EXPECT_EQ(m.gate.total(), m.detections);
+  EXPECT_EQ(m.gate.starts, 1u + m.reacquisitions);
+  EXPECT_GT(m.gate.accepted, m.detections / 2);
+  for (const auto& r : sink.innovationsOf("predictive")) {
+    if (r.decision == GateDecision::Start) {
+      EXPECT_EQ(r.innovation.size(), 0);
+    } else {
+      ASSERT_EQ(r.innovation.size(), 2);
+      EXPECT_NEAR(r.nis, r.innovation.dot(r.S.ldlt().solve(r.innovation)), 1e-6 * (1.0 + r.nis));
+    }
+  }
+  EXPECT_EQ(sink.estimates.size(), m.detections);
+  EXPECT_EQ(sink.commands.size(), m.commands);
+}
+
+TEST(PanTiltScenario, PacedAndFastRunsAreIdentical) {
+  // One scheduler for every event: pacing to the wall clock changes when the events run, never which
+  // or in what order. The same seed as fast as possible and at 20x real time (--realtime 20).
+  auto cfg = shipped("rectangle");
+  cfg.duration = 1.0;
+  cfg.metrics_start = 0.3;
+  cfg.occlusion_start = -1.0;
+  cfg.run_baseline = false;
+  runtime::MemorySink fast_sink, paced_sink;
+  scenarios::PanTiltRunIo io;
+  io.telemetry = &fast_sink;
+  const auto fast = scenarios::runPanTilt(cfg, 4, PanTiltControllerKind::Predictive, io);
+  io.telemetry = &paced_sink;
+  io.pacing = runtime::Pacing{20.0};
+  const auto t1 = std::chrono::steady_clock::now();
+  const auto paced = scenarios::runPanTilt(cfg, 4, PanTiltControllerKind::Predictive, io);
+  const double paced_wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
+  EXPECT_GE(paced_wall, 0.9 * cfg.duration / 20.0);  // it was paced
+  auto without_wall = [](nlohmann::json j) {
+    j.erase("wall_ms_per_frame");
+    return j.dump();
+  };
+  EXPECT_EQ(without_wall(fast.toJson()), without_wall(paced.toJson()));
+  ASSERT_EQ(fast_sink.innovations.size(), paced_sink.innovations.size());
+  for (std::size_t i = 0; i < fast_sink.innovations.size(); ++i) {
+    const auto &a = fast_sink.innovations[i], &b = paced_sink.innovations[i];
+    EXPECT_EQ(a.t, b.t);
+    EXPECT_EQ(a.decision, b.decision);
+    EXPECT_EQ(a.nis, b.nis);  // bit for bit
+  }
+  ASSERT_EQ(fast_sink.commands.size(), paced_sink.commands.size());
+  for (std::size_t i = 0; i < fast_sink.commands.size(); ++i) {
+    EXPECT_EQ(fast_sink.commands[i].t, paced_sink.commands[i].t);
+    EXPECT_TRUE(fast_sink.commands[i].u == paced_sink.commands[i].u) << i;
+  }
 }
 
 TEST(PanTiltScenario, ConfigErrorsNameTheKey) {
@@ -172,7 +240,7 @@ TEST(PanTiltScenario, ConfigErrorsNameTheKey) {
 }
 
 TEST(PanTiltScenario, ShippedConfigsRenderTheTruthAndControlWithTheCalibration) {
-  // Issue 9: the shipped configs name the default rig; the simulator's camera and mount (truth.yaml)
+  // The shipped configs name the default rig; the simulator's camera and mount (truth.yaml)
   // differ from what the controllers use (rig.yaml + e_M_c.yaml, calibrated from rendered images).
   for (const std::string name : {"rectangle", "circle", "random"}) {
     const auto cfg = shipped(name);

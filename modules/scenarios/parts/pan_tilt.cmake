@@ -1,3 +1,10 @@
-# Pan-tilt tracking ([T], issue 6): the closed loop (screen world, rendering, [T] detection, [T]
-# noise, predictive and ViSP baseline controllers, metrics) and its live view, as library code.
-list(APPEND scenarios_sources src/pan_tilt_scenario.cpp src/pan_tilt_display.cpp)
+# Pan-tilt tracking ([T]): config, world, loop, metrics, telemetry, replay and the app's command, one
+# file each under pan_tilt/. Its live view is in the viz module (viz/parts/pan_tilt.cmake).
+list(APPEND scenarios_sources
+  pan_tilt/command.cpp
+  pan_tilt/config.cpp
+  pan_tilt/loop.cpp
+  pan_tilt/metrics.cpp
+  pan_tilt/replay.cpp
+  pan_tilt/telemetry.cpp
+  pan_tilt/world.cpp)

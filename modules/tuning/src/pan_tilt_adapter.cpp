@@ -1,17 +1,16 @@
-// Pan-tilt scenario adapter ([T], issue 6): runs scenarios::runPanTilt (rendered images, [T]
-// detection, the predictive controller; the ViSP baseline is not run in sweeps) in-process, with
-// the config read by the scenario's own loader (loadPanTiltScenarioConfig: strict keys), so a
-// config the tuning tool accepts or writes is one pan_tilt_tracking reads.
+// Pan-tilt scenario adapter ([T]): runs scenarios::runPanTilt (rendered images, [T] detection, the
+// predictive controller; the ViSP baseline is not run in sweeps) in-process, with the config read by
+// the scenario's own loader (loadPanTiltScenarioConfig: strict keys), so a config the tuning tool
+// accepts or writes is one pan_tilt_tracking reads.
 //
-// Innovations. runPanTilt does not expose its filter's innovations; it logs every frame (time,
-// detection, measured screen position with [T]'s noise, truth) when given a log folder. A run
-// therefore logs to a private temporary folder and the adapter re-runs the same filter
-// (control::PlanarTargetFilter with the same config, the same measurements, time stamps and R, the
-// same reacquisition rule: re-initialise after control.coast_time without an accepted
-// measurement) on the logged frames. The filter is deterministic, so these are the controller's
-// innovations: d = z − p̂(t|t−), S = P_pos(t|t−) + R (2 dof). NIS samples once a track has
-// `burn_in` accepted measurements; NEES (2 dof, screen position) against the truth, one sample
-// every `nees_spacing_s` seconds (spaced so that they are nearly independent).
+// Innovations. A live run reports them to a runtime::MemorySink: for every detected frame the
+// controller's gate decision, d = z − p̂(t|t−) and S = P_pos(t|t−) + R (2 dof) of its filter, and its
+// estimate after the update; the truth and the image error of every frame. NIS samples once a track
+// has `burn_in` accepted measurements; NEES (2 dof, screen position) against the truth, one sample
+// every `nees_spacing_s` seconds (spaced so that they are nearly independent). Replays with other
+// noise parameters (auto-tuning) re-run the same filter (control::PlanarTargetFilter, same
+// measurements, time stamps and R, the controller's reacquisition rule: re-initialise after
+// control.coast_time without an accepted measurement) on the recorded frames.
 //
 // Noise parameters: process q = filter.q (CV: m²/s³, CA: m²/s⁵) and a measurement-noise scale
 // (the filter's R = scale² × the scenario's R). The scenario gives the filter the true R
@@ -25,15 +24,15 @@
 #include <atomic>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
-#include <unistd.h>
+#include <map>
+#include <optional>
 
 #include "adapter_util.h"
 #include "viewline/control/pan_tilt_servo.h"
 #include "viewline/core/error.h"
 #include "viewline/core/random.h"
-#include "viewline/scenarios/pan_tilt_display.h"
+#include "viewline/io/log.h"
+#include "viewline/runtime/telemetry.h"
 #include "viewline/scenarios/pan_tilt_scenario.h"
 #include "viewline/tuning/scenario.h"
 
@@ -101,6 +100,18 @@ struct Accum {
   Consistency nis, nees;
 };
 
+/// The live error curve of a run (RunOptions::live), fed frame by frame.
+class LiveCurve : public scenarios::pan_tilt::FrameSink {
+public:
+  explicit LiveCurve(std::function<void(const LiveSample&)> live) : live_(std::move(live)) {}
+  void frame(const scenarios::pan_tilt::FrameRecord& r) override {
+    if (live_) live_({r.t, r.error_px, -1.0});
+  }
+
+private:
+  std::function<void(const LiveSample&)> live_;
+};
+
 class PanTiltInstance final : public ScenarioInstance {
 public:
   PanTiltInstance(scenarios::PanTiltScenarioConfig cfg, PanTiltOptions opt, double r_scale)
@@ -109,47 +120,47 @@ public:
     if (opt_.duration > 0.0) cfg_.duration = opt_.duration;
   }
 
-  /// The R the scenario gives the filter for a seed (as runPanTilt computes it).
+  /// The R the scenario gives the filter for a seed (its own helpers: the same path and amplitude).
   Eigen::Matrix2d trueR(std::uint64_t seed) const {
-    core::Rng path_rng = core::makeRng(core::deriveSeed(seed, 1));
-    sim::ScreenPathParams pp = cfg_.path;
-    pp.duration = cfg_.duration + 10.0;
-    const sim::ScreenPath path(pp, path_rng);
-    const Eigen::Vector2d s = cfg_.noise_fraction * scenarios::pathAmplitude(path, cfg_.duration);
-    Eigen::Matrix2d R = s.cwiseProduct(s).asDiagonal();
-    if (R.determinant() <= 0.0) R += 1e-8 * Eigen::Matrix2d::Identity();
-    return R;
+    namespace pt = scenarios::pan_tilt;
+    return pt::noiseCovariance(pt::noiseSigma(cfg_, pt::makePath(cfg_, seed)));
   }
 
-  Recorded recordOne(std::uint64_t seed, const RunOptions& ro, scenarios::PanTiltRunMetrics* metrics) const {
-    const detail::TempLogDir tmp;
+  /// One live run of ours: its metrics and telemetry (in `sink`), and the frames a replay needs.
+  Recorded recordOne(std::uint64_t seed, const RunOptions& ro, scenarios::PanTiltRunMetrics* metrics,
+                     runtime::MemorySink& sink) const {
+    // The live error curve during the run (--display: the camera view lives in the viz module,
+    // which the tuning module does not link), and with a log the frames CSV pan_tilt_tracking writes.
+    LiveCurve live(ro.live);
+    std::optional<scenarios::pan_tilt::FrameCsvSink> csv;
+    scenarios::pan_tilt::FrameFanout frames;
+    if (ro.live) frames.add(&live);
+    if (ro.log != nullptr && ro.log->enabled()) frames.add(&csv.emplace(*ro.log));
+    scenarios::PanTiltRunIo io;
+    io.telemetry = &sink;
+    io.frames = frames.empty() ? nullptr : &frames;
+    io.progress = ro.progress;
+    const scenarios::PanTiltRunMetrics m = scenarios::runPanTilt(cfg_, seed, scenarios::PanTiltControllerKind::Predictive, io);
+    if (metrics != nullptr) *metrics = m;
+    const std::string name = m.controller;
     Recorded rec;
-    {
-      io::LogDirectory log(tmp.dir());
-      // --display: the scenario's camera view (vpDisplayX) and the live error curve during the run.
-      std::unique_ptr<scenarios::PanTiltDisplay> view;
-      if (ro.display) {
-        try {
-          view = std::make_unique<scenarios::PanTiltDisplay>();
-        } catch (const core::InvalidInput&) {
-          view.reset();  // no X display: headless
-        }
-      }
-      scenarios::PanTiltFrameSink sink;
-      if (view || ro.live) {
-        sink = [&view, &ro](const scenarios::PanTiltFrameView& v) {
-          if (view) view->show(v);
-          if (ro.live) ro.live({v.t, v.error_px, -1.0});
-        };
-      }
-      const scenarios::PanTiltRunMetrics m =
-          scenarios::runPanTilt(cfg_, seed, scenarios::PanTiltControllerKind::Predictive, sink, &log, ro.progress);
-      log.flush();
-      if (metrics != nullptr) *metrics = m;
-      rec.frames = readFrames(tmp.file("predictive_frames.csv"));
-      if (ro.log != nullptr && ro.log->enabled())
-        fs::copy_file(tmp.file("predictive_frames.csv"), fs::path(ro.log->dir()) / "predictive_frames.csv",
-                      fs::copy_options::overwrite_existing);
+    std::map<std::uint64_t, std::size_t> frame_of;  // measurement id -> frame
+    std::size_t i = 0;
+    for (const auto& t : sink.measurements) {
+      if (t.channel != scenarios::truthChannel(name)) continue;
+      Frame fr;
+      fr.t = t.t;
+      fr.truth = t.z.head<2>();
+      frame_of[t.id] = rec.frames.size();
+      rec.frames.push_back(fr);
+    }
+    for (const auto& e : sink.scalars)
+      if (e.channel == scenarios::imageErrorChannel(name) && i < rec.frames.size()) rec.frames[i++].error_px = e.value;
+    for (const auto& z : sink.measurements) {
+      if (z.channel != name) continue;
+      Frame& fr = rec.frames.at(frame_of.at(z.id));
+      fr.detected = true;
+      fr.z = z.z.head<2>();
     }
     rec.R = trueR(seed);
     return rec;
@@ -157,7 +168,8 @@ public:
 
   RunResult run(std::uint64_t seed, const RunOptions& ro) const override {
     scenarios::PanTiltRunMetrics m;
-    const Recorded rec = recordOne(seed, ro, &m);
+    runtime::MemorySink sink;
+    const Recorded rec = recordOne(seed, ro, &m, sink);
     RunResult r;
     r.seed = seed;
     std::shared_ptr<RunSeries> series;
@@ -166,9 +178,7 @@ public:
     io::CsvWriter* inn = nullptr;
     if (ro.log != nullptr && ro.log->enabled())
       inn = &ro.log->stream("innovations", {"t", "d0", "d1", "S00", "S01", "S11", "nis", "accepted", "in_statistics"});
-    RunOptions replay_options = ro;  // the live curve was fed during the run; the NIS follows below
-    replay_options.live = nullptr;
-    replayRun(rec, cfg_.control.filter.q, 1.0, 0.0, a, series.get(), inn, replay_options);
+    scoreRun(rec, sink, m.controller, a, series.get(), inn);
     r.nis = a.nis;
     r.nees = a.nees;
     r.metrics["image_error_rms_px"] = m.image_error_rms_px;
@@ -206,7 +216,10 @@ public:
 
   std::unique_ptr<ReplayData> record(std::uint64_t seed, int runs) const override {
     auto d = std::make_unique<PanTiltReplayData>();
-    for (int i = 0; i < runs; ++i) d->runs.push_back(recordOne(core::deriveSeed(seed, static_cast<std::uint64_t>(i)), {}, nullptr));
+    for (int i = 0; i < runs; ++i) {
+      runtime::MemorySink sink;
+      d->runs.push_back(recordOne(core::deriveSeed(seed, static_cast<std::uint64_t>(i)), {}, nullptr, sink));
+    }
     d->source = "live: " + std::to_string(runs) + " run(s) from seed " + std::to_string(seed);
     return d;
   }
@@ -245,6 +258,89 @@ private:
     s->traj_x_label = "screen x (right) [m]";
     s->traj_y_label = "screen y (down) [m]";
     return s;
+  }
+
+  /// NIS, NEES and the innovation cost of a live run, read from its telemetry: the controller's own
+  /// gate decisions, innovations and estimates (nothing re-run).
+  void scoreRun(const Recorded& rec, const runtime::MemorySink& sink, const std::string& name, Accum& a,
+                RunSeries* series, io::CsvWriter* inn) const {
+    using tracking::GateDecision;
+    const double u = 1.0 / (cfg_.screen_width * cfg_.screen_height);
+    const double horizon = 0.2;  // s, the prediction drawn in the trajectory plot
+    Curve err{"error", {}, {}}, tru{"truth", {}, {}}, est{"estimate", {}, {}}, pre{"prediction", {}, {}};
+    if (series != nullptr) {
+      for (const Frame& f : rec.frames) {
+        err.x.push_back(f.t);
+        err.y.push_back(f.error_px);
+        tru.x.push_back(f.truth.x());
+        tru.y.push_back(f.truth.y());
+      }
+    }
+    std::vector<const runtime::EstimateRecord*> estimates;
+    for (const auto& e : sink.estimates)
+      if (e.channel == name) estimates.push_back(&e);
+    std::map<std::uint64_t, Eigen::Vector2d> truth;  // by measurement id (the frame's)
+    for (const auto& t : sink.measurements)
+      if (t.channel == scenarios::truthChannel(name)) truth[t.id] = t.z.head<2>();
+    double next_nees = cfg_.metrics_start;
+    int accepted_in_track = 0;
+    std::size_t k = 0;
+    for (const runtime::InnovationRecord& r : sink.innovations) {
+      if (r.channel != name) continue;
+      const runtime::EstimateRecord& e = *estimates.at(k++);
+      const GateDecision d = r.decision;
+      bool have = false;
+      double nis = 0.0;
+      if (d != GateDecision::Start && accepted_in_track >= opt_.burn_in && r.innovation.size() == 2) {
+        const Eigen::LLT<Eigen::Matrix2d> llt(Eigen::Matrix2d(r.S));
+        if (llt.info() == Eigen::Success) {
+          const Eigen::Vector2d dv = r.innovation;
+          nis = dv.dot(llt.solve(dv));
+          have = std::isfinite(nis);
+        }
+      }
+      if (d == GateDecision::Start || d == GateDecision::Restart) accepted_in_track = 0;
+      const bool accepted = tracking::uses(d);
+      if (accepted) ++accepted_in_track;
+      if (have) {
+        a.cost += detail::innovationCost(nis, std::log(Eigen::Matrix2d(r.S).determinant()), 2, 0.0, std::log(u));
+        ++a.terms;
+        if (d == GateDecision::Accept) {
+          a.nis.add(nis, 2.0);
+          if (series != nullptr) {
+            series->nis_t.push_back(r.t);
+            series->nis.push_back(nis);
+          }
+        }
+      }
+      if (inn != nullptr) {
+        const double nan = std::nan("");
+        inn->row({r.t, have ? r.innovation(0) : nan, have ? r.innovation(1) : nan, have ? r.S(0, 0) : nan,
+                  have ? r.S(0, 1) : nan, have ? r.S(1, 1) : nan, have ? nis : nan, accepted ? 1.0 : 0.0,
+                  have && accepted ? 1.0 : 0.0});
+      }
+      const Eigen::Vector2d p = e.x.head<2>(), v = e.x.segment<2>(2);
+      const auto t = truth.find(r.id);
+      if (rec.has_truth && t != truth.end() && d != GateDecision::Start && accepted && r.t >= next_nees &&
+          accepted_in_track >= opt_.burn_in) {
+        const Eigen::Vector2d ex = p - t->second;
+        a.nees.add(ex.dot(Eigen::Matrix2d(e.P).ldlt().solve(ex)), 2.0);
+        next_nees = r.t + opt_.nees_spacing;
+      }
+      if (series != nullptr) {
+        est.x.push_back(p.x());
+        est.y.push_back(p.y());
+        pre.x.push_back(p.x() + horizon * v.x());  // constant velocity from the published estimate
+        pre.y.push_back(p.y() + horizon * v.y());
+      }
+    }
+    if (series != nullptr) {
+      series->error.push_back(err);
+      series->truth.push_back(tru);
+      series->estimate.push_back(est);
+      pre.name = "prediction 0.2 s ahead";
+      series->prediction.push_back(pre);
+    }
   }
 
   void replayRun(const Recorded& rec, double q, double r_scale, double eps, Accum& a, RunSeries* series,

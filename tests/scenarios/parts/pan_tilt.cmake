@@ -1,2 +1,2 @@
-# Pan-tilt tracking ([T], issue 6): short seeded runs of each shipped path, limits, occlusion.
+# Pan-tilt tracking ([T]): short seeded runs of each shipped path, limits, occlusion and telemetry, paced vs fast.
 list(APPEND scenarios_tests pan_tilt_test.cpp)

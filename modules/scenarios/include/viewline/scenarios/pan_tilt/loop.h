@@ -1,0 +1,66 @@
+#pragma once
+// The pan-tilt closed loop ([T]) on the scenario runtime: one scheduler orders every event, the
+// camera frames come from a runtime::FrameSource (the renderer over the simulated world), and
+// the loop only wires the detector, the controller and the unit.
+//
+// One frame k (capture time t_k = k / fps), two events:
+//   capture (at the end of the frame's exposure):
+//     1. grab the frame; detect with [T]'s pipeline (vision::ScreenTargetDetector: crop,
+//        resize 50 %, binarise, median, centroid);
+//     2. back-project the centroid through the capture-time camera onto the screen plane -> m_k
+//        (screen coordinates, m): the camera the controllers believe in (calibrated intrinsics and
+//        mount) at the encoder reading of the capture stamp;
+//     3. add [T]'s measurement noise: m̃_k = m_k + n_k (pan_tilt::World); the noisy feature s̃_k
+//        is m̃_k projected into the capture-time camera;
+//     4. the observation (s̃_k, m̃_k, diag(σx², σy²)) stamped t_k enters a runtime::DelayLine that
+//        delivers it after the processing delay;
+//   control (at t_k + processing_delay): the controller takes the delivered observation and issues
+//     a joint velocity command to the unit, which applies it after the unit's own latency
+//     (robots::SimulatedPanTiltUnit); the commands still in flight go to the law (its prediction of
+//     the joints at the effect time).
+// processing_delay < 1/fps (validated), so every frame's command precedes the next capture: the
+// order of all stateful calls is that of one frame after the other.
+//
+// Reports: generic telemetry records (measurement and truth per frame, the innovation with the
+// filter's NIS and gate decision, the estimate, the command) to a runtime::TelemetrySink, and one
+// pan_tilt::FrameRecord per frame (display, frames CSV) to a pan_tilt::FrameSink.
+
+#include <cstdint>
+#include <functional>
+#include <string>
+
+#include "viewline/runtime/scheduler.h"
+#include "viewline/runtime/telemetry.h"
+#include "viewline/scenarios/pan_tilt/config.h"
+#include "viewline/scenarios/pan_tilt/metrics.h"
+#include "viewline/scenarios/pan_tilt/telemetry.h"
+
+namespace viewline::scenarios {
+
+enum class PanTiltControllerKind { Predictive, Baseline };
+
+/// Where a run reports, and how it relates to the wall clock.
+struct PanTiltRunIo {
+  runtime::TelemetrySink* telemetry = nullptr;  ///< generic records; null: none (nothing is computed for them)
+  pan_tilt::FrameSink* frames = nullptr;        ///< per-frame records; null: none
+  runtime::Pacing pacing;                       ///< as fast as possible by default
+  std::function<void(double)> progress;         ///< fraction of the run done
+};
+
+/// Telemetry channels of a run of `controller`: the target's measurements, innovations, estimates
+/// and the commands on `controller`; the truth on `controller`_truth; the image error (px) as a
+/// scalar on `controller`_image_error_px. Measurement and innovation ids are the frame index + 1.
+std::string truthChannel(const std::string& controller);
+std::string imageErrorChannel(const std::string& controller);
+
+/// Runs one controller on the scenario; deterministic for (config, seed) whatever the pacing and
+/// the sinks: both controllers see the same path, sensor noise stream and [T] noise draws for the
+/// same frame index.
+PanTiltRunMetrics runPanTilt(const PanTiltScenarioConfig& config, std::uint64_t seed, PanTiltControllerKind kind,
+                             const PanTiltRunIo& io = {});
+
+/// Ours, then (when config.run_baseline) ViSP's law on the same seed (not after a quit).
+PanTiltComparison runPanTiltComparison(const PanTiltScenarioConfig& config, std::uint64_t seed,
+                                       const PanTiltRunIo& io = {});
+
+}  // namespace viewline::scenarios

@@ -1,0 +1,126 @@
+#pragma once
+// Metrics of the pan-tilt scenario ([T]) and the summary JSON.
+//
+// Metrics (after `metrics_start`, and outside [occlusion start, end + 2 s]):
+//   rmse_measured_cm    RMS of m̃_k − truth per axis (frames with a detection)
+//   rmse_filtered_cm    RMS of the filter's x(k|k) − truth per axis (same frames, including those whose
+//                       measurement the gate rejected: then x(k|k−1); ours only)
+//   image_error_rms_px  RMS distance of the *true* target projection from the
+//                       principal point, all frames (target off-image included)
+// Occlusion: the disc is not rendered during [occlusion_start, + duration); reacquired when a
+// measurement is accepted after it, with the delay from the occlusion's end.
+
+#include <Eigen/Core>
+#include <cmath>
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <utility>
+
+#include "viewline/control/pan_tilt_servo.h"
+#include "viewline/core/statistics.h"
+#include "viewline/scenarios/pan_tilt/config.h"
+#include "viewline/tracking/track_gate.h"
+
+namespace viewline::scenarios {
+
+struct PanTiltRunMetrics {
+  std::string controller;
+  std::size_t frames = 0, detections = 0, metric_frames = 0;
+  double image_error_rms_px = 0.0, image_error_max_px = 0.0;
+  Eigen::Vector2d rmse_measured_cm = Eigen::Vector2d::Zero();
+  Eigen::Vector2d rmse_filtered_cm = Eigen::Vector2d::Constant(std::nan(""));
+  Eigen::Vector2d noise_sigma_cm = Eigen::Vector2d::Zero();
+  double detection_pixel_rmse_px = 0.0;  ///< detector error (before [T] noise) vs the true centre projection
+  // limits
+  std::size_t commands = 0, unsafe_commands = 0, rate_violations = 0, limit_hits = 0;
+  double max_rate_fraction = 0.0;            ///< max |q̇ cmd| / q̇max
+  Eigen::Vector2d min_limit_distance_deg = Eigen::Vector2d::Constant(1e9);  ///< (pan, tilt)
+  Eigen::Vector2d pan_range_deg = Eigen::Vector2d::Zero(), tilt_range_deg = Eigen::Vector2d::Zero();
+  // occlusion
+  bool occlusion = false, reacquired = false;
+  double reacquisition_delay_s = std::nan("");
+  std::size_t reacquisitions = 0;
+  std::size_t frames_searching = 0;
+  std::size_t filter_jumps = 0;              ///< velocity jumps (corners) the filter detected (ours)
+  /// Ours, Kalman models with jump detection: the corner settings in force at the end of the run (the
+  /// configured filter.jump_min_samples / jump_corner_sigma, or what "auto" made of them); 0 otherwise.
+  int filter_min_samples = 0;
+  double filter_corner_sigma = 0.0;
+  bool filter_region_dropped = false;        ///< ours: filter.region was dropped (the target left it: a wrong box)
+  double wall_ms_per_frame = 0.0;
+  /// Ours: the gate's decisions on the detected frames (start, accept, reject, restart), as the
+  /// telemetry's innovation records report them. (Not in the JSON summary.)
+  tracking::GateCounts gate;
+  bool stopped = false;  ///< the run ended early (a display's quit key)
+
+  nlohmann::json toJson() const;
+};
+
+struct PanTiltComparison {
+  PanTiltRunMetrics ours, baseline;
+  bool has_baseline = false;
+  std::string path;
+  std::uint64_t seed = 0;
+  /// The summary (keys: rmse_measured_cm, rmse_filtered_cm, image_error_rms_px,
+  /// baseline_image_error_rms_px, [T]'s Table 1 beside ours, limits, occlusion).
+  nlohmann::json toJson(const PanTiltScenarioConfig& config) const;
+};
+
+/// [T] Table 1 (RMSE in cm, (x, y)): noisy measurement and Kalman filter; nothing for the random path.
+struct TTable1Row {
+  bool available = false;
+  Eigen::Vector2d measured = Eigen::Vector2d::Zero(), kalman = Eigen::Vector2d::Zero();
+};
+TTable1Row tTable1(sim::PathShape shape);
+
+namespace pan_tilt {
+
+/// The filter's corner settings in force (its configured values or what "auto" made of them);
+/// (0, 0) for the particle filter and without jump detection, where they do not apply.
+std::pair<int, double> cornerSettings(const control::PlanarTargetFilter& filter);
+
+/// A sum of squares and its count: the RMS of a metric accumulated frame by frame.
+struct SquareSum {
+  double sum = 0.0;
+  long n = 0;
+  void add(double v) {
+    sum += v;
+    ++n;
+  }
+  double rms() const { return core::rmsFromSum(sum, n); }
+};
+
+/// "met" or "not met" of a target line.
+const char* metText(bool met);
+
+/// Accumulates one run's metrics frame by frame (the loop feeds it in frame order).
+class Scorer {
+public:
+  Scorer(const PanTiltScenarioConfig& config, double occlusion_start, double occlusion_end,
+         const Eigen::Vector2d& sigma, std::string controller);
+  void frameCaptured() { ++m_.frames; }
+  /// The detector's pixel (before [T]'s noise) against the true projection (from metrics_start).
+  void detectorError(double tc, const Eigen::Vector2d& detected_px, const Eigen::Vector2d& truth_px);
+  /// One processed frame: `used` = ours accepted it (the baseline: it was detected); `filtered`:
+  /// ours' estimate at the frame (NaN when none).
+  void frame(double tc, double error_px, bool detected, const Eigen::Vector2d& measured, const Eigen::Vector2d& truth,
+             bool used, const Eigen::Vector2d& filtered);
+  /// One command issued at the joints q (`safe`: within the limits from the predicted state).
+  void command(const robots::PanTiltLimits& limits, const Eigen::Vector2d& q, const Eigen::Vector2d& qdot, bool safe,
+               bool searching);
+  void decision(tracking::GateDecision d);
+  /// The figures; `ours`: the predictive controller (filter figures), null for the baseline.
+  PanTiltRunMetrics finish(const control::PredictivePanTiltController* ours, const robots::SimulatedPanTiltUnit& unit,
+                           double wall_ms);
+
+private:
+  const PanTiltScenarioConfig& cfg_;
+  double occ0_, occ1_;
+  PanTiltRunMetrics m_;
+  SquareSum img_, mx_, my_, fx_, fy_, det_px_;
+  Eigen::Vector2d pan_rng_{1e9, -1e9}, tilt_rng_{1e9, -1e9};
+};
+
+}  // namespace pan_tilt
+}  // namespace viewline::scenarios

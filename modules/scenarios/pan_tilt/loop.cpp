@@ -1,0 +1,266 @@
+#include "viewline/scenarios/pan_tilt/loop.h"
+
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <optional>
+#include <utility>
+#include <vector>
+
+#include "viewline/core/random.h"
+#include "viewline/runtime/delay_line.h"
+#include "viewline/scenarios/pan_tilt/world.h"
+
+namespace viewline::scenarios {
+
+using Eigen::Vector2d;
+using Eigen::Vector3d;
+
+std::string truthChannel(const std::string& controller) { return controller + "_truth"; }
+std::string imageErrorChannel(const std::string& controller) { return controller + "_image_error_px"; }
+
+namespace {
+
+/// A frame after detection, on its way to the controller.
+struct Processed {
+  std::size_t index = 0;
+  runtime::Frame frame;
+  pan_tilt::FrameTruth truth;
+  control::TargetObservation obs;
+  Vector2d meas_px = Vector2d::Constant(std::nan(""));
+};
+
+/// The commands the law still has to account for: those issued within the unit's latency plus
+/// two periods (at least the last two). Not a delivery queue: the unit applies each command after
+/// its latency itself; the law predicts the joints at the effect time from these.
+class CommandsInFlight {
+public:
+  CommandsInFlight(double latency, double period) : keep_(latency + 2.0 * period) {}
+  const std::vector<robots::IssuedCommand>& all() const { return recent_; }
+  void issued(double t, const Vector2d& qdot) {
+    recent_.push_back({t, qdot});
+    while (recent_.size() > 2 && recent_.front().t < t - keep_) recent_.erase(recent_.begin());
+  }
+
+private:
+  double keep_;
+  std::vector<robots::IssuedCommand> recent_;
+};
+
+/// The gate's decision for ours' last observe(), from the controller's own report: a measurement
+/// that (re)initialised a filter without a live track starts one; one that re-initialised it
+/// after rejections in a row restarts it.
+tracking::GateDecision decisionOf(const control::PlanarTargetFilter::Update& u, bool started) {
+  if (started) return tracking::GateDecision::Start;
+  if (!u.accepted) return tracking::GateDecision::Reject;
+  return u.reinitialized ? tracking::GateDecision::Restart : tracking::GateDecision::Accept;
+}
+
+Eigen::VectorXd vec(const Vector2d& v) { return Eigen::VectorXd(v); }
+
+}  // namespace
+
+PanTiltRunMetrics runPanTilt(const PanTiltScenarioConfig& cfg, std::uint64_t seed, PanTiltControllerKind kind,
+                             const PanTiltRunIo& io) {
+  cfg.validate();
+  const auto wall0 = std::chrono::steady_clock::now();
+  pan_tilt::World world(cfg, seed);
+  robots::SimulatedPanTiltUnit& unit = world.unit();
+  const robots::PanTiltLimits& limits = cfg.unit.limits;
+  const double latency = unit.commandLatency();  // the unit owns its latency; the laws ask it
+  const robots::PanTiltKinematics& kin_model = world.modelKinematics();
+  core::Camera model_cam = panTiltModelCamera(cfg);  // pose set per frame
+  vision::ScreenTargetDetector detector(cfg.detector);
+
+  std::unique_ptr<control::PanTiltController> ctrl;
+  control::PredictivePanTiltController* ours = nullptr;
+  if (kind == PanTiltControllerKind::Predictive) {
+    control::PredictiveConfig pc = cfg.control;
+    pc.filter.particle_seed = core::deriveSeed(seed, 78);  // (waypoint_particles; the replay uses the same)
+    auto p = std::make_unique<control::PredictivePanTiltController>(pc, limits, latency, world.f_M_screen(), kin_model);
+    ours = p.get();
+    ctrl = std::move(p);
+  } else {
+    ctrl = std::make_unique<control::BaselinePanTiltController>(cfg.control.servo, limits, latency, cfg.control.limits,
+                                                                kin_model);
+  }
+  const std::string name = ctrl->name();
+  pan_tilt::Scorer score(cfg, world.occlusionStart(), world.occlusionEnd(), world.sigma(), name);
+  const double period = 1.0 / cfg.fps;
+  const auto n_frames = static_cast<std::size_t>(std::floor(cfg.duration * cfg.fps));
+  pan_tilt::RendererSource source(world, n_frames);
+  CommandsInFlight recent(latency, period);
+  runtime::DelayLine<Processed> to_controller;  // the processing delay
+  runtime::TelemetrySink* tel = io.telemetry;
+  if (io.frames != nullptr) io.frames->runStarted(name);
+
+  // The controller's half of a frame, when its observation is delivered.
+  const auto deliver = [&](double t_cmd, Processed& p) {
+    const control::TargetObservation& obs = p.obs;
+    const double tc = p.frame.capture_time;
+    const bool had_track = ours != nullptr && ours->filter().initialized();
+    const std::size_t reacquisitions = ours != nullptr ? ours->reacquisitions() : 0;
+    std::optional<control::PlanarTargetFilter::Kinematics> prior;  // x(k|k−1), for the innovation record
+    if (tel != nullptr && had_track && obs.detected) prior = ours->filter().at(obs.stamp);
+    ctrl->observe(obs);
+
+    bool used = obs.detected;  // the baseline uses every detection
+    Vector2d filt = Vector2d::Constant(std::nan(""));
+    if (ours != nullptr && obs.detected) {
+      const control::PlanarTargetFilter::Update& u = ours->lastUpdate();
+      const bool started = !had_track || ours->reacquisitions() != reacquisitions;
+      const tracking::GateDecision d = decisionOf(u, started);
+      score.decision(d);
+      used = u.accepted;
+      // The filtered estimate scored on every detected frame: a measurement the gate rejected
+      // still counts, with the filter's own estimate at that time (its prediction).
+      if (ours->filter().initialized())
+        filt = u.accepted ? ours->filteredPlane() : Vector2d(ours->filter().at(obs.stamp).p);
+      if (tel != nullptr) {
+        runtime::InnovationRecord r;
+        r.channel = name;
+        r.t = obs.stamp;
+        r.id = p.index + 1;
+        r.rows = 2;
+        r.decision = d;
+        if (d != tracking::GateDecision::Start && prior) {
+          r.innovation = vec(obs.plane - prior->p);
+          r.S = prior->P_pos + obs.plane_cov;
+          r.nis = u.nis;
+        }
+        tel->innovation(r);
+        const control::PlanarTargetFilter::Kinematics k = ours->filter().at(obs.stamp);
+        Eigen::VectorXd x(4);
+        x << k.p, k.v;
+        tel->estimate({name, obs.stamp, x, k.P_pos});
+      }
+    }
+    score.frame(tc, p.truth.error_px, obs.detected, obs.plane, p.truth.plane, used, filt);
+
+    // The command, issued after the processing delay.
+    control::ControlInput in;
+    in.t = t_cmd;
+    in.joints = unit.read(t_cmd);
+    in.recent = recent.all();
+    in.period = period;
+    const control::ControlOutput out = ctrl->command(in);
+    const robots::JointState e = robots::predictJointState(limits, in.joints, recent.all(), latency, t_cmd + latency);
+    const bool safe = robots::isSafeCommand(limits, e.q, e.qdot, out.qdot, period, 1e-9);
+    score.command(limits, in.joints.q, out.qdot, safe, out.mode == control::TrackingMode::Searching);
+    unit.commandVelocity(t_cmd, out.qdot);
+    recent.issued(t_cmd, out.qdot);
+    if (tel != nullptr) tel->command({name, t_cmd, vec(out.qdot)});
+
+    if (io.frames != nullptr) {
+      pan_tilt::FrameRecord r;
+      r.controller = name;
+      r.image = &p.frame.image;
+      r.t = tc;
+      r.truth = p.truth.plane;
+      r.detected = obs.detected;
+      r.measured = obs.plane;
+      r.filtered = filt;
+      r.truth_px = p.truth.px;
+      r.measured_px = p.meas_px;
+      r.has_prediction = out.has_prediction;
+      r.predicted_px = out.has_prediction ? model_cam.normalizedToPixel(out.predicted_feature)
+                                          : Vector2d::Constant(std::nan(""));
+      r.principal_px = world.principal();
+      r.error_px = p.truth.error_px;
+      r.q = in.joints.q;
+      r.qdot = in.joints.qdot;
+      r.command = out.qdot;
+      r.mode = static_cast<int>(out.mode);
+      r.mode_name = control::toString(out.mode);
+      io.frames->frame(r);
+    }
+    if (io.progress && (p.index % 30 == 0 || p.index + 1 == n_frames))
+      io.progress(static_cast<double>(p.index + 1) / static_cast<double>(n_frames));
+  };
+
+  runtime::Scheduler sched;
+  sched.setPacing(io.pacing);
+  std::size_t grabbed = 0;
+  // The camera's half of a frame: grab, detect, measure, and send the observation on.
+  std::function<void(double)> capture = [&](double) {
+    const std::size_t k = grabbed++;
+    std::optional<runtime::Frame> frame = source.grab();
+    if (frame) {
+      Processed p;
+      p.index = k;
+      const double tc = frame->capture_time;
+      score.frameCaptured();
+      p.truth = world.truth(source.lastCamera(), tc);
+      // [T] noise draws happen every frame (same sequence for both controllers).
+      const Vector2d n = world.drawNoise();
+      control::TargetObservation& obs = p.obs;
+      obs.stamp = frame->stamp;
+      const auto det = detector.detect(frame->image, frame->stamp);
+      // The camera as the controllers know it at the capture stamp: calibrated intrinsics,
+      // calibrated mount, encoder reading at the stamp.
+      model_cam.c_M_w = kin_model.c_M_f(unit.read(frame->stamp).q);
+      if (det.ok()) {
+        // Back-project onto the screen plane (z_screen = 0) through that camera.
+        const Vector3d ray_f = model_cam.rayThroughPixel_w(det.value().pixel);
+        const Vector3d c_f = model_cam.center_w();
+        const Eigen::Isometry3d screen_M_f = world.f_M_screen().inverse();
+        const Vector3d o_s = screen_M_f * c_f;
+        const Vector3d d_s = screen_M_f.linear() * ray_f;
+        if (d_s.z() > 1e-9) {
+          const double lambda = -o_s.z() / d_s.z();
+          const Vector3d hit = o_s + lambda * d_s;
+          const Vector2d measured = hit.head<2>() + n;
+          const Vector3d meas_c = model_cam.toCamera(world.f_M_screen() * Vector3d(measured.x(), measured.y(), 0.0));
+          obs.detected = meas_c.z() > 0.0;
+          obs.plane = measured;
+          obs.plane_cov = world.R();
+          obs.feature = Vector2d(meas_c.x() / meas_c.z(), meas_c.y() / meas_c.z());
+          p.meas_px = model_cam.normalizedToPixel(obs.feature);
+          score.detectorError(tc, det.value().pixel, p.truth.px);
+        }
+      }
+      if (tel != nullptr) {
+        tel->measurement({truthChannel(name), tc, k + 1, vec(p.truth.plane), {}});
+        tel->scalar({imageErrorChannel(name), tc, p.truth.error_px});
+        if (obs.detected) tel->measurement({name, obs.stamp, k + 1, vec(obs.plane), vec(world.sigma())});
+      }
+      const double t_cmd = tc + cfg.processing_delay;
+      p.frame = std::move(*frame);
+      to_controller.send(t_cmd, std::move(p));
+      sched.at(t_cmd, runtime::priority::Control, [&](double t) {
+        to_controller.receive(t, [&](double t_available, Processed& q) { deliver(t_available, q); });
+        if (io.frames != nullptr && io.frames->quitRequested()) sched.requestStop();
+      });
+    }
+    if (const auto next = source.nextReadyTime()) sched.at(*next, runtime::priority::Capture, capture);
+  };
+  if (const auto first = source.nextReadyTime()) sched.at(*first, runtime::priority::Capture, capture);
+  while (!sched.stopRequested() && sched.step()) {
+  }
+  unit.stop(unit.now().t);
+  unit.advanceTo(unit.now().t + 1.0);
+
+  const double wall =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - wall0).count();
+  PanTiltRunMetrics m = score.finish(ours, unit, wall);
+  m.stopped = sched.stopRequested();
+  return m;
+}
+
+PanTiltComparison runPanTiltComparison(const PanTiltScenarioConfig& config, std::uint64_t seed, const PanTiltRunIo& io) {
+  PanTiltComparison c;
+  c.seed = seed;
+  c.path = pathShapeName(config.path.shape);
+  const double share = config.run_baseline ? 0.5 : 1.0;
+  PanTiltRunIo part = io;
+  if (io.progress) part.progress = [&](double f) { io.progress(share * f); };
+  c.ours = runPanTilt(config, seed, PanTiltControllerKind::Predictive, part);
+  if (config.run_baseline && !c.ours.stopped) {
+    if (io.progress) part.progress = [&](double f) { io.progress(0.5 + 0.5 * f); };
+    c.baseline = runPanTilt(config, seed, PanTiltControllerKind::Baseline, part);
+    c.has_baseline = true;
+  }
+  return c;
+}
+
+}  // namespace viewline::scenarios
