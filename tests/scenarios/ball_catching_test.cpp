@@ -2,8 +2,13 @@
 // colour-blob detector -> viewline tracker -> interception planner -> simulated robot).
 #include <gtest/gtest.h>
 
+#include <memory>
+#include <vector>
+
 #include "viewline/core/error.h"
+#include "viewline/core/statistics.h"
 #include "viewline/io/config.h"
+#include "viewline/runtime/telemetry.h"
 #include "viewline/scenarios/ball_catching.h"
 
 using namespace viewline;
@@ -61,7 +66,6 @@ TEST(BallCatchingScenario, ShortSeededSessionCatchesAndRespectsTheLimits) {
 TEST(BallCatchingScenario, ViperArmBackEndFollowsThePlan) {
   auto cfg = shipped("config/ball_catching.yaml");
   cfg.robot.kind = robots::CartesianBackEnd::Arm;
-  cfg.finalize();
   cfg.threads = 1;
   const auto s = scenarios::runBallCatching(cfg, 2, 5);
   EXPECT_EQ(s.limit_violations, 0u);
@@ -116,6 +120,58 @@ TEST(BallCatchingScenario, RigRendersWithTheTruthAndEstimatesWithTheCalibration)
   const core::Camera t = inline_cfg.cameras[0].renderCamera(), e = inline_cfg.cameras[0].estimatorCamera();
   EXPECT_TRUE(t.c_M_w.isApprox(e.c_M_w));
   EXPECT_DOUBLE_EQ(t.intrinsics.get_kud(), e.intrinsics.get_kud());
+}
+
+// The loop on the scheduler: pacing changes when events run, never what they compute; telemetry
+// only observes. A throw run as fast as possible with a memory sink and the same throw paced at
+// 20x real time (what --realtime 20 asks) without one give identical results, and the sink saw
+// every gate decision the tracker made.
+TEST(BallCatchingScenario, PacedAndUnpacedRunsAreIdenticalAndTelemetrySeesEveryGateDecision) {
+  auto cfg = shipped("config/ball_catching.yaml");
+  cfg.threads = 1;
+  const int throws = 2;
+  std::vector<std::shared_ptr<runtime::MemorySink>> sinks;
+  for (int i = 0; i < throws; ++i) sinks.push_back(std::make_shared<runtime::MemorySink>());
+  scenarios::CatchHooks fast;
+  fast.telemetry = [&](int i) { return sinks[static_cast<std::size_t>(i)]; };
+  const auto a = scenarios::runBallCatching(cfg, throws, 7, fast);
+  scenarios::CatchHooks paced;
+  paced.pacing = runtime::Pacing{20.0};
+  const auto b = scenarios::runBallCatching(cfg, throws, 7, paced);
+  ASSERT_EQ(a.results.size(), b.results.size());
+  for (std::size_t i = 0; i < a.results.size(); ++i) {
+    const auto &ra = a.results[i], &rb = b.results[i];
+    EXPECT_EQ(ra.frames, rb.frames);
+    EXPECT_EQ(ra.detections, rb.detections);
+    EXPECT_EQ(ra.fused, rb.fused);
+    EXPECT_EQ(ra.gated, rb.gated);
+    EXPECT_EQ(ra.caught, rb.caught);
+    EXPECT_EQ(ra.miss_reason, rb.miss_reason);
+    EXPECT_EQ(ra.miss_distance, rb.miss_distance);  // bit for bit
+    EXPECT_EQ(ra.prediction_error, rb.prediction_error);
+    EXPECT_EQ(ra.decision_time, rb.decision_time);
+    EXPECT_EQ(ra.t_first_move, rb.t_first_move);
+    EXPECT_TRUE(ra.target == rb.target);
+    EXPECT_TRUE(ra.hole_at_cross == rb.hole_at_cross);
+    EXPECT_GT(rb.wall_s, 0.9 * ra.t_cross / 20.0) << "the paced run waits for the wall clock";
+    // Every submitted image has one innovation record whose decision matches the tracker's fate.
+    const auto& sink = *sinks[i];
+    using D = tracking::GateDecision;
+    const std::size_t used = sink.count(D::Start) + sink.count(D::Accept) + sink.count(D::Restart);
+    EXPECT_EQ(used, static_cast<std::size_t>(ra.fused)) << "throw " << i;
+    EXPECT_EQ(sink.count(D::Reject), static_cast<std::size_t>(ra.gated)) << "throw " << i;
+    EXPECT_GE(sink.count(D::Start), 1u);
+    EXPECT_EQ(sink.innovations.size(), static_cast<std::size_t>(ra.fused + ra.gated));
+    EXPECT_EQ(sink.measurements.size(), static_cast<std::size_t>(ra.detections));
+    std::size_t ball_estimates = 0;
+    for (const auto& e : sink.estimates) ball_estimates += e.channel == "ball";
+    EXPECT_EQ(ball_estimates, static_cast<std::size_t>(ra.fused));
+    EXPECT_FALSE(sink.commands.empty());  // a set point every control period
+    for (const auto& r : sink.innovations)
+      if (r.decision == D::Accept) {
+        EXPECT_LE(r.nis, core::chiSquareQuantile(2.0, 1.0 - cfg.tracker.gate.mahalanobis_alpha) * (1.0 + 1e-9));
+      }
+  }
 }
 
 TEST(BallCatchingScenario, UnknownConfigKeyIsAnError) {
