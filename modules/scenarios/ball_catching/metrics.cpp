@@ -88,16 +88,7 @@ CatchSummary summarise(std::vector<ThrowResult> results, std::uint64_t seed,
     flight.push_back(r.t_cross);
     frame_time += r.wall_s;
   }
-  // Linear interpolation between order statistics, written as a weighted sum (replaced by
-  // core::percentile in the next commit, which rounds differently in the last bit).
-  auto percentile = [](std::vector<double> v, double q) {
-    if (v.empty()) return std::nan("");
-    std::sort(v.begin(), v.end());
-    const double pos = q * static_cast<double>(v.size() - 1);
-    const auto i = static_cast<std::size_t>(std::floor(pos));
-    const double f = pos - static_cast<double>(i);
-    return i + 1 < v.size() ? v[i] * (1 - f) + v[i + 1] * f : v[i];
-  };
+  using core::percentile;
   s.catch_rate_all = static_cast<double>(s.caught) / s.throws;
   s.catch_rate_reachable = s.reachable_throws > 0 ? static_cast<double>(s.caught_reachable) / s.reachable_throws : 0.0;
   s.prediction_error_mm_median = percentile(pred_err, 0.5);
