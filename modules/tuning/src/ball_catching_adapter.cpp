@@ -27,7 +27,7 @@
 
 #include <algorithm>
 #include <cmath>
-#include <map>
+#include <memory>
 #include <optional>
 
 #include "adapter_util.h"
@@ -50,8 +50,7 @@ struct CatchOptions {
 class CatchInstance final : public ScenarioInstance {
 public:
   CatchInstance(scenarios::BallCatchingConfig cfg, CatchOptions opt) : cfg_(std::move(cfg)), opt_(opt) {
-    cfg_.threads = 1;
-    cfg_.validate();
+    cfg_.threads = 1;  // loadBallCatchingConfig validated the rest
   }
 
   std::string autotuneUnsupported() const override {
