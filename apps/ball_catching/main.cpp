@@ -1,100 +1,56 @@
-// ball_catching: [L]'s ball catcher (issue 5). Thin main: parse the CLI, load the YAML scenario,
-// run scenarios::runBallCatching, print and write the summary. The loop is documented in
-// modules/scenarios/include/viewline/scenarios/ball_catching.h.
+// ball_catching: [L]'s ball catcher. Thin main: the common flags, the YAML scenario (every
+// setting is a config key: --set camera_count=1, --set rate_override_hz=100,
+// --set noise_sigma_override=8, --set robot.v_max=1, --set robot.a_max=26, --set planner.model=ballistic,
+// --set robot.kind=arm, --set threads=4), scenarios::runBallCatching, the summary. The loop is
+// documented in modules/scenarios/include/viewline/scenarios/ball_catching/loop.h.
 
 #include <CLI/CLI.hpp>
 #include <cstdio>
-#include <cstdlib>
-#include <iostream>
 #include <memory>
 
-#include "viewline/core/error.h"
+#include "app_options.h"
 #include "viewline/io/config_edit.h"
 #include "viewline/io/files.h"
 #include "viewline/io/log.h"
+#include "viewline/runtime/progress.h"
 #include "viewline/scenarios/ball_catching.h"
-#include "viewline/scenarios/ball_catching_display.h"
+#include "viewline/viz/ball_catching_display.h"
 
 using namespace viewline;
 
 int main(int argc, char** argv) {
-  CLI::App app{"Ball catching: rendered unsynchronised cameras, colour-blob detector, multi-view viewline "
+  CLI::App cli{"Ball catching: rendered unsynchronised cameras, colour-blob detector, multi-view viewline "
                "tracker, drag-aware interception planner and a robot with [L]'s limits"};
-  std::string config_path = "config/ball_catching.yaml", summary_path, log_dir, model;
-  std::uint64_t seed = 1;
-  int throws = 20, jobs = 0;
-  unsigned cameras = 0;
-  double rate = 0.0, noise = -1.0, vmax = 0.0, amax = 0.0;
-  bool headless = false, display = false;
-  std::string robot_kind;
-  std::vector<std::string> sets;
-  app.add_option("--config", config_path, "scenario YAML")->check(CLI::ExistingFile);
-  app.add_option("--set", sets, io::kSetOptionHelp)->take_all();
-  app.add_option("--seed", seed, "random seed (throw i uses deriveSeed(seed, i))");
-  app.add_option("--throws", throws, "number of throws")->check(CLI::PositiveNumber);
-  app.add_option("--jobs", jobs, "worker threads (default: the config's threads)");
-  app.add_flag("--headless", headless, "no display (never needs X)");
-  app.add_flag("--display", display, "show the camera images with detections and the predicted crossing (vpDisplayX)");
-  app.add_option("--log", log_dir, "CSV logs (throws, truth, measurements, estimates, plan) in this directory");
-  app.add_option("--summary", summary_path, "write the metrics as JSON");
-  // Overrides for the comparison tables (the config stays the reference).
-  app.add_option("--cameras", cameras, "use the first N cameras of the config");
-  app.add_option("--rate", rate, "every camera at this frame rate, Hz");
-  app.add_option("--pixel-noise", noise, "sensor noise of every camera, grey levels");
-  app.add_option("--v-max", vmax, "robot speed limit per axis, m/s");
-  app.add_option("--a-max", amax, "robot acceleration limit per axis, m/s²");
-  app.add_option("--planner-model", model, "drag | ballistic");
-  app.add_option("--robot", robot_kind, "stage | arm");
-  CLI11_PARSE(app, argc, argv);
-  if (headless && display) {
-    std::cerr << "ball_catching: --headless and --display exclude each other\n";
-    return 2;
-  }
-  try {
-    scenarios::BallCatchingConfig cfg = scenarios::loadBallCatchingConfig(io::loadConfigWithValues(config_path, sets));
-    if (jobs > 0) cfg.threads = jobs;
-    if (cameras > 0) cfg.camera_count = cameras;
-    if (rate > 0.0) cfg.rate_override_hz = rate;
-    if (noise >= 0.0)
-      for (auto& c : cfg.cameras) c.noise_sigma = noise;
-    if (vmax > 0.0) cfg.robot.limits.v_max.setConstant(vmax);
-    if (amax > 0.0) cfg.robot.limits.a_max.setConstant(amax);
-    if (!model.empty()) {
-      if (model != "drag" && model != "ballistic") throw core::InvalidInput("--planner-model: expected drag or ballistic");
-      cfg.planner.model.kind = model == "drag" ? planning::FlightModel::Drag : planning::FlightModel::Ballistic;
-    }
-    if (!robot_kind.empty()) {
-      if (robot_kind != "stage" && robot_kind != "arm") throw core::InvalidInput("--robot: expected stage or arm");
-      cfg.robot.kind = robot_kind == "arm" ? robots::CartesianBackEnd::Arm : robots::CartesianBackEnd::Stage;
-    }
-    cfg.finalize();
-    cfg.validate();
-
-    io::LogDirectory log(log_dir);
+  apps::CommonOptions opt;
+  opt.config_path = "config/ball_catching.yaml";
+  int throws = 20;
+  apps::addCommonOptions(cli, opt);
+  cli.add_option("--throws", throws, "number of throws (throw i uses deriveSeed(seed, i))")->check(CLI::PositiveNumber);
+  if (const auto code = apps::parseCommandLine(cli, argc, argv)) return *code;
+  return apps::runGuarded("ball_catching", [&] {
+    const auto cfg = scenarios::loadBallCatchingConfig(io::loadConfigWithValues(opt.config_path, opt.sets));
     scenarios::CatchHooks hooks;
-    if (!log_dir.empty()) hooks.log = &log;
-    std::unique_ptr<scenarios::BallCatchingDisplay> viewer;
-    if (display) {
-      if (std::getenv("DISPLAY") == nullptr) {
-        std::cerr << "ball_catching: --display needs an X display (DISPLAY is not set); running headless\n";
-      } else {
-        viewer = std::make_unique<scenarios::BallCatchingDisplay>(cfg);
-        hooks.on_frame = [&](const scenarios::CatchFrame& f) { viewer->show(f); };
-      }
+    hooks.pacing = opt.pacing();
+    // --log DIR: one folder per throw (throw_007/, the runtime's CSV files), throws.csv on top.
+    io::LogDirectory log(opt.log_dir);
+    if (log.enabled()) hooks.telemetry = scenarios::csvTelemetry(opt.log_dir);
+    std::unique_ptr<viz::BallCatchingDisplay> view;
+    if (opt.wantDisplay("ball_catching")) {
+      view = std::make_unique<viz::BallCatchingDisplay>(cfg);
+      hooks.on_frame = [&](const scenarios::CatchFrame& f) { return view->show(f); };
     }
-    hooks.progress = [](int done, int total) {
-      std::fprintf(stderr, "\r  throws %d / %d", done, total);
-      std::fflush(stderr);
-    };
-    const auto s = scenarios::runBallCatching(cfg, throws, seed, hooks);
-    std::fprintf(stderr, "\n");
+    runtime::Progress progress = opt.quiet ? runtime::Progress::quiet() : runtime::Progress("throws", throws);
+    hooks.progress = [&](int done, int) { progress.update(done); };
+    const auto s = scenarios::runBallCatching(cfg, throws, opt.seed, hooks);
+    progress.finish();
+    scenarios::writeThrowsCsv(log, s.results);
+    log.flush();
     nlohmann::json j = scenarios::summaryJson(s, cfg);
-    if (!sets.empty()) j["config_set"] = sets;
-    if (!summary_path.empty()) io::writeJsonFile(summary_path, j);
+    if (!opt.sets.empty()) j["config_set"] = opt.sets;
+    if (!opt.summary_path.empty()) io::writeJsonFile(opt.summary_path, j);
     std::printf("ball_catching: %d throws, seed %llu, %zu cameras, %s robot (%.2f m/s, %.1f m/s²), planner %s, %.1f s wall\n",
-                s.throws, static_cast<unsigned long long>(seed), cfg.camera_count > 0 ? cfg.camera_count : cfg.cameras.size(),
-                robots::toString(cfg.robot.kind), cfg.robot.limits.v_max.x(), cfg.robot.limits.a_max.x(),
-                planning::toString(cfg.planner.model.kind), s.wall_s);
+                s.throws, static_cast<unsigned long long>(opt.seed), cfg.activeCameras(), robots::toString(cfg.robot.kind),
+                cfg.robot.limits.v_max.x(), cfg.robot.limits.a_max.x(), planning::toString(cfg.planner.model.kind), s.wall_s);
     std::printf("  caught %d: catch rate %.3f of all, %.3f of the %d reachable throws\n", s.caught, s.catch_rate_all,
                 s.catch_rate_reachable, s.reachable_throws);
     std::printf("  misses: late %d, off target %d, lost track %d, not reachable %d\n", s.miss_reasons.at("late"),
@@ -104,9 +60,7 @@ int main(int argc, char** argv) {
     std::printf("  %d frames, detection rate %.3f, %.2f ms per frame (render + detect + track + plan); "
                 "robot limit violations %zu\n",
                 s.frames, s.detection_rate, s.ms_per_frame, s.limit_violations);
+    if (view) view->waitForClose();
     return 0;
-  } catch (const core::Error& e) {
-    std::cerr << "\nball_catching: " << e.what() << "\n";
-    return 1;
-  }
+  });
 }

@@ -1,7 +1,8 @@
-// catch_table: the comparison tables of issue 5 (catch rate against camera count, frame rate,
+// catch_table: the catch-rate comparison tables (catch rate against camera count, frame rate,
 // pixel noise, robot limits and planner model), each cell a seeded session of the shipped
 // scenario run through the same library loop as apps/ball_catching (scenarios::runBallCatching).
-// Every variant changes ONE thing of the config; the reachability oracle is the scenario's (a robot
+// Every variant changes ONE thing of the config (the app reaches each through --set: camera_count,
+// rate_override_hz, noise_sigma_override, detector.pixel_noise_px, robot.v_max / a_max, planner.model); the reachability oracle is the scenario's (a robot
 // knowing the true flight from the first frame showing the ball, with that variant's limits), so
 // reachable_throws changes with the robot limits and the cameras (what they see first), never by
 // a change of definition. Throw i of every cell uses the same seed: cells differ only in the variant.
@@ -46,7 +47,7 @@ std::string row(const std::string& label, const scenarios::CatchSummary& s) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"Issue-5 catch-rate tables: cameras, frame rate, pixel noise, robot limits, planner model"};
+  CLI::App app{"Catch-rate tables: cameras, frame rate, pixel noise, robot limits, planner model"};
   std::string config_path = "config/ball_catching.yaml", only, json_path;
   int throws = 150, jobs = 2;
   std::uint64_t seed = 1;
@@ -96,9 +97,7 @@ int main(int argc, char** argv) {
     std::snprintf(base_label, sizeof base_label, "baseline: %zu cameras, 50 Hz, 2 grey levels, %.2g m/s & %.3g m/s², drag",
                   base.camera_count > 0 ? base.camera_count : base.cameras.size(), v0, a0);
     nlohmann::json all = nlohmann::json::array();
-    auto run = [&](const std::string& label, scenarios::BallCatchingConfig cfg) {
-      cfg.finalize();
-      cfg.validate();
+    auto run = [&](const std::string& label, const scenarios::BallCatchingConfig& cfg) {
       std::fprintf(stderr, "%s: ", label.c_str());
       scenarios::CatchHooks hooks;
       hooks.progress = [](int done, int total) {

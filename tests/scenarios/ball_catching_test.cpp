@@ -2,8 +2,13 @@
 // colour-blob detector -> viewline tracker -> interception planner -> simulated robot).
 #include <gtest/gtest.h>
 
+#include <memory>
+#include <vector>
+
 #include "viewline/core/error.h"
+#include "viewline/core/statistics.h"
 #include "viewline/io/config.h"
+#include "viewline/runtime/telemetry.h"
 #include "viewline/scenarios/ball_catching.h"
 
 using namespace viewline;
@@ -12,12 +17,57 @@ namespace {
 scenarios::BallCatchingConfig shipped(const char* path) {
   return scenarios::loadBallCatchingConfig(io::ConfigNode::loadFile(path));
 }
+
+// The same throw run twice gives the same result, bit for bit.
+void expectSameThrow(const scenarios::ThrowResult& a, const scenarios::ThrowResult& b) {
+  EXPECT_EQ(a.frames, b.frames);
+  EXPECT_EQ(a.detections, b.detections);
+  EXPECT_EQ(a.fused, b.fused);
+  EXPECT_EQ(a.gated, b.gated);
+  EXPECT_EQ(a.caught, b.caught);
+  EXPECT_EQ(a.miss_reason, b.miss_reason);
+  EXPECT_EQ(a.miss_distance, b.miss_distance);
+  EXPECT_EQ(a.prediction_error, b.prediction_error);
+  EXPECT_EQ(a.prediction_error_lead, b.prediction_error_lead);
+  EXPECT_EQ(a.decision_time, b.decision_time);
+  EXPECT_EQ(a.t_first_move, b.t_first_move);
+  EXPECT_TRUE(a.target == b.target);
+  EXPECT_TRUE(a.hole_at_cross == b.hole_at_cross);
+}
+
+// Every image the tracker was given has one innovation record, whose decision is the tracker's:
+// Start, Accept and Restart fused it, Reject gated it (the counts of the throw's result).
+void expectEveryGateDecision(const runtime::MemorySink& sink, const scenarios::ThrowResult& r, double gate) {
+  using D = tracking::GateDecision;
+  const std::size_t used = sink.count(D::Start) + sink.count(D::Accept) + sink.count(D::Restart);
+  EXPECT_EQ(used, static_cast<std::size_t>(r.fused)) << "throw " << r.index;
+  EXPECT_EQ(sink.count(D::Reject), static_cast<std::size_t>(r.gated)) << "throw " << r.index;
+  EXPECT_GE(sink.count(D::Start), 1u);
+  EXPECT_EQ(sink.innovations.size(), static_cast<std::size_t>(r.fused + r.gated));
+  EXPECT_EQ(sink.measurements.size(), static_cast<std::size_t>(r.detections));
+  std::size_t ball_estimates = 0;
+  for (const auto& e : sink.estimates) ball_estimates += e.channel == "ball";
+  EXPECT_EQ(ball_estimates, static_cast<std::size_t>(r.fused));
+  EXPECT_FALSE(sink.commands.empty());  // a set point every control period
+  for (const auto& i : sink.innovations)
+    if (i.decision == D::Accept) {
+      EXPECT_LE(i.nis, gate * (1.0 + 1e-9)) << "an accepted image inside the chi-square gate";
+    }
+}
 }  // namespace
 
-TEST(BallCatchingScenario, ShortSeededSessionCatchesAndRespectsTheLimits) {
+// A short session (two threads, as fast as possible, telemetry in memory), then its first throws
+// again on one thread paced at 20x real time (what --realtime 20 asks): the scheduler's pacing
+// changes when events run, never their order, and telemetry only observes, so the throws are the
+// same bit for bit; the telemetry saw every gate decision the tracker made.
+TEST(BallCatchingScenario, ShortSessionCatchesWithinLimitsIsTheSamePacedAndTelemetrySeesEveryGateDecision) {
   auto cfg = shipped("config/ball_catching.yaml");
   cfg.threads = 2;
-  const auto s = scenarios::runBallCatching(cfg, 6, 3);
+  std::vector<std::shared_ptr<runtime::MemorySink>> sinks;
+  for (int i = 0; i < 6; ++i) sinks.push_back(std::make_shared<runtime::MemorySink>());
+  scenarios::CatchHooks fast;
+  fast.telemetry = [&](int i) { return sinks[static_cast<std::size_t>(i)]; };  // one per throw: thread-safe
+  const auto s = scenarios::runBallCatching(cfg, 6, 3, fast);
   ASSERT_EQ(s.results.size(), 6u);
   EXPECT_GT(s.frames, 100);
   EXPECT_GT(s.detection_rate, 0.7);  // the ball is detected in most images
@@ -45,12 +95,17 @@ TEST(BallCatchingScenario, ShortSeededSessionCatchesAndRespectsTheLimits) {
   EXPECT_LT(s.registration->reprojection_px_after, 0.5 * s.registration->reprojection_px_before);
   EXPECT_GE(s.reachable_throws, 1);
   EXPECT_GE(s.caught_reachable, 1);
-  // Same seeds, one thread: identical results (throws are independent of the scheduling).
+  const double gate = core::chiSquareQuantile(2.0, 1.0 - cfg.tracker.gate.mahalanobis_alpha);
+  for (std::size_t i = 0; i < s.results.size(); ++i) expectEveryGateDecision(*sinks[i], s.results[i], gate);
+  // Same seeds, one thread, paced: identical results.
   cfg.threads = 1;
-  const auto s1 = scenarios::runBallCatching(cfg, 3, 3);
-  for (int i = 0; i < 3; ++i) {
-    EXPECT_EQ(s1.results[i].caught, s.results[i].caught);
-    EXPECT_DOUBLE_EQ(s1.results[i].miss_distance, s.results[i].miss_distance);
+  scenarios::CatchHooks paced;
+  paced.pacing = runtime::Pacing{20.0};
+  const auto s1 = scenarios::runBallCatching(cfg, 3, 3, paced);
+  ASSERT_EQ(s1.results.size(), 3u);
+  for (std::size_t i = 0; i < 3; ++i) {
+    expectSameThrow(s1.results[i], s.results[i]);
+    EXPECT_GT(s1.results[i].wall_s, 0.9 * s1.results[i].t_cross / 20.0) << "paced: waits for the wall clock";
   }
   const auto j = scenarios::summaryJson(s, cfg);
   for (const char* key : {"catch_rate_reachable", "catch_rate_all", "throws", "reachable_throws", "miss_reasons",
@@ -61,7 +116,6 @@ TEST(BallCatchingScenario, ShortSeededSessionCatchesAndRespectsTheLimits) {
 TEST(BallCatchingScenario, ViperArmBackEndFollowsThePlan) {
   auto cfg = shipped("config/ball_catching.yaml");
   cfg.robot.kind = robots::CartesianBackEnd::Arm;
-  cfg.finalize();
   cfg.threads = 1;
   const auto s = scenarios::runBallCatching(cfg, 2, 5);
   EXPECT_EQ(s.limit_violations, 0u);

@@ -44,6 +44,17 @@ CatchPlanner::CatchPlanner(CatchPlannerConfig cfg, std::function<bool(const Eige
   reset(0.0, cfg_.home);
 }
 
+namespace {
+CatchPlannerConfig withRobot(CatchPlannerConfig cfg, const robots::CartesianRobot& robot) {
+  cfg.limits = robot.limits();
+  cfg.latency = robot.commandLatency();
+  return cfg;
+}
+}  // namespace
+
+CatchPlanner::CatchPlanner(CatchPlannerConfig cfg, const robots::CartesianRobot& robot)
+    : CatchPlanner(withRobot(std::move(cfg), robot), [&robot](const Eigen::Vector3d& p) { return robot.reachable(p); }) {}
+
 void CatchPlanner::reset(double t, const Eigen::Vector3d& p, const Eigen::Vector3d& v) {
   phase_ = CatchPhase::Idle;
   profile_ = SyncProfile::plan(t, p, v, p, cfg_.limits.v_max, cfg_.limits.a_max);  // stop, return to p

@@ -1,4 +1,9 @@
-# Ball catching ([L] §VI.C, issue 5): the catch session as library code (throw distribution with
-# drag, rendered unsynchronised cameras, blob detector, viewline tracker, interception planner,
-# simulated stage/arm, oracle reachability, metrics) and its live view (vpDisplayX, --display only).
-list(APPEND scenarios_sources src/ball_catching.cpp src/ball_catching_display.cpp)
+# Ball catching ([L] §VI.C): the catch session as library code on the scenario runtime (config
+# reader, world and cameras as a frame source, registration, the scheduled loop, metrics). Its
+# live view is in modules/viz (ball_catching_display).
+list(APPEND scenarios_sources
+  ball_catching/config.cpp
+  ball_catching/loop.cpp
+  ball_catching/metrics.cpp
+  ball_catching/registration.cpp
+  ball_catching/world.cpp)

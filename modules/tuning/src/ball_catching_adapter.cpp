@@ -1,21 +1,18 @@
-// Ball-catching scenario adapter ([L] §VI.C, issue 5): runs scenarios::runBallCatching (throws
-// with drag, free-running rendered cameras, blob detection, the ViewlineTracker, the catch
-// planner and the robot) in-process, with the config read by the scenario's own loader
-// (loadBallCatchingConfig: strict keys), so a config the tuning tool accepts or writes is one
-// ball_catching reads. One run = `throws` throws (adapter option), throw i from deriveSeed(seed, i),
-// exactly as ball_catching --throws N --seed S; the summary metrics are the scenario's own
-// (CatchSummary). The scenario's thread pool is set to one thread: the sweep runs settings in
-// parallel instead.
+// Ball-catching scenario adapter ([L] §VI.C): runs scenarios::runBallCatching (throws with drag,
+// free-running rendered cameras, blob detection, the ViewlineTracker, the catch planner and the
+// robot) in-process, with the config read by the scenario's own loader (loadBallCatchingConfig:
+// strict keys), so a config the tuning tool accepts or writes is one ball_catching reads. One run =
+// `throws` throws (adapter option), throw i from deriveSeed(seed, i), exactly as
+// ball_catching --throws N --seed S; the summary metrics are the scenario's own (CatchSummary).
+// The scenario's thread pool is set to one thread: the sweep runs settings in parallel instead.
 //
-// Innovations. runBallCatching does not expose its tracker; with a log folder it writes every
-// measurement it submits (throw, stamp, camera, pixel, σ_px, fused). A run therefore logs to a
-// private temporary folder and the adapter re-runs a ViewlineTracker with the same cameras (the
-// camera models of the frames, from the on_frame hook) and config on the same measurements in the
-// same order: the innovation before each submit is formed as the tracker forms it (see
-// adapter_util.h: d = y − C x̂(t|t−), S = R2 + C P Cᵀ, 2 dof). NIS: fused, non-seed measurements
-// once the track has `burn_in` fused images. The log keeps 12 significant digits, so the replay
-// can in principle differ from the loop; the metric replay_fate_mismatch counts measurements
-// whose fused/rejected fate differs (a self-check; expected 0).
+// Innovations come from the loop's telemetry (one runtime::MemorySink per throw): for every image
+// the tracker was given, its own gate statistic NIS = dᵀ S⁻¹ d (2 dof) and its decision (Start,
+// Accept, Reject, Restart), and the estimate after every fused image. Nothing is recomputed or
+// replayed. NIS counts accepted (non-seed) images once the track has `burn_in` fused images (counted
+// from the decisions: a Start or Restart begins a track). replay_fate_mismatch is a self-check that
+// the telemetry saw every decision: |used − fused| + |rejected − gated| against the loop's counts
+// (expected 0).
 // NEES (6 dof, position and velocity) against the true flight: one sample per throw, after the
 // `nees_fused`-th fused image, truth from sim::DragFlight re-integrated from the throw's release
 // point and launch velocity (the scenario's own flight, deterministic RK4). Only for
@@ -25,17 +22,19 @@
 // pixel, so which blobs are detected depends on the filter being tuned, and the measurement σ is
 // per detection (blob covariance, floored by detector.sigma_px_floor) rather than one config
 // value. Sweeps of tracker.accel_psd, tracker gates and detector.sigma_px_floor work.
+// The scenario's live view (viz::BallCatchingDisplay) is not wired here: this module does not
+// link viz.
 
 #include <algorithm>
 #include <cmath>
-#include <map>
+#include <memory>
 #include <optional>
 
 #include "adapter_util.h"
 #include "viewline/core/error.h"
 #include "viewline/estimation/consistency.h"
+#include "viewline/runtime/telemetry.h"
 #include "viewline/scenarios/ball_catching.h"
-#include "viewline/scenarios/ball_catching_display.h"
 #include "viewline/tuning/scenario.h"
 
 namespace viewline::tuning {
@@ -48,17 +47,10 @@ struct CatchOptions {
   int nees_fused = 8;
 };
 
-struct LoggedMeasurement {
-  tracking::ImageMeasurement m;
-  bool fused = false;
-};
-
 class CatchInstance final : public ScenarioInstance {
 public:
   CatchInstance(scenarios::BallCatchingConfig cfg, CatchOptions opt) : cfg_(std::move(cfg)), opt_(opt) {
-    cfg_.threads = 1;
-    cfg_.finalize();
-    cfg_.validate();
+    cfg_.threads = 1;  // loadBallCatchingConfig validated the rest
   }
 
   std::string autotuneUnsupported() const override {
@@ -69,35 +61,12 @@ public:
   }
 
   RunResult run(std::uint64_t seed, const RunOptions& ro) const override {
-    const detail::TempLogDir tmp;
-    std::map<std::size_t, core::Camera> cams_seen;
-    std::unique_ptr<scenarios::BallCatchingDisplay> view;
-    if (ro.display && detail::xDisplayAvailable()) {
-      try {
-        view = std::make_unique<scenarios::BallCatchingDisplay>(cfg_);
-      } catch (const std::exception&) {
-        view.reset();  // no X display: headless
-      }
-    }
-    scenarios::CatchSummary sum;
-    {
-      io::LogDirectory log(tmp.dir());
-      scenarios::CatchHooks hooks;
-      hooks.log = &log;
-      hooks.on_frame = [&](const scenarios::CatchFrame& f) {
-        if (f.camera_model != nullptr && !cams_seen.count(f.camera)) cams_seen.emplace(f.camera, *f.camera_model);
-        if (view) view->show(f);
-      };
-      if (ro.progress) hooks.progress = [&ro](int done, int total) { ro.progress(static_cast<double>(done) / total); };
-      sum = scenarios::runBallCatching(cfg_, opt_.throws, seed, hooks);
-      log.flush();
-    }
-    std::vector<core::Camera> cams;
-    for (std::size_t i = 0; !cams_seen.empty() && i <= cams_seen.rbegin()->first; ++i) {
-      const auto it = cams_seen.find(i);
-      cams.push_back(it != cams_seen.end() ? it->second : cams_seen.begin()->second);  // unseen: never measured
-    }
-    const std::map<int, std::vector<LoggedMeasurement>> meas = readMeasurements(tmp.file("measurements.csv"));
+    std::vector<std::shared_ptr<runtime::MemorySink>> sinks;
+    for (int i = 0; i < opt_.throws; ++i) sinks.push_back(std::make_shared<runtime::MemorySink>());
+    scenarios::CatchHooks hooks;
+    hooks.telemetry = [&sinks](int i) { return sinks[static_cast<std::size_t>(i)]; };
+    if (ro.progress) hooks.progress = [&ro](int done, int total) { ro.progress(static_cast<double>(done) / total); };
+    const scenarios::CatchSummary sum = scenarios::runBallCatching(cfg_, opt_.throws, seed, hooks);
 
     RunResult r;
     r.seed = seed;
@@ -105,14 +74,10 @@ public:
     if (ro.series) series = makeSeries();
     io::CsvWriter* inn_csv = nullptr;
     if (ro.log != nullptr && ro.log->enabled())
-      inn_csv = &ro.log->stream("innovations", {"throw", "id", "camera", "t", "d0", "d1", "S00", "S01", "S11", "nis",
-                                                "fused", "in_statistics"});
+      inn_csv = &ro.log->stream("innovations", {"throw", "id", "camera", "t", "nis", "decision", "fused", "in_statistics"});
     std::size_t mismatch = 0, sample = 0;
-    for (const scenarios::ThrowResult& tr : sum.results) {
-      const auto it = meas.find(tr.index);
-      if (it == meas.end() || cams.empty()) continue;
-      replayThrow(tr, it->second, cams, r, series.get(), inn_csv, mismatch, sample, ro);
-    }
+    for (const scenarios::ThrowResult& tr : sum.results)
+      readThrow(tr, *sinks[static_cast<std::size_t>(tr.index)], r, series.get(), inn_csv, mismatch, sample, ro);
     auto& m = r.metrics;
     m["catch_rate_all"] = sum.catch_rate_all;
     m["catch_rate_reachable"] = sum.reachable_throws > 0 ? sum.catch_rate_reachable : std::nan("");
@@ -134,25 +99,6 @@ public:
   }
 
 private:
-  static std::map<int, std::vector<LoggedMeasurement>> readMeasurements(const std::string& path) {
-    std::map<int, std::vector<LoggedMeasurement>> out;
-    const detail::CsvTable csv = detail::CsvTable::read(path, "measurements.csv of a ball_catching log");
-    const std::size_t cth = csv.col("throw"), ct = csv.col("t"), cc = csv.col("camera"), cu = csv.col("u"),
-                      cv = csv.col("v"), cs = csv.col("sigma_px"), cf = csv.col("fused");
-    for (std::size_t row = 0; row < csv.rows(); ++row) {
-      auto& list = out[static_cast<int>(csv.number(row, cth))];
-      LoggedMeasurement lm;
-      lm.m.id = list.size() + 1;  // the scenario numbers each throw's measurements from 1
-      lm.m.camera = static_cast<std::size_t>(csv.number(row, cc));
-      lm.m.t = csv.number(row, ct);
-      lm.m.uv = Eigen::Vector2d(csv.number(row, cu), csv.number(row, cv));
-      lm.m.sigma_px = csv.number(row, cs);
-      lm.fused = csv.number(row, cf) > 0.5;
-      list.push_back(lm);
-    }
-    return out;
-  }
-
   std::shared_ptr<RunSeries> makeSeries() const {
     auto s = std::make_shared<RunSeries>();
     s->time_label = "time since release [s]";
@@ -164,9 +110,9 @@ private:
     return s;
   }
 
-  void replayThrow(const scenarios::ThrowResult& tr, const std::vector<LoggedMeasurement>& list,
-                   const std::vector<core::Camera>& cams, RunResult& r, RunSeries* series, io::CsvWriter* inn_csv,
-                   std::size_t& mismatch, std::size_t& sample, const RunOptions& ro) const {
+  void readThrow(const scenarios::ThrowResult& tr, const runtime::MemorySink& sink, RunResult& r, RunSeries* series,
+                 io::CsvWriter* inn_csv, std::size_t& mismatch, std::size_t& sample, const RunOptions& ro) const {
+    using tracking::GateDecision;
     const bool truth = cfg_.object == "ball";
     const double t_end = tr.t_cross + cfg_.post_crossing_s + 0.3;
     const sim::DragFlight flight({tr.release, tr.launch_velocity}, 0.0, t_end, cfg_.throws.body);
@@ -176,21 +122,22 @@ private:
       x << s.p, s.v;
       return x;
     };
-    tracking::ViewlineTracker tracker(cams, cfg_.tracker);
+    std::vector<const runtime::EstimateRecord*> estimates;  // one per fused image, in order
+    for (const auto& e : sink.estimates)
+      if (e.channel == "ball") estimates.push_back(&e);
     const bool keep_err = series != nullptr && tr.index < 30;
     const bool keep_traj = series != nullptr && tr.index < 5;
     Curve err{"throw " + std::to_string(tr.index), {}, {}}, tru{"truth", {}, {}}, est{"estimate", {}, {}};
-    int fused_count = 0;
+    int fused_count = 0, in_track = 0, used = 0, rejected = 0;
     std::optional<estimation::StateEstimate> half_state;  // the prediction drawn: from mid-flight on
     std::vector<double> est_t;
-    for (const LoggedMeasurement& lm : list) {
-      if (lm.m.camera >= cams.size()) throw core::InvalidInput("ball_catching replay: camera index beyond the cameras seen");
-      const detail::ViewlineInnovation inn = detail::viewlineInnovation(tracker, cams, cfg_.tracker, lm.m, opt_.burn_in);
-      const tracking::Refusal refusal = tracker.submit(lm.m);
-      const auto out = refusal == tracking::Refusal::None ? tracker.outcome(lm.m.id) : std::nullopt;
-      const bool fused = out && out->fate == tracking::Fate::Fused;
-      mismatch += fused != lm.fused;
-      const bool counted = inn.valid && fused && !out->seed;
+    for (const runtime::InnovationRecord& inn : sink.innovationsOf("ball")) {
+      const bool fused = tracking::uses(inn.decision);
+      const bool counted = inn.decision == GateDecision::Accept && in_track >= opt_.burn_in && std::isfinite(inn.nis);
+      if (inn.decision == GateDecision::Start || inn.decision == GateDecision::Restart) in_track = 0;
+      in_track += fused;
+      used += fused;
+      rejected += !fused;
       if (counted) {
         r.nis.add(inn.nis, 2.0);
         if (series != nullptr) {
@@ -199,23 +146,21 @@ private:
         }
         ++sample;
       }
-      if (inn_csv != nullptr) {
-        const double nan = std::nan("");
-        inn_csv->row({static_cast<double>(tr.index), static_cast<double>(lm.m.id), static_cast<double>(lm.m.camera), lm.m.t,
-                      inn.valid ? inn.d(0) : nan, inn.valid ? inn.d(1) : nan, inn.valid ? inn.S(0, 0) : nan,
-                      inn.valid ? inn.S(0, 1) : nan, inn.valid ? inn.S(1, 1) : nan, inn.valid ? inn.nis : nan,
-                      fused ? 1.0 : 0.0, counted ? 1.0 : 0.0});
-      }
-      if (!fused || !tracker.initialised()) continue;
+      if (inn_csv != nullptr)
+        inn_csv->row({static_cast<double>(tr.index), static_cast<double>(inn.id), static_cast<double>(inn.source), inn.t,
+                      inn.nis, static_cast<double>(static_cast<int>(inn.decision)), fused ? 1.0 : 0.0,
+                      counted ? 1.0 : 0.0});
+      if (!fused || fused_count >= static_cast<int>(estimates.size())) continue;
+      const runtime::EstimateRecord& e = *estimates[static_cast<std::size_t>(fused_count)];
       ++fused_count;
-      const estimation::StateEstimate& s = tracker.state();
+      const estimation::StateEstimate s(e.x, e.P, e.t);
       const Eigen::VectorXd xt = trueState(s.t());
       if (truth && fused_count == opt_.nees_fused) r.nees.add(estimation::nees(s, xt), 6.0);
-      const double e = (s.x().head<3>() - xt.head<3>()).norm();
-      if (ro.live) ro.live({s.t(), e, counted ? inn.nis : -1.0});
+      const double d = (s.x().head<3>() - xt.head<3>()).norm();
+      if (ro.live) ro.live({s.t(), d, counted ? inn.nis : -1.0});
       if (keep_err) {
         err.x.push_back(s.t());
-        err.y.push_back(e);
+        err.y.push_back(d);
       }
       if (keep_traj) {
         tru.x.push_back(xt(0));
@@ -226,6 +171,7 @@ private:
         if (!half_state && 2 * fused_count >= tr.fused) half_state = s;
       }
     }
+    mismatch += static_cast<std::size_t>(std::abs(used - tr.fused) + std::abs(rejected - tr.gated));
     if (series == nullptr) return;
     if (truth && !err.x.empty()) series->error.push_back(err);
     if (truth && !tru.x.empty()) series->truth.push_back(tru);

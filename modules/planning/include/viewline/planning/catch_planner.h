@@ -1,5 +1,5 @@
 #pragma once
-// Interception planner of the ball catcher ([L] §VI.C, issue 5): moves the hole of a box to the
+// Interception planner of the ball catcher ([L] §VI.C): moves the hole of a box to the
 // point where a tracked ball will cross the box-front plane, in time, under the robot's limits.
 //
 // Geometry: the hole centre h(t) is the robot's tool point; the box front is the plane through
@@ -38,8 +38,8 @@ struct CatchPlannerConfig {
   CrossingModel model;
   Eigen::Vector3d home = Eigen::Vector3d(0.0, 0.0, 1.2);   ///< hole centre at rest, world, m
   Eigen::Vector3d normal = Eigen::Vector3d::UnitX();         ///< box-front normal (unit, towards the thrower)
-  robots::CartesianLimits limits;                            ///< per-axis limits of the hole
-  double latency = 0.0;           ///< robot command latency, s (the box follows set points this late)
+  robots::CartesianLimits limits;                            ///< per-axis limits of the hole (robot's, see below)
+  double latency = 0.0;           ///< robot command latency, s (the box follows set points this late; robot's)
   double start_sigma = 0.15;      ///< m, start moving below this crossing-point std
   double commit_sigma = 0.01;     ///< m, commit the target below this std
   int commit_min_updates = 3;     ///< updates (fused images) before a commitment
@@ -70,6 +70,9 @@ class CatchPlanner {
 public:
   /// `workspace(p)`: can the hole be at p (robot workspace / IK); empty = everywhere.
   explicit CatchPlanner(CatchPlannerConfig cfg, std::function<bool(const Eigen::Vector3d&)> workspace = {});
+  /// The planner of `robot` (which must outlive it): the limits, the command latency and the
+  /// workspace are asked from the robot, their owner (cfg's limits and latency are ignored).
+  CatchPlanner(CatchPlannerConfig cfg, const robots::CartesianRobot& robot);
 
   /// New throw: the commanded state is (p, v) at time t, phase Idle.
   void reset(double t, const Eigen::Vector3d& p, const Eigen::Vector3d& v = Eigen::Vector3d::Zero());

@@ -1,4 +1,4 @@
-#include "viewline/scenarios/ball_catching_display.h"
+#include "viewline/viz/ball_catching_display.h"
 
 #include <Eigen/Eigenvalues>
 #include <cmath>
@@ -10,17 +10,18 @@
 #include <visp3/gui/vpDisplayX.h>
 
 #include "viewline/core/error.h"
+#include "viewline/viz/display_controls.h"
 
-namespace viewline::scenarios {
+namespace viewline::viz {
 
 #if defined(VISP_HAVE_X11)
 struct BallCatchingDisplay::Impl {
   std::vector<std::unique_ptr<vpImage<vpRGBa>>> images;
   std::vector<std::unique_ptr<vpDisplayX>> displays;
-  explicit Impl(const BallCatchingConfig& cfg) {
-    const std::size_t n = cfg.camera_count > 0 ? cfg.camera_count : cfg.cameras.size();
+  DisplayControls controls;
+  explicit Impl(const scenarios::BallCatchingConfig& cfg) {
     int x = 0;
-    for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t i = 0; i < cfg.activeCameras(); ++i) {
       const auto& c = cfg.cameras[i];
       images.push_back(std::make_unique<vpImage<vpRGBa>>(c.height, c.width));
       displays.push_back(std::make_unique<vpDisplayX>());
@@ -33,7 +34,7 @@ struct BallCatchingDisplay::Impl {
 struct BallCatchingDisplay::Impl {};
 #endif
 
-BallCatchingDisplay::BallCatchingDisplay(const BallCatchingConfig& cfg) {
+BallCatchingDisplay::BallCatchingDisplay(const scenarios::BallCatchingConfig& cfg) {
 #if defined(VISP_HAVE_X11)
   impl_ = std::make_unique<Impl>(cfg);
 #else
@@ -44,9 +45,9 @@ BallCatchingDisplay::BallCatchingDisplay(const BallCatchingConfig& cfg) {
 
 BallCatchingDisplay::~BallCatchingDisplay() = default;
 
-void BallCatchingDisplay::show(const CatchFrame& f) {
+bool BallCatchingDisplay::show(const scenarios::CatchFrame& f) {
 #if defined(VISP_HAVE_X11)
-  if (f.camera >= impl_->images.size() || !f.image || !f.camera_model) return;
+  if (f.camera >= impl_->images.size() || !f.image || !f.camera_model) return !impl_->controls.quitRequested();
   vpImage<vpRGBa>& I = *impl_->images[f.camera];
   vpImageConvert::convert(*f.image, I);
   vpDisplay::display(I);
@@ -69,13 +70,21 @@ void BallCatchingDisplay::show(const CatchFrame& f) {
     }
   }
   char text[160];
-  std::snprintf(text, sizeof text, "throw %d  t = %.3f s%s", f.throw_index, f.t,
-                f.crossing ? "  target set" : "");
+  std::snprintf(text, sizeof text, "throw %d  t = %.3f s%s", f.throw_index, f.t, f.crossing ? "  target set" : "");
   vpDisplay::displayText(I, 14, 6, text, vpColor::yellow);
+  impl_->controls.drawLegend(I);
   vpDisplay::flush(I);
+  return impl_->controls.poll(I);
 #else
   (void)f;
+  return true;
 #endif
 }
 
-}  // namespace viewline::scenarios
+void BallCatchingDisplay::waitForClose() {
+#if defined(VISP_HAVE_X11)
+  if (!impl_->images.empty()) impl_->controls.waitForClose(*impl_->images.front());
+#endif
+}
+
+}  // namespace viewline::viz

@@ -1,0 +1,299 @@
+#include "viewline/scenarios/ball_catching/loop.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <exception>
+#include <mutex>
+#include <string>
+#include <thread>
+
+#include "viewline/core/error.h"
+#include "viewline/core/frames.h"
+#include "viewline/core/random.h"
+#include "viewline/io/log.h"
+#include "viewline/runtime/delay_line.h"
+#include "viewline/scenarios/ball_catching/world.h"
+#include "viewline/tracking/tracker.h"
+#include "viewline/vision/ball_detector.h"
+
+namespace viewline::scenarios {
+
+namespace {
+
+using Vector6 = Eigen::Matrix<double, 6, 1>;
+
+// The tracker's verdict on one submitted image, as a gate decision (tracking::TrackGate's terms).
+tracking::GateDecision decisionOf(const tracking::MeasurementOutcome& o, bool restarted) {
+  if (o.fate != tracking::Fate::Fused) return tracking::GateDecision::Reject;
+  if (restarted) return tracking::GateDecision::Restart;
+  return o.seed ? tracking::GateDecision::Start : tracking::GateDecision::Accept;
+}
+
+// Everything one throw owns, and what happens at its two kinds of event: the control tick and
+// a frame becoming ready.
+class ThrowLoop {
+public:
+  ThrowLoop(const BallCatchingConfig& cfg, const sim::DragFlight& flight, RigFrameSource& source,
+            std::vector<core::Camera> est_cams, robots::SimulatedCartesianRobot& robot, ThrowResult& res,
+            const CatchHooks* hooks, runtime::TelemetrySink* tel, std::uint64_t seed)
+      : cfg_(cfg), flight_(flight), source_(source), est_cams_(std::move(est_cams)), robot_(robot),
+        planner_(cfg.plannerConfig(), robot), tracker_(est_cams_, cfg.tracker), res_(res), hooks_(hooks), tel_(tel),
+        noise_rng_(core::makeRng(core::deriveSeed(seed, 0xD37))) {  // pixel_noise_px only
+    planner_.reset(0.0, cfg.robot.home);
+    for (const auto& c : est_cams_) detectors_.emplace_back(cfg.detector, c);
+  }
+
+  // Control period: the estimates that have arrived reach the planner, then one set point.
+  void tick(double t) {
+    to_planner_.receive(t, [&](double t_avail, const estimation::StateEstimate& est) {
+      const planning::PlannerUpdate u = planner_.update(t_avail, est);
+      if (u.crossing && t_avail <= res_.t_cross - cfg_.prediction_lead_s) lead_prediction_ = u.crossing->p;
+      if (tel_ && u.crossing) {
+        Eigen::VectorXd x(4);
+        x << u.crossing->t, u.crossing->p;
+        Eigen::MatrixXd P = Eigen::MatrixXd::Zero(4, 4);
+        P(0, 0) = u.crossing->var_t;
+        P.bottomRightCorner<3, 3>() = u.crossing->cov_p;
+        tel_->estimate({"crossing", t_avail, x, P});
+      }
+    });
+    const robots::CartesianState sp = planner_.setpoint(t);
+    robot_.command(sp);
+    if (tel_) {
+      Eigen::VectorXd u(6);
+      u << sp.p, sp.v;
+      tel_->command({"setpoint", t, u});
+    }
+  }
+
+  // A frame is ready: grab, detect, track; the estimate leaves for the planner. Returns false
+  // when the live view asks to stop.
+  bool capture() {
+    const std::optional<runtime::Frame> frame = source_.grab();
+    if (!frame) return true;  // dropped
+    ++res_.frames;
+    const std::size_t ci = frame->camera;
+    const sim::ObjectTruth* truth = source_.lastTruthOf(cfg_.object);
+    if (truth && truth->in_front && truth->in_image && res_.t_first_visible < 0.0)
+      res_.t_first_visible = frame->capture_time;
+    if (tel_ && truth) tel_->estimate({"truth", frame->capture_time, flight_.state(frame->capture_time).p, {}});
+    const std::optional<Eigen::Vector2d> det_px = measure(*frame);
+    if (!hooks_ || !hooks_->on_frame) return true;
+    CatchFrame f;
+    f.throw_index = res_.index;
+    f.camera = ci;
+    f.camera_model = &est_cams_[ci];
+    f.t = frame->capture_time;
+    f.image = &frame->image;
+    f.detection = det_px;
+    f.crossing = planner_.target();
+    f.hole = robot_.read(frame->capture_time).p;
+    if (tracker_.initialised()) f.estimate = tracker_.state().x().head<3>();
+    return hooks_->on_frame(f);
+  }
+
+  const planning::CatchPlanner& planner() const { return planner_; }
+  const std::optional<Eigen::Vector3d>& leadPrediction() const { return lead_prediction_; }
+
+private:
+  // Detection (searching around the tracker's predicted pixel) and the tracker update. Returns
+  // the pixel given to the tracker.
+  std::optional<Eigen::Vector2d> measure(const runtime::Frame& frame) {
+    const std::size_t ci = frame.camera;
+    std::optional<Eigen::Vector2d> predicted;
+    if (tracker_.initialised()) {
+      const double tp = std::max(frame.stamp, tracker_.state().t());
+      if (auto uv = est_cams_[ci].project(tracker_.predictAt(tp).x().head<3>())) predicted = *uv;
+    }
+    const auto det = detectors_[ci].detect(frame.image, frame.stamp, predicted);
+    if (!det.ok()) return std::nullopt;
+    ++res_.detections;
+    if (res_.t_first_detection < 0.0) res_.t_first_detection = frame.capture_time;
+    const double sigma_det = std::max(cfg_.sigma_px_floor, std::sqrt(0.5 * det.value().pixel_covariance.trace()));
+    const double sigma = std::hypot(sigma_det, cfg_.pixel_noise_px);  // the tracker is told the added noise
+    Eigen::Vector2d px = det.value().pixel;
+    if (cfg_.pixel_noise_px > 0.0)
+      px += cfg_.pixel_noise_px * Eigen::Vector2d(core::gaussian(noise_rng_), core::gaussian(noise_rng_));
+    const tracking::ImageMeasurement m{next_id_++, ci, frame.stamp, px, sigma};
+    if (tel_) tel_->measurement({"camera" + std::to_string(ci), m.t, m.id, m.uv, Eigen::Vector2d::Constant(sigma)});
+    const int restarts_before = tracker_.trackState().restarts;
+    if (tracker_.submit(m) != tracking::Refusal::None) return px;
+    const auto o = tracker_.outcome(m.id);
+    const bool fused = o && o->fate == tracking::Fate::Fused;
+    if (fused) ++res_.fused;
+    else ++res_.gated;
+    if (fused && tracker_.initialised()) to_planner_.send(frame.stamp + cfg_.processing_latency, tracker_.state());
+    if (tel_ && o) report(m, *o, tracker_.trackState().restarts > restarts_before);
+    return px;
+  }
+
+  void report(const tracking::ImageMeasurement& m, const tracking::MeasurementOutcome& o, bool restarted) {
+    runtime::InnovationRecord r;
+    r.channel = "ball";
+    r.t = m.t;
+    r.id = m.id;
+    r.source = m.camera;
+    r.rows = 2;  // one image: its two viewline rows
+    r.decision = decisionOf(o, restarted);
+    // The tracker's own gate statistic (dᵀ S⁻¹ d); it does not expose d and S themselves.
+    if (r.decision != tracking::GateDecision::Start) r.nis = o.gate.mahalanobis;
+    tel_->innovation(r);
+    if (o.fate == tracking::Fate::Fused)
+      tel_->estimate({"ball", tracker_.state().t(), tracker_.state().x(), tracker_.state().P()});
+  }
+
+  const BallCatchingConfig& cfg_;
+  const sim::DragFlight& flight_;
+  RigFrameSource& source_;
+  std::vector<core::Camera> est_cams_;
+  robots::SimulatedCartesianRobot& robot_;
+  planning::CatchPlanner planner_;
+  tracking::ViewlineTracker tracker_;
+  std::vector<vision::BallDetector> detectors_;
+  ThrowResult& res_;
+  const CatchHooks* hooks_;
+  runtime::TelemetrySink* tel_;
+  core::Rng noise_rng_;
+  runtime::DelayLine<estimation::StateEstimate> to_planner_;  // processing latency
+  std::optional<Eigen::Vector3d> lead_prediction_;
+  std::uint64_t next_id_ = 1;
+};
+
+}  // namespace
+
+ThrowResult runThrow(const BallCatchingConfig& cfg, const sim::Scene& room, int index, std::uint64_t seed,
+                     const CatchHooks* hooks, bool* interrupted) {
+  const auto wall0 = std::chrono::steady_clock::now();
+  ThrowResult res;
+  res.index = index;
+  res.seed = seed;
+  core::Rng rng = core::makeRng(seed);
+  std::shared_ptr<runtime::TelemetrySink> telemetry = hooks && hooks->telemetry ? hooks->telemetry(index) : nullptr;
+  runtime::TelemetrySink* tel = telemetry.get();
+
+  // 1. The throw and its true crossing of the plane through home (the planner moves the hole in
+  // that plane; scoreThrow checks it against the robot's actual position).
+  const ThrowDraw d = drawThrow(cfg, rng);
+  res.release = d.release;
+  res.launch_velocity = d.launch_velocity;
+  res.launch_speed = d.launch_velocity.norm();
+  res.launch_elevation_deg = core::rad2deg(std::atan2(d.launch_velocity.z(), d.launch_velocity.head<2>().norm()));
+  res.distance = d.distance;
+  const sim::DragFlight flight({d.release, d.launch_velocity}, 0.0, d.flight_time + cfg.post_crossing_s + 0.3,
+                               cfg.throws.body);
+  res.t_cross = crossingTime(flight, cfg.robot.home, cfg.box_normal);
+  res.cross_true = flight.state(res.t_cross).p;
+  const double t_end = res.t_cross + cfg.post_crossing_s;
+
+  // 2. Robot, cameras (random phase per throw), and the loop's estimators.
+  robots::SimulatedCartesianRobot robot(cfg.robot);
+  robot.reset(0.0);
+  const CatchWorld world(room, flight, cfg, robot);
+  RigFrameSource source(throwCameras(cfg, rng), rng, cfg.render, world, t_end);
+  std::vector<core::Camera> est_cams;  // calibrated (rig:) or the render camera (inline cameras)
+  for (std::size_t i = 0; i < cfg.activeCameras(); ++i) est_cams.push_back(cfg.cameras[i].estimatorCamera());
+  ThrowLoop loop(cfg, flight, source, std::move(est_cams), robot, res, hooks, tel, seed);
+
+  // 3. One clock: the control tick every period, the next frame when it is ready.
+  runtime::Scheduler sched;
+  if (hooks) sched.setPacing(hooks->pacing);
+  sched.every(0.0, cfg.control_period, runtime::priority::Control, [&](double t) { loop.tick(t); });
+  bool source_done = false;
+  std::function<void()> next_capture = [&] {
+    const std::optional<double> t_ready = source.nextReadyTime();
+    if (!t_ready) {
+      source_done = true;
+      return;
+    }
+    // A frame ready before now (an earlier end of exposure on another camera) is taken at once.
+    sched.at(std::max(*t_ready, sched.now()), runtime::priority::Capture, [&](double) {
+      if (!loop.capture()) sched.requestStop();
+      next_capture();
+    });
+  };
+  next_capture();
+  while (!source_done && sched.step()) {
+  }
+  // The set points in flight reach the box after the last frame.
+  if (!sched.stopRequested()) sched.runUntil(t_end + robot.commandLatency() + cfg.control_period);
+  if (interrupted) *interrupted = sched.stopRequested();
+
+  // 4. Outcome.
+  scoreThrow(res, cfg, robot, loop.planner(), loop.leadPrediction());
+  res.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  if (tel) tel->flush();
+  return res;
+}
+
+std::function<std::shared_ptr<runtime::TelemetrySink>(int)> csvTelemetry(const std::string& dir) {
+  return [dir](int i) -> std::shared_ptr<runtime::TelemetrySink> {
+    char name[32];
+    std::snprintf(name, sizeof name, "/throw_%03d", i);
+    auto log = std::make_shared<io::LogDirectory>(dir + name);
+    // The sink keeps its folder alive; both go (files closed) when the throw drops the sink.
+    return std::shared_ptr<runtime::CsvSink>(new runtime::CsvSink(*log), [log](runtime::CsvSink* s) { delete s; });
+  };
+}
+
+CatchSummary runBallCatching(const BallCatchingConfig& cfg, int throws, std::uint64_t seed, const CatchHooks& hooks) {
+  if (throws < 1) throw core::InvalidInput("throws: expected >= 1");
+  cfg.validate();
+  const auto wall0 = std::chrono::steady_clock::now();
+  core::Rng room_rng = core::makeRng(core::deriveSeed(seed, 0xB0B));
+  const sim::Scene room = sim::makeRoom(cfg.room, room_rng);
+  std::optional<RegistrationResult> registration;
+  BallCatchingConfig registered = cfg;  // estimator cameras in the robot's world
+  if (cfg.registration.enabled) registration = registerCamerasToRobot(registered, room, core::deriveSeed(seed, 0x4E6));
+  std::vector<ThrowResult> results(static_cast<std::size_t>(throws));
+  std::vector<char> completed(static_cast<std::size_t>(throws), 0);
+  const bool serial = static_cast<bool>(hooks.on_frame) || cfg.threads <= 1;
+  std::atomic<int> next{0}, done{0};
+  std::mutex mu;
+  std::exception_ptr error;
+  auto worker = [&]() {
+    while (true) {
+      const int i = next++;
+      if (i >= throws) return;
+      bool interrupted = false;
+      try {
+        const auto k = static_cast<std::size_t>(i);
+        results[k] = runThrow(registered, room, i, core::deriveSeed(seed, static_cast<std::uint64_t>(i)), &hooks,
+                              &interrupted);
+        completed[k] = !interrupted;
+      } catch (...) {
+        std::lock_guard<std::mutex> lock(mu);
+        if (!error) error = std::current_exception();
+        next = throws;
+        return;
+      }
+      if (interrupted) {
+        next = throws;  // the live view was closed: no more throws
+        return;
+      }
+      const int dn = ++done;
+      if (hooks.progress) {
+        std::lock_guard<std::mutex> lock(mu);
+        hooks.progress(dn, throws);
+      }
+    }
+  };
+  if (serial) {
+    worker();
+  } else {
+    std::vector<std::thread> pool;
+    for (int t = 0; t < cfg.threads; ++t) pool.emplace_back(worker);
+    for (auto& t : pool) t.join();
+  }
+  if (error) std::rethrow_exception(error);
+  std::vector<ThrowResult> kept;
+  for (std::size_t k = 0; k < results.size(); ++k)
+    if (completed[k]) kept.push_back(std::move(results[k]));
+  CatchSummary s = summarise(std::move(kept), seed, std::move(registration));
+  s.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  return s;
+}
+
+}  // namespace viewline::scenarios

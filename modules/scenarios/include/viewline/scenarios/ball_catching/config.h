@@ -1,0 +1,144 @@
+#pragma once
+// Ball catching ([L] §VI.C): the scenario's configuration, read once from YAML
+// (config/ball_catching.yaml documents every key; unknown keys are errors) and validated once.
+//
+// One owner per value: the robot's limits and command latency belong to the robot config
+// (robots::SimulatedCartesianConfig) and the planner asks the robot for them when it is built
+// (planning::CatchPlanner(cfg, robot)); the drag of the known ball belongs to the throw's body;
+// the box rotation is derived from the box normal when the file is read.
+
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "viewline/core/camera.h"
+#include "viewline/io/config.h"
+#include "viewline/planning/catch_planner.h"
+#include "viewline/robots/cartesian_robot.h"
+#include "viewline/sim/physics.h"
+#include "viewline/sim/renderer.h"
+#include "viewline/sim/worlds.h"
+#include "viewline/tracking/tracker.h"
+#include "viewline/vision/ball_detector.h"
+
+namespace viewline::scenarios {
+
+struct CatchCameraConfig {
+  std::string name = "camera";
+  unsigned width = 640, height = 480;
+  double hfov_rad = 1.0471975511965976;  ///< 60°
+  double cx = -1.0, cy = -1.0;           ///< principal point, px (< 0: image centre)
+  double kud = 0.0;                      ///< ViSP forward radial distortion
+  Eigen::Vector3d position = Eigen::Vector3d(1.0, -3.2, 1.9);
+  Eigen::Vector3d look_at = Eigen::Vector3d(2.2, 0.0, 1.3);
+  double rate_hz = 50.0;
+  double drift = 0.0;                 ///< relative clock period error
+  double exposure_s = 0.002;          ///< motion blur exposure (0: none)
+  int blur_samples = 3;
+  double noise_sigma = 2.0;           ///< grey levels
+  double drop_probability = 0.0;
+  double trigger_jitter_s = 0.0002;
+  double stamp_jitter_s = 0.0;
+  /// With a `rig:` (scenarios::loadSimulatedRig): the TRUE camera the simulator renders with
+  /// (truth.yaml) and the CALIBRATED one the detector and tracker use (rig.yaml); the geometry
+  /// fields above are then unused (width/height are copied from the truth). Without a rig both are
+  /// built from the fields above: a perfectly calibrated rig.
+  std::optional<core::Camera> true_camera, calibrated_camera;
+  core::Camera renderCamera() const;     ///< true_camera, or the one built from the fields
+  core::Camera estimatorCamera() const;  ///< calibrated_camera, or the one built from the fields
+};
+
+struct ThrowDistribution {
+  Eigen::Vector3d release_min = Eigen::Vector3d(-1.0, -0.3, 1.0);  ///< m (x: 3-5 m from the box at x = 4)
+  Eigen::Vector3d release_max = Eigen::Vector3d(1.0, 0.3, 1.6);
+  double aim_radius = 0.35;         ///< m, aim points uniform in this disc around home (box plane)
+  double speed_min = 6.0;           ///< m/s, mean horizontal speed
+  double speed_max = 9.0;
+  sim::DragBody body = sim::DragBody::ball5cm();  ///< 5 cm ball, 57 g, Cd 0.5, ρ 1.2 (k ≈ 0.0103 /m)
+};
+
+/// Camera-to-robot registration, once per session before the throws (config `registration:`).
+/// The catcher needs the ball in the ROBOT's frame to a few mm (5 mm clearance), but a rig
+/// calibrated from board views carries ~1 px / 5-10 mm of pose error per camera (docs/results.md).
+/// So, as a real catcher would (eye-to-hand): a green marker sphere sits on the box top at a known
+/// offset from the hole; the robot holds the box still at a grid of set points around home, every
+/// configured camera renders it, the detector finds the marker (searching only around where the
+/// calibrated camera expects it), and each camera's pose c_M_w is re-estimated by PnP (Levenberg-
+/// Marquardt from the calibrated pose, calibrated intrinsics) from the known marker positions
+/// (robot kinematics: set point + offset) and their detections. Nothing of the truth is used but
+/// the robot's own set points. Detections beyond gate_px of the expected pixel are dropped, then
+/// residuals above 3x the median after a first solve; cameras with fewer than min_points detections,
+/// or whose registration fits badly (max_rms_px) or moves them implausibly far (max_shift_m,
+/// max_rotation_deg), keep their calibrated pose.
+struct CatchRegistration {
+  bool enabled = false;  ///< off unless the config's registration.enabled says so
+  Eigen::Vector3d marker_offset = Eigen::Vector3d(0.15, 0.0, 0.175);  ///< m, from the hole centre (world axes)
+  double marker_radius = 0.025;
+  Eigen::Vector3d marker_albedo_bgr = Eigen::Vector3d(0.15, 0.75, 0.15);  ///< green
+  vision::ColorRange marker_hsv{35, 85, 80, 255, 30, 255};
+  std::vector<double> offsets_x{-0.08, 0.08}, offsets_y{-0.4, 0.0, 0.4}, offsets_z{-0.3, 0.0, 0.3};  ///< m, from home
+  int min_points = 6;
+  double gate_px = 10.0;          ///< detections farther than this from the expected pixel are dropped
+  double max_rms_px = 0.5;        ///< refuse a camera's registration above this reprojection RMS,
+  double max_shift_m = 0.05;      ///< or moving its centre more than this,
+  double max_rotation_rad = 0.0087;  ///< or rotating it more than this (0.5°)
+};
+
+struct BallCatchingConfig {
+  std::string name = "ball_catching";
+  std::string rig;                   ///< rig folder as resolved ("" : inline cameras)
+  std::vector<CatchCameraConfig> cameras;
+  std::size_t camera_count = 0;      ///< use the first N cameras (0: all)
+  double rate_override_hz = 0.0;     ///< > 0: every camera at this rate (throws; registration keeps rate_hz)
+  ThrowDistribution throws;
+  Eigen::Vector3d ball_albedo_bgr = Eigen::Vector3d(0.08, 0.45, 0.95);  ///< orange (dart: flight colour)
+  /// "ball" (a sphere of the body's radius) or "dart" (sim::makeDart oriented along its velocity;
+  /// the detector then finds the coloured flights, 5 cm behind the centre of mass, and the
+  /// tracked point is theirs: its crossing point lies on the same flight line).
+  std::string object = "ball";
+  double hole_radius = 0.03;         ///< m (6 cm hole)
+  Eigen::Vector3d box_normal = -Eigen::Vector3d::UnitX();  ///< box-front normal (unit), towards the thrower
+  double box_size = 0.3;             ///< m, cube side (rendered)
+  bool render_box = true;
+  robots::SimulatedCartesianConfig robot;   ///< kind, limits, latency, home, workspace, arm geometry (w_R_box from box_normal)
+  double control_period = 0.004;     ///< s between set points (250 Hz)
+  double processing_latency = 0.008; ///< s from capture to the tracker/planner update
+  double post_crossing_s = 0.05;     ///< s simulated after the true crossing
+  double prediction_lead_s = 0.2;    ///< the early-prediction metric uses the last prediction this long before the crossing
+  vision::BallDetectorConfig detector;
+  double sigma_px_floor = 0.3;       ///< px, floor of the measurement std given to the tracker
+  /// px per axis: white Gaussian noise added to every detected pixel (pixel-noise table; 0: none).
+  /// The tracker is told: its σ is the detector's σ and this one added in quadrature. Drawn from
+  /// its own stream (deriveSeed(throw seed, 0xD37)), so the rest of a throw is unchanged.
+  double pixel_noise_px = 0.0;
+  tracking::TrackerConfig tracker;
+  /// The planner's own settings (model, thresholds). Home, limits and latency are the robot's and
+  /// the plane normal is the box's: plannerConfig() and CatchPlanner(cfg, robot) ask their owners.
+  planning::CatchPlannerConfig planner;
+  CatchRegistration registration;
+  sim::RenderSettings render;
+  sim::RoomParams room;
+  int threads = 2;                   ///< throws run in parallel (independent seeds: same results)
+
+  /// The cameras a throw uses: the first camera_count (all when 0).
+  std::size_t activeCameras() const { return camera_count > 0 ? camera_count : cameras.size(); }
+  /// Frame rate of camera i in a throw (rate_override_hz when set).
+  double throwRate(std::size_t i) const { return rate_override_hz > 0.0 ? rate_override_hz : cameras[i].rate_hz; }
+  /// The planner settings with what the planner takes from the world: the crossing plane (home,
+  /// box normal), gravity and the known ball's drag. Limits and latency come from the robot.
+  planning::CatchPlannerConfig plannerConfig() const;
+  /// Throws core::InvalidInput naming the key. loadBallCatchingConfig() calls it; code that edits
+  /// a loaded config (benches, tests) calls it again through runBallCatching().
+  void validate() const;
+};
+
+/// Reads the YAML scenario (documented in config/ball_catching.yaml); unknown keys are errors.
+/// Validated before it returns.
+BallCatchingConfig loadBallCatchingConfig(const io::ConfigNode& node);
+
+/// Orientation of the box whose front face has unit normal n (z = n, x horizontal).
+Eigen::Matrix3d boxRotation(const Eigen::Vector3d& n);
+
+}  // namespace viewline::scenarios

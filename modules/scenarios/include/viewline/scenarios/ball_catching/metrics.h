@@ -1,0 +1,109 @@
+#pragma once
+// Ball catching: what one throw and a session measure.
+//
+// Caught = the ball centre crosses the (moving) box-front plane within hole_radius − ball_radius
+// of the hole centre (5 mm for a 6 cm hole and a 5 cm ball); the true crossing is found on the
+// true flight against the robot's actual hole position at that instant.
+//
+// Reachability (the oracle): a throw is reachable when a robot that knows the true flight from
+// the first capture in which the ball is inside at least one camera's image (truth of the
+// rendered frame), starting at home at rest with the same limits and command latency, could put
+// the hole exactly on the true crossing point by the crossing time:
+//     t_first_visible + latency + T_min(home -> crossing) <= t_cross
+// (T_min from the same synchronised profile generator; no processing latency).
+//
+// Miss reasons (each missed throw gets exactly one):
+//   not_reachable  the oracle could not have caught it;
+//   lost_track     reachable, but the planner never had a target (too few / no detections, or
+//                  the crossing prediction never became certain enough to move);
+//   late           the hole was more than the clearance away from the planner's final target
+//                  at the crossing (still moving, or the planner gave up);
+//   off_target     the hole was at the planner's final target but the prediction was off.
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "viewline/io/log.h"
+#include "viewline/planning/catch_planner.h"
+#include "viewline/robots/cartesian_robot.h"
+#include "viewline/scenarios/ball_catching/config.h"
+#include "viewline/scenarios/ball_catching/registration.h"
+
+namespace viewline::scenarios {
+
+struct ThrowResult {
+  int index = 0;
+  std::uint64_t seed = 0;
+  // Throw
+  Eigen::Vector3d release = Eigen::Vector3d::Zero(), launch_velocity = Eigen::Vector3d::Zero();
+  double launch_speed = 0.0, launch_elevation_deg = 0.0, distance = 0.0;
+  // Truth
+  double t_cross = 0.0;                                 ///< true crossing time (release at 0)
+  Eigen::Vector3d cross_true = Eigen::Vector3d::Zero(); ///< true crossing point
+  double t_first_visible = -1.0;                        ///< first capture with the ball in an image
+  bool reachable = false;
+  double oracle_time = 0.0;                             ///< T_min home -> crossing, s
+  // Run
+  int frames = 0, detections = 0, fused = 0, gated = 0;
+  double t_first_detection = -1.0;
+  double t_first_move = -1.0;                           ///< planner's first move towards a target
+  bool had_target = false, committed = false, gave_up = false;
+  double give_up_lead = -1.0;                           ///< true crossing − give-up decision, s
+  double decision_time = -1.0;                          ///< commit − first update, s
+  Eigen::Vector3d target = Eigen::Vector3d::Zero();     ///< planner's final target
+  double prediction_error = -1.0;                       ///< |target − true crossing|, m
+  double prediction_error_lead = -1.0;                  ///< same, last prediction >= prediction_lead_s before it
+  Eigen::Vector3d hole_at_cross = Eigen::Vector3d::Zero();
+  double miss_distance = 0.0;                           ///< in-plane |ball − hole| at the crossing, m
+  bool caught = false;
+  std::string miss_reason;                              ///< "" when caught
+  std::size_t limit_violations = 0, refused_setpoints = 0;
+  double wall_s = 0.0;
+};
+
+struct CatchSummary {
+  std::uint64_t seed = 0;
+  int throws = 0, reachable_throws = 0, caught = 0, caught_reachable = 0;
+  double catch_rate_all = 0.0, catch_rate_reachable = 0.0;
+  std::map<std::string, int> miss_reasons;
+  double prediction_error_mm_median = 0.0, prediction_error_mm_p95 = 0.0;
+  double prediction_error_lead_mm_median = 0.0, prediction_error_lead_mm_p95 = 0.0;
+  int predictions_at_lead = 0;
+  double decision_time_s_median = 0.0, decision_time_s_p95 = 0.0;
+  int decisions = 0;
+  int gave_up_unreachable = 0;   ///< not-reachable throws the planner gave up on (early decision)
+  int gave_up_reachable = 0;     ///< reachable throws it gave up on (wrong decisions)
+  double give_up_lead_s_median = 0.0;  ///< how long before the crossing it gave up (unreachable ones)
+  double miss_distance_mm_median_reachable = 0.0;
+  std::size_t limit_violations = 0, refused_setpoints = 0;
+  int frames = 0, detections = 0;
+  double detection_rate = 0.0;
+  std::optional<RegistrationResult> registration;
+  double launch_speed_min = 0.0, launch_speed_max = 0.0, launch_speed_mean = 0.0;
+  double elevation_deg_min = 0.0, elevation_deg_max = 0.0;
+  double flight_time_min = 0.0, flight_time_max = 0.0;
+  double wall_s = 0.0, ms_per_frame = 0.0;
+  std::vector<ThrowResult> results;
+};
+
+/// The end of a throw: caught or not (and why), the oracle, the planner's decisions, the robot's
+/// limit counters. `lead_prediction`: the last predicted crossing available prediction_lead_s or
+/// more before the true crossing.
+void scoreThrow(ThrowResult& res, const BallCatchingConfig& cfg, const robots::SimulatedCartesianRobot& robot,
+                const planning::CatchPlanner& planner, const std::optional<Eigen::Vector3d>& lead_prediction);
+
+/// The session's figures over `results` (in throw order); wall_s is left to the caller.
+CatchSummary summarise(std::vector<ThrowResult> results, std::uint64_t seed,
+                       std::optional<RegistrationResult> registration);
+
+nlohmann::json summaryJson(const CatchSummary& s, const BallCatchingConfig& cfg);
+
+/// One row per throw (throws.csv in a --log folder).
+void writeThrowsCsv(io::LogDirectory& log, const std::vector<ThrowResult>& results);
+
+}  // namespace viewline::scenarios
