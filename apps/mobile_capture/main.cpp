@@ -22,12 +22,13 @@ using namespace viewline;
 int main(int argc, char** argv) {
   CLI::App cli{"Mobile capture: differential-drive robot with a pan/tilt camera, curvilinear-target EKF, "
                "least-squares path prediction and [K]'s shortest-time capture planner, on rendered images"};
-  apps::CommonOptions opt{"config/mobile_capture.yaml"};
+  apps::CommonOptions opt;
+  opt.config_path = "config/mobile_capture.yaml";
   int runs = 1, jobs = 0;
   apps::addCommonOptions(cli, opt);
   cli.add_option("--runs", runs, "number of capture runs (run i uses deriveSeed(seed, i))")->check(CLI::PositiveNumber);
   cli.add_option("--jobs", jobs, "worker threads (default: the config's threads)");
-  CLI11_PARSE(cli, argc, argv);
+  if (const auto code = apps::parseCommandLine(cli, argc, argv)) return *code;
   return apps::runGuarded("mobile_capture", [&] {
     auto cfg = scenarios::loadMobileCaptureConfig(io::loadConfigWithValues(opt.config_path, opt.sets));
     if (jobs > 0) cfg.threads = jobs;

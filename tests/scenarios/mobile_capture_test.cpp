@@ -2,6 +2,7 @@
 // command reported in docs/results.md.
 #include <gtest/gtest.h>
 
+#include <Eigen/Cholesky>
 #include <chrono>
 #include <cmath>
 

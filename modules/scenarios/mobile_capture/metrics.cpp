@@ -132,8 +132,7 @@ FovSweepResult compareGroundLocalization(const MobileCaptureConfig& cfg, std::ui
 MobileCaptureSummary runMobileCaptureBatch(const MobileCaptureConfig& cfg, int runs, std::uint64_t seed,
                                            const std::function<void(int, int)>& progress) {
   cfg.validate();
-  if (runs < 1) throw core::InvalidInstd::snprintf(line, sizeof line, "runs: expected >= 1");
-  out += line;
+  if (runs < 1) throw core::InvalidInput("runs: expected >= 1");
   const auto start = std::chrono::steady_clock::now();
   MobileCaptureSummary s;
   s.runs.resize(static_cast<std::size_t>(runs));

@@ -98,7 +98,7 @@ struct RenderedHeadCamera::Impl {
   long every;
   std::uint64_t next = 0;  // index of the next frame
 
-  static sim::Scene floor(const MobileCaptureConfig& cfg, core::Rng& room_rng) {
+  static sim::Scene makeFloor(const MobileCaptureConfig& cfg, core::Rng& room_rng) {
     sim::RoomParams room;
     room.floor_size = cfg.floor_size;
     room.walls = false;
@@ -116,7 +116,7 @@ struct RenderedHeadCamera::Impl {
       : cfg(c),
         rng(streams.render),
         camera_pose(std::move(pose)),
-        world(target, floor(c, streams.room)),
+        world(target, makeFloor(c, streams.room)),
         renderer(settings(c)),
         camera(renderCamera(c)),
         clock(TickClock::of(c)),

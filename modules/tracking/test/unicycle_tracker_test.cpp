@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Cholesky>
 #include <cmath>
 
 #include "viewline/core/error.h"
@@ -19,7 +20,7 @@ namespace {
 
 UnicycleTrackerConfig config() {
   UnicycleTrackerConfig c;
-  c.model.q_v = 0.01;
+  c.model.q_v = 0.0005;  // m²/s³
   c.model.q_w = 0.05;
   return c;
 }
@@ -120,7 +121,9 @@ TEST(UnicycleTracker, NeesAndNisAreConsistentOnTheModelsOwnMotion) {
   // floor positions): the time-averaged NEES (5 dof) and NIS (2 dof) over many runs must lie in
   // the chi-square band of their averages (Bar-Shalom et al. 2001, §5.4) — loosely: the EKF
   // linearises the heading, and the two-point start is not the true prior, so a settling time
-  // is skipped and the band is widened by 15 %.
+  // is skipped and the band is widened by 15 %. The speed random walk is slow enough (0.5 m/s
+  // ± 0.12 m/s over the run) that the object never stops: at a standstill the heading is not
+  // observable and no EKF stays consistent there.
   const UnicycleTrackerConfig cfg = config();
   const double dt = 0.1, sigma = 0.02, settle = 3.0;
   const int runs = 20, steps = 300;
@@ -130,7 +133,7 @@ TEST(UnicycleTracker, NeesAndNisAreConsistentOnTheModelsOwnMotion) {
     core::Rng rng = core::makeRng(core::deriveSeed(42, static_cast<std::uint64_t>(run)));
     UnicycleTracker tr(cfg);
     VectorXd x(5);
-    x << 0.0, 0.0, core::uniform(rng, -M_PI, M_PI), 0.3, 0.0;
+    x << 0.0, 0.0, core::uniform(rng, -M_PI, M_PI), 0.5, 0.0;
     for (int k = 0; k < steps; ++k) {
       const double t = k * dt;
       if (k > 0) {
@@ -138,6 +141,10 @@ TEST(UnicycleTracker, NeesAndNisAreConsistentOnTheModelsOwnMotion) {
         x[2] = estimation::wrapAngle(x[2]);
         x[3] += core::gaussian(rng, std::sqrt(cfg.model.q_v * dt));
         x[4] += core::gaussian(rng, std::sqrt(cfg.model.q_w * dt));
+        if (x[3] < 0.0) {  // the same motion as the tracker writes it: v >= 0, θ its heading
+          x[3] = -x[3];
+          x[2] = estimation::wrapAngle(x[2] + M_PI);
+        }
       }
       const Vector2d z(x[0] + core::gaussian(rng, sigma), x[1] + core::gaussian(rng, sigma));
       const bool was_valid = tr.valid();
