@@ -4,6 +4,7 @@
 // the true cameras the simulator renders with (calib::loadRigTruth) and prints how far off the
 // calibration is -- a simulated app renders with the truth and estimates with the calibration.
 #include <iostream>
+#include <string>
 
 #include "viewline/calib/synthetic.h"
 #include "viewline/core/frames.h"
@@ -11,9 +12,20 @@
 #include "viewline/core/error.h"
 #include "viewline/io/rig.h"
 
+namespace {
+const char* const kUsage =
+    "usage: load_rig RIG.yaml [TRUTH.yaml]\n"
+    "  prints each camera of the rig file (calibrate-rig's output or calib/rigs/<rig>/rig.yaml);\n"
+    "  with a simulated rig's truth file, also how far the calibration is from the truth\n";
+}  // namespace
+
 int main(int argc, char** argv) {
-  if (argc != 2 && argc != 3) {
-    std::cerr << "usage: load_rig RIG.yaml [TRUTH.yaml]\n";
+  if (argc == 2 && (std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h")) {
+    std::cout << kUsage;
+    return 0;
+  }
+  if ((argc != 2 && argc != 3) || argv[1][0] == '-') {
+    std::cerr << kUsage;
     return 2;
   }
   try {
@@ -33,7 +45,7 @@ int main(int argc, char** argv) {
                   << "; calibration off by " << 1e3 * e.position_error_m << " mm, "
                   << viewline::core::rad2deg(e.rotation_error_rad) << " deg, rays " << e.world_ray_rms_px << " px RMS\n";
     }
-  } catch (const viewline::core::InvalidInput& e) {
+  } catch (const std::exception& e) {
     std::cerr << "load_rig: error: " << e.what() << "\n";
     return 1;
   }

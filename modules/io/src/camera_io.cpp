@@ -45,6 +45,20 @@ std::string extensionOf(const std::string& path) {
   for (auto& c : e) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   return e;
 }
+// cv::read(FileNode, Mat) sizes the matrix from the node's rows/cols before it looks at the data: a
+// 'rows' that is not a plain integer (e.g. "rows:(5") made OpenCV 4.6 allocate and clear gigabytes
+// (found by fuzz_opencv_yaml). Our matrices are small: check the header first.
+void checkMatrixNode(const cv::FileNode& n, const std::string& path, const char* key) {
+  if (n.empty() || n.isNone()) return;  // absent: the caller's checks name it
+  const std::string what = path + ": '" + key + "': ";
+  if (!n.isMap()) throw core::InvalidInput(what + "expected an OpenCV matrix (rows, cols, dt, data)");
+  const cv::FileNode r = n["rows"], c = n["cols"], d = n["data"];
+  if (!r.isInt() || !c.isInt() || static_cast<int>(r) < 1 || static_cast<int>(c) < 1 || static_cast<int>(r) > 16 ||
+      static_cast<int>(c) > 16)
+    throw core::InvalidInput(what + "rows and cols must be integers from 1 to 16");
+  if (!d.isSeq() || d.size() != static_cast<std::size_t>(static_cast<int>(r) * static_cast<int>(c)))
+    throw core::InvalidInput(what + "data must be a list of rows x cols numbers");
+}
 }  // namespace
 
 std::string toString(Projection p) {
@@ -59,7 +73,8 @@ Projection projectionFromString(const std::string& s) {
 
 CameraXml loadVispCameraXml(const std::string& path, const std::string& camera_name, Projection projection,
                             unsigned width, unsigned height) {
-  if (!fs::is_regular_file(path)) throw core::InvalidInput(path + ": camera XML file does not exist");
+  std::error_code ec;  // the throwing overload raised filesystem_error on e.g. a name too long (found by fuzz_rig)
+  if (!fs::is_regular_file(path, ec)) throw core::InvalidInput(path + ": camera XML file does not exist");
   vpXmlParserCamera parser;
   vpCameraParameters cam;
   int status = vpXmlParserCamera::SEQUENCE_ERROR;
@@ -119,17 +134,22 @@ void saveVispCameraXml(const std::string& path, const std::string& camera_name,
 }
 
 OpenCvIntrinsics loadOpenCvIntrinsics(const std::string& path) {
-  if (!fs::is_regular_file(path)) throw core::InvalidInput(path + ": OpenCV intrinsics file does not exist");
+  std::error_code ec;  // (as loadVispCameraXml: no filesystem_error on a bad name)
+  if (!fs::is_regular_file(path, ec)) throw core::InvalidInput(path + ": OpenCV intrinsics file does not exist");
   cv::FileStorage fsr;
   try {
     fsr.open(path, cv::FileStorage::READ);
   } catch (const cv::Exception& e) {
+    throw core::InvalidInput(path + ": cannot parse as OpenCV FileStorage: " + e.what());
+  } catch (const std::exception& e) {  // OpenCV 4.6 lets std::length_error out of a bad file (fuzz_opencv_yaml)
     throw core::InvalidInput(path + ": cannot parse as OpenCV FileStorage: " + e.what());
   }
   if (!fsr.isOpened()) throw core::InvalidInput(path + ": cannot open as OpenCV FileStorage");
   cv::Mat K, D;
   OpenCvIntrinsics out;
   try {
+    checkMatrixNode(fsr["camera_matrix"], path, "camera_matrix");
+    checkMatrixNode(fsr["distortion_coefficients"], path, "distortion_coefficients");
     fsr["camera_matrix"] >> K;
     fsr["distortion_coefficients"] >> D;
     int w = 0, h = 0;
@@ -140,6 +160,10 @@ OpenCvIntrinsics loadOpenCvIntrinsics(const std::string& path) {
     out.height = static_cast<unsigned>(h);
     if (!fsr["avg_reprojection_error"].empty()) fsr["avg_reprojection_error"] >> out.rms_px;
   } catch (const cv::Exception& e) {
+    throw core::InvalidInput(path + ": bad OpenCV intrinsics: " + e.what());
+  } catch (const core::InvalidInput&) {
+    throw;
+  } catch (const std::exception& e) {  // (as open: not only cv::Exception comes out of FileStorage)
     throw core::InvalidInput(path + ": bad OpenCV intrinsics: " + e.what());
   }
   if (K.rows != 3 || K.cols != 3)

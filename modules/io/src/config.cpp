@@ -40,8 +40,11 @@ std::optional<YAML::Node> keyNode(const YAML::Node& map, const std::string& key)
   return std::nullopt;
 }
 
-// Rejects duplicate keys (yaml-cpp silently keeps one) and non-scalar keys.
-void checkKeys(const YAML::Node& n, const std::string& file) {
+// Rejects duplicate keys (yaml-cpp silently keeps one) and non-scalar keys. An alias (*a) is the
+// anchored node itself: each map/list is checked once (by its position in the text), else nested
+// aliases made a 400-byte file cost 10^9 visits (found by fuzzing the scenario loader).
+void checkKeys(const YAML::Node& n, const std::string& file, std::set<int>& visited) {
+  if ((n.IsMap() || n.IsSequence()) && n.Mark().pos >= 0 && !visited.insert(n.Mark().pos).second) return;
   if (n.IsMap()) {
     std::set<std::string> seen;
     for (auto it = n.begin(); it != n.end(); ++it) {
@@ -49,11 +52,16 @@ void checkKeys(const YAML::Node& n, const std::string& file) {
         throw InvalidInput(markText(file, it->first.Mark()) + ": map keys must be plain names");
       if (!seen.insert(it->first.Scalar()).second)
         throw InvalidInput(markText(file, it->first.Mark()) + ": duplicate key '" + it->first.Scalar() + "'");
-      checkKeys(it->second, file);
+      checkKeys(it->second, file, visited);
     }
   } else if (n.IsSequence()) {
-    for (const auto& e : n) checkKeys(e, file);
+    for (const auto& e : n) checkKeys(e, file, visited);
   }
+}
+
+void checkKeys(const YAML::Node& n, const std::string& file) {
+  std::set<int> visited;
+  checkKeys(n, file, visited);
 }
 
 template <class T>
@@ -75,7 +83,8 @@ ConfigNode::ConfigNode(std::shared_ptr<Shared> shared, YAML::Node node, std::str
     : shared_(std::move(shared)), node_(std::move(node)), path_(std::move(path)) {}
 
 ConfigNode ConfigNode::loadFile(const std::string& path) {
-  if (!std::filesystem::exists(path)) throw InvalidInput(path + ": config file does not exist");
+  std::error_code ec;  // the throwing overload raised filesystem_error on e.g. a name too long
+  if (!std::filesystem::exists(path, ec)) throw InvalidInput(path + ": config file does not exist");
   YAML::Node root;
   try {
     root = YAML::LoadFile(path);

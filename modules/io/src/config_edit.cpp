@@ -29,6 +29,8 @@ std::vector<KeySegment> parseDottedKey(const std::string& dotted) {
       const std::string idx = part.substr(br + 1, part.size() - br - 2);
       if (idx.empty() || !std::all_of(idx.begin(), idx.end(), [](char c) { return std::isdigit(static_cast<unsigned char>(c)) != 0; }))
         throw InvalidInput("parameter key '" + dotted + "': list index must be a number in '" + part + "'");
+      if (idx.size() > 9)  // std::stoi would throw std::out_of_range past INT_MAX (found by fuzz_config_set)
+        throw InvalidInput("parameter key '" + dotted + "': list index too large in '" + part + "'");
       s.index = std::stoi(idx);
     }
     if (s.key.empty()) throw InvalidInput("parameter key '" + dotted + "': empty segment");

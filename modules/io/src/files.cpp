@@ -78,15 +78,17 @@ std::string StagedFiles::stage(const std::string& path) {
 void StagedFiles::commit() {
   for (const auto& f : files_)
     if (!fs::exists(f.first)) {
+      const std::string target = f.second;  // discard() clears files_, which f points into (ASan: use after free)
       discard();
-      throw core::InvalidInput(f.second + ": the file was not written");
+      throw core::InvalidInput(target + ": the file was not written");
     }
   for (const auto& f : files_) {
     std::error_code ec;
     fs::rename(f.first, f.second, ec);
     if (ec) {
+      const std::string target = f.second;  // (as above)
       discard();
-      throw core::InvalidInput(f.second + ": cannot rename the temporary file onto it: " + ec.message());
+      throw core::InvalidInput(target + ": cannot rename the temporary file onto it: " + ec.message());
     }
   }
   files_.clear();
