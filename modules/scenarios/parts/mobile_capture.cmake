@@ -1,3 +1,4 @@
-# Mobile capture ([K], SPEC §4, issue 8): the scenario loop, oracle, filter test, ground-localisation sweep,
-# and the live view (vpDisplayX, only used with --display).
-list(APPEND scenarios_sources src/mobile_capture.cpp src/mobile_capture_display.cpp)
+# Mobile capture ([K], SPEC §4): config, world (object, floor, robot, rendered head camera), the loop
+# on the scenario runtime with its oracle, and the metrics (filter test, localisation sweep, batch).
+list(APPEND scenarios_sources mobile_capture/config.cpp mobile_capture/world.cpp mobile_capture/loop.cpp
+  mobile_capture/metrics.cpp)

@@ -1,18 +1,15 @@
-// Mobile-capture scenario adapter ([K], issue 8): runs scenarios::runMobileCapture (rendered head
-// camera, red-blob detection, ground back-projection, the curvilinear EKF, LS predictor, capture
-// planner, base and head control, grasp; and the oracle on the same object path) in-process, with
-// the config read by the scenario's own loader (loadMobileCaptureConfig: strict keys), so a config
-// the tuning tool accepts or writes is one mobile_capture reads. One run = one chase (seed).
+// Mobile-capture scenario adapter ([K]): runs scenarios::runMobileCapture (rendered head camera,
+// red-blob detection, ground back-projection, the unicycle track, LS predictor, capture planner,
+// base and head control, grasp; and the oracle on the same object path) in-process, with the
+// config read by the scenario's own loader (loadMobileCaptureConfig: strict keys), so a config the
+// tuning tool accepts or writes is one mobile_capture reads. One run = one chase (seed).
 //
-// Consistency. The scenario's EKF (x, y, θ, v, ω) is private to the scenario; what it exposes is
-// its --log output: per vision step the truth (object pose, v, ω) and the estimate with its
-// standard deviations (the covariance diagonal). A run therefore logs to a private temporary
-// folder. NEES: the full covariance is not exposed, but each marginal is exact — for a consistent
-// filter e_i² / P_ii ~ χ²(1) — so every `nees_spacing_s` seconds (nearly independent samples) the
-// adapter takes one 1-dof sample, cycling through the components x, y, θ (wrapped), v, ω, once the
-// track has been valid for `settle_s`. NIS: the gate's d' S⁻¹ d of every measurement tested
-// against the track (MobileCaptureFrame::nis, 2 dof, fused or gated out), once the track has been
-// valid for `settle_s`.
+// Consistency, from the run's telemetry (a runtime::MemorySink; no files). NEES: per vision step
+// the sink has the true object (x, y, θ, v, ω) and the track's estimate with its covariance;
+// every `nees_spacing_s` seconds (nearly independent samples) one 1-dof marginal sample
+// e_i² / P_ii (χ²(1) for a consistent filter) is taken, cycling through x, y, θ (wrapped), v, ω,
+// once the track has been valid for `settle_s`. NIS: the track's own innovation records (2 dof,
+// accepted or gated out), once the track has been valid for `settle_s`.
 //
 // Noise auto-tuning is not offered: the head points the camera at the filter's own prediction, so
 // which frames see the object depends on the filter being tuned (the measurements cannot be
@@ -21,12 +18,18 @@
 
 #include <cmath>
 #include <map>
+#include <memory>
 
 #include "adapter_util.h"
 #include "viewline/core/error.h"
+#include "viewline/runtime/telemetry.h"
 #include "viewline/scenarios/mobile_capture.h"
-#include "viewline/scenarios/mobile_capture_display.h"
 #include "viewline/tuning/scenario.h"
+// The camera view lives in the viz module; it is shown when this library links viz.
+#if __has_include("viewline/viz/mobile_capture_display.h")
+#include "viewline/viz/mobile_capture_display.h"
+#define VIEWLINE_MOBILE_CAPTURE_VIEW 1
+#endif
 
 namespace viewline::tuning {
 
@@ -54,73 +57,68 @@ public:
   }
 
   RunResult run(std::uint64_t seed, const RunOptions& ro) const override {
-    const detail::TempLogDir tmp;
-    std::unique_ptr<scenarios::MobileCaptureDisplay> view;
+#ifdef VIEWLINE_MOBILE_CAPTURE_VIEW
+    std::unique_ptr<viz::MobileCaptureDisplay> view;
     if (ro.display && detail::xDisplayAvailable()) {
       try {
-        view = std::make_unique<scenarios::MobileCaptureDisplay>(cfg_);
+        view = std::make_unique<viz::MobileCaptureDisplay>(cfg_);
       } catch (const std::exception&) {
         view.reset();
       }
     }
+#endif
     std::shared_ptr<RunSeries> series;
     if (ro.series) series = makeSeries();
     Curve err{"position error", {}, {}}, obj{"object", {}, {}}, robot{"robot", {}, {}}, est{"estimate", {}, {}};
     double sq = 0.0;
     std::size_t n = 0;
-    double next_prediction = 5.0, valid_since = -1.0;
-    Consistency nis;
-    scenarios::MobileCaptureRun res;
-    {
-      io::LogDirectory log(tmp.dir());
-      scenarios::MobileCaptureHooks hooks;
-      hooks.log = &log;
-      hooks.on_frame = [&](const scenarios::MobileCaptureFrame& f) {
-        if (view) view->show(f);
-        if (!f.estimate_valid) valid_since = -1.0;
-        else if (valid_since < 0.0) valid_since = f.t;
-        if (std::isfinite(f.nis) && valid_since >= 0.0 && f.t - valid_since >= opt_.settle) {
-          nis.add(f.nis, 2.0);
-          if (series) {
-            series->nis_t.push_back(f.t);
-            series->nis.push_back(f.nis);
-          }
-        }
-        double e = std::nan("");
-        if (f.estimate_valid && f.estimate.size() >= 2) {
-          e = (f.estimate.head<2>() - f.object_true).norm();
-          sq += e * e;
-          ++n;
-        }
-        if (ro.progress) ro.progress(std::min(1.0, f.t / cfg_.max_time));
-        if (ro.live) ro.live({f.t, e, -1.0});
-        if (!series) return;
-        obj.x.push_back(f.object_true.x());
-        obj.y.push_back(f.object_true.y());
-        robot.x.push_back(f.robot.x);
-        robot.y.push_back(f.robot.y);
-        if (!std::isfinite(e)) return;
-        err.x.push_back(f.t);
-        err.y.push_back(e);
-        est.x.push_back(f.estimate(0));
-        est.y.push_back(f.estimate(1));
-        if (f.t >= next_prediction && !f.prediction.empty()) {
-          Curve p{"prediction at t = " + std::to_string(static_cast<int>(f.t)) + " s", {}, {}};
-          for (const auto& q : f.prediction) {
-            p.x.push_back(q.x());
-            p.y.push_back(q.y());
-          }
-          series->prediction.push_back(p);
-          next_prediction = f.t + 10.0;
-        }
-      };
-      res = scenarios::runMobileCapture(cfg_, seed, &hooks);
-      log.flush();
+    double next_prediction = 5.0;
+    runtime::MemorySink memory;
+    std::unique_ptr<runtime::CsvSink> csv;
+    runtime::FanoutSink sinks;
+    sinks.add(&memory);
+    if (ro.log) {
+      csv = std::make_unique<runtime::CsvSink>(*ro.log);
+      sinks.add(csv.get());
     }
+    scenarios::MobileCaptureHooks hooks;
+    hooks.telemetry = &sinks;
+    hooks.on_frame = [&](const scenarios::MobileCaptureFrame& f) {
+#ifdef VIEWLINE_MOBILE_CAPTURE_VIEW
+      if (view) view->show(f);
+#endif
+      double e = std::nan("");
+      if (f.estimate_valid && f.estimate.size() >= 2) {
+        e = (f.estimate.head<2>() - f.object_true).norm();
+        sq += e * e;
+        ++n;
+      }
+      if (ro.progress) ro.progress(std::min(1.0, f.t / cfg_.max_time));
+      if (ro.live) ro.live({f.t, e, -1.0});
+      if (!series) return;
+      obj.x.push_back(f.object_true.x());
+      obj.y.push_back(f.object_true.y());
+      robot.x.push_back(f.robot.x);
+      robot.y.push_back(f.robot.y);
+      if (!std::isfinite(e)) return;
+      err.x.push_back(f.t);
+      err.y.push_back(e);
+      est.x.push_back(f.estimate(0));
+      est.y.push_back(f.estimate(1));
+      if (f.t >= next_prediction && !f.prediction.empty()) {
+        Curve p{"prediction at t = " + std::to_string(static_cast<int>(f.t)) + " s", {}, {}};
+        for (const auto& q : f.prediction) {
+          p.x.push_back(q.x());
+          p.y.push_back(q.y());
+        }
+        series->prediction.push_back(p);
+        next_prediction = f.t + 10.0;
+      }
+    };
+    const scenarios::MobileCaptureRun res = scenarios::runMobileCapture(cfg_, seed, &hooks);
     RunResult r;
     r.seed = seed;
-    neesFromLog(tmp, r.nees);
-    r.nis = nis;
+    consistency(memory, r.nees, r.nis, series.get());
     auto& m = r.metrics;
     m["captured"] = res.captured ? 1.0 : 0.0;
     m["capture_time_s"] = res.capture_time;
@@ -156,39 +154,42 @@ private:
     return s;
   }
 
-  /// One 1-dof marginal NEES sample every nees_spacing s, cycling over (x, y, θ, v, ω).
-  void neesFromLog(const detail::TempLogDir& tmp, Consistency& nees) const {
-    const detail::CsvTable truth = detail::CsvTable::read(tmp.file("truth.csv"), "truth.csv of a mobile_capture log");
-    const detail::CsvTable est = detail::CsvTable::read(tmp.file("estimates.csv"), "estimates.csv of a mobile_capture log");
-    std::map<std::string, std::size_t> truth_row;  // by the exact text of t (both written at the same step)
-    const std::size_t tt = truth.col("t");
-    for (std::size_t i = 0; i < truth.rows(); ++i) truth_row[truth.text(i, tt)] = i;
-    const char* true_cols[5] = {"object_x", "object_y", "object_theta", "object_v", "object_omega"};
-    const char* est_cols[5] = {"x", "y", "theta", "v", "omega"};
-    const char* sd_cols[5] = {"sx", "sy", "stheta", "sv", "somega"};
-    std::size_t tc[5], ec[5], sc[5];
-    for (int k = 0; k < 5; ++k) {
-      tc[k] = truth.col(true_cols[k]);
-      ec[k] = est.col(est_cols[k]);
-      sc[k] = est.col(sd_cols[k]);
-    }
-    const std::size_t et = est.col("t");
-    double valid_since = -1.0, last_t = -1e300, next = -1e300;
+  /// NEES: one 1-dof marginal sample every nees_spacing s, cycling over (x, y, θ, v, ω). NIS: the
+  /// track's innovation records. Both once the track has been valid for settle s (a track is
+  /// valid at the times it has an estimate record; a gap of more than a frame is a restart).
+  void consistency(const runtime::MemorySink& mem, Consistency& nees, Consistency& nis, RunSeries* series) const {
+    namespace channel = scenarios::mobile_capture::channel;
+    std::map<double, const Eigen::VectorXd*> truth;  // by time (both records carry the frame's stamp)
+    for (const auto& e : mem.estimates)
+      if (e.channel == channel::kTruthObject) truth[e.t] = &e.x;
+    std::map<double, double> valid_since;  // frame time -> start of the track valid then
+    double since = -1.0, last_t = -1e300, next = -1e300;
     std::size_t component = 0;
-    for (std::size_t i = 0; i < est.rows(); ++i) {
-      const double t = est.number(i, et);
-      if (t - last_t > 1.5 * cfg_.vision_period) valid_since = t;  // the track (re)started
+    for (const auto& e : mem.estimates) {
+      if (e.channel != channel::kObject) continue;
+      const double t = e.t;
+      if (t - last_t > 1.5 * cfg_.vision_period) since = t;  // the track (re)started
       last_t = t;
-      const auto it = truth_row.find(est.text(i, et));
-      if (it == truth_row.end() || t - valid_since < opt_.settle || t < next) continue;
+      valid_since[t] = since;
+      const auto it = truth.find(t);
+      if (it == truth.end() || t - since < opt_.settle || t < next) continue;
       const std::size_t k = component % 5;
-      double e = est.number(i, ec[k]) - truth.number(it->second, tc[k]);
-      if (k == 2) e = std::remainder(e, 2.0 * kPi);
-      const double sd = est.number(i, sc[k]);
-      if (!(sd > 0.0)) continue;
-      nees.add(e * e / (sd * sd), 1.0);
+      double err = e.x[static_cast<Eigen::Index>(k)] - (*it->second)[static_cast<Eigen::Index>(k)];
+      if (k == 2) err = std::remainder(err, 2.0 * kPi);
+      const double var = e.P(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(k));
+      if (!(var > 0.0)) continue;
+      nees.add(err * err / var, 1.0);
       ++component;
       next = t + opt_.nees_spacing;
+    }
+    for (const auto& i : mem.innovationsOf(channel::kObject)) {
+      const auto v = valid_since.find(i.t);
+      if (!std::isfinite(i.nis) || v == valid_since.end() || i.t - v->second < opt_.settle) continue;
+      nis.add(i.nis, 2.0);
+      if (series) {
+        series->nis_t.push_back(i.t);
+        series->nis.push_back(i.nis);
+      }
     }
   }
 

@@ -1,2 +1,3 @@
-# Mobile capture (issue 8): a short seeded capture, the filter test, the localisation sweep, config errors.
+# Mobile capture: short seeded captures, the filter test, the localisation sweep, config errors, the
+# run paced and unpaced through the scheduler, the telemetry against the run's counts.
 list(APPEND scenarios_tests mobile_capture_test.cpp)

@@ -1,4 +1,4 @@
-#include "viewline/scenarios/mobile_capture_display.h"
+#include "viewline/viz/mobile_capture_display.h"
 
 #include <cmath>
 #include <visp3/core/vpConfig.h>
@@ -7,8 +7,12 @@
 #include <visp3/gui/vpDisplayX.h>
 
 #include "viewline/core/error.h"
+#include "viewline/viz/display_controls.h"
 
-namespace viewline::scenarios {
+namespace viewline::viz {
+
+using scenarios::MobileCaptureConfig;
+using scenarios::MobileCaptureFrame;
 
 #if defined(VISP_HAVE_X11)
 struct MobileCaptureDisplay::Impl {
@@ -17,6 +21,7 @@ struct MobileCaptureDisplay::Impl {
   double span;
   vpImage<vpRGBa> camera, top;
   vpDisplayX d_camera, d_top;
+  DisplayControls controls;
   Eigen::Vector2d centre = Eigen::Vector2d::Zero();
   Impl(const MobileCaptureConfig& c, int s, double sp)
       : cfg(c), size(s), span(sp), camera(c.height, c.width), top(static_cast<unsigned>(s), static_cast<unsigned>(s)) {
@@ -82,10 +87,26 @@ void MobileCaptureDisplay::show(const MobileCaptureFrame& f) {
                                                         : "searching",
                 f.plan.time, f.plan.reachable ? "" : " (not reachable)");
   vpDisplay::displayText(m.top, 12, 5, text, vpColor::yellow);
+  m.controls.drawLegend(m.top);
   vpDisplay::flush(m.top);
+  m.controls.poll(m.top);
 #else
   (void)f;
 #endif
 }
 
-}  // namespace viewline::scenarios
+bool MobileCaptureDisplay::quitRequested() const {
+#if defined(VISP_HAVE_X11)
+  return impl_->controls.quitRequested();
+#else
+  return true;
+#endif
+}
+
+void MobileCaptureDisplay::waitForClose() {
+#if defined(VISP_HAVE_X11)
+  impl_->controls.waitForClose(impl_->top);
+#endif
+}
+
+}  // namespace viewline::viz

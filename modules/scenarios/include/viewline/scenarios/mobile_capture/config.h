@@ -1,0 +1,123 @@
+#pragma once
+// Mobile capture: the scenario's parameters and their one reader (keys documented in
+// config/mobile_capture.yaml; the scenario itself in viewline/scenarios/mobile_capture.h).
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <cmath>
+#include <optional>
+#include <string>
+
+#include "viewline/control/mobile_capture_control.h"
+#include "viewline/core/camera.h"
+#include "viewline/io/config.h"
+#include "viewline/planning/capture_planner.h"
+#include "viewline/robots/differential_drive.h"
+#include "viewline/robots/mobile_pan_tilt.h"
+#include "viewline/tracking/unicycle_tracker.h"
+#include "viewline/vision/ball_detector.h"
+
+namespace viewline::scenarios {
+
+/// Gripper zones in the robot frame (x forward from the axle centre, y left), m.
+struct GripperZone {
+  double x_min = 0.12, x_max = 0.28, half_width = 0.07;
+  bool contains(const Eigen::Vector2d& p_r) const {
+    return p_r.x() >= x_min && p_r.x() <= x_max && std::abs(p_r.y()) <= half_width;
+  }
+};
+
+struct MobileCaptureConfig {
+  // Start ([K]) and world.
+  Eigen::Vector2d robot_start = Eigen::Vector2d(-0.5, -0.5);  ///< m
+  double robot_heading = 1.5707963267948966;                 ///< rad
+  Eigen::Vector2d object_start = Eigen::Vector2d(-2.5, 3.0);  ///< m
+  double object_heading = 0.0;                                ///< rad
+  bool object_noise = true;             ///< ξv, ξω on (else the nominal profile)
+  double max_time = 90.0;               ///< s; a run without capture by then is a failure
+  double floor_size = 30.0;             ///< m (textured floor square centred at the origin)
+  /// Camera blackout (lens covered: frames give no detection) on [start, start + duration), s;
+  /// start < 0: none. Exercises losing the target and finding it again.
+  double blackout_start = -1.0, blackout_duration = 0.0;
+
+  // Timing.
+  double vision_period = 0.1;           ///< s ([K]); also the profile step and the planner's T
+  double control_period = 0.01;         ///< s ([K]: wheel PID every 10 ms)
+
+  // Camera (320x240, 50° x 40°).
+  unsigned width = 320, height = 240;
+  double hfov = 0.8726646259971648;     ///< rad (50°)
+  double vfov = 0.6981317008965228;     ///< rad (40°)
+  double sensor_noise = 2.0;            ///< grey levels (std)
+  int supersampling = 2;                ///< renderer anti-aliasing sub-samples on edges
+
+  /// Calibrated rig (key `rig`): replaces width, height, hfov, vfov (see mobile_capture.h).
+  struct RigCameras {
+    std::string folder;
+    core::Camera truth;                 ///< renders (intrinsics; its pose is the DH head at q0)
+    core::Camera calibrated;            ///< estimators (intrinsics; c_M_w = calibrated pose at q0)
+    robots::PanTiltJoints q0;           ///< head joints of truth.yaml's pose
+    Eigen::Isometry3d cal_M_c = Eigen::Isometry3d::Identity();  ///< c'_M_c, calibrated vs DH camera
+  };
+  std::optional<RigCameras> rig;
+
+  // Robot.
+  robots::MobilePanTiltParams head;
+  robots::DifferentialDriveParams base;
+  GripperZone jaws;                                 ///< grasp succeeds when the true object is here
+  GripperZone trigger{0.14, 0.26, 0.045};           ///< grasp is attempted when the estimate is here
+  double grasp_cooldown = 0.5;                      ///< s after a failed grasp
+
+  // Detection.
+  vision::BallDetectorConfig detector;  ///< red HSV range etc. (set in defaults())
+  double pixel_sigma = 1.0;             ///< px, blob centre noise used for the measurement covariance
+  double floor_sigma = 0.01;            ///< m, added floor-position std (blob centroid vs centre)
+  double object_height = 0.05;          ///< m: measurements on the plane z = height / 2
+
+  // Estimation: the target track (keys filter.q_v, q_w, init_speed_sigma, init_turn_sigma,
+  // gate_probability, predictor_window; it restarts after 5 rejections in a row).
+  tracking::UnicycleTrackerConfig filter;
+  double init_speed = 0.3;              ///< m/s (key filter.init_speed; the two-point start measures it)
+  /// The LS accelerations are used only once the window is full, clamped to these (physically
+  /// plausible) bounds; 0 switches them off (constant v, ω prediction).
+  double max_accel_v = 0.1;             ///< m/s²
+  double max_accel_omega = 0.5;         ///< rad/s²
+  int horizon_steps = 200;              ///< M of [K] eq 30
+
+  // Planning and control.
+  planning::CapturePlannerParams planner;
+  control::GoToPointParams go;
+  control::SearchParams search;
+
+  // Filter test ([K] §3.2).
+  double filter_test_duration = 60.0;        ///< s
+  double filter_test_measurement_var = 2.0;  ///< cm² per axis
+  double filter_test_q_v = 0.003;            ///< m²/s³ (ξv variance 3 (cm/s)² per 0.1 s step)
+  double filter_test_q_w = 1.0;              ///< rad²/s³ (ξω variance 0.1 (rad/s)² per step)
+  double convergence_time = 10.0;            ///< s: RMSE is taken after this
+  int filter_test_runs = 20;
+
+  // Field-of-view sweep of the ground localisation.
+  int fov_sweep_poses = 50;             ///< random head/base poses
+  int fov_sweep_points = 200;           ///< floor points per pose
+  double fov_sweep_pixel_sigma = 0.5;   ///< px noise added to the projected pixels
+
+  int threads = 2;                      ///< parallel runs in runMobileCaptureBatch
+
+  /// The defaults above plus [K]'s red-object detector settings.
+  static MobileCaptureConfig defaults();
+  /// Throws core::InvalidInput naming the field.
+  void validate() const;
+};
+
+/// Reads the YAML keys documented in config/mobile_capture.yaml (unknown keys rejected).
+/// `rig:` (folder relative to the config file) loads truth.yaml, rig.yaml and ground.yaml; with it
+/// the camera's width, height, hfov_deg and vfov_deg keys are errors.
+MobileCaptureConfig loadMobileCaptureConfig(const io::ConfigNode& root);
+
+/// Loads the head camera of a mobile rig folder for the head `head` (see mobile_capture.h);
+/// throws core::InvalidInput when truth.yaml's pose is not the DH head camera at some joints
+/// (1 mm, 0.05°) or ground.yaml disagrees with rig.yaml.
+MobileCaptureConfig::RigCameras loadMobileRig(const std::string& folder, const robots::MobilePanTiltParams& head);
+
+}  // namespace viewline::scenarios

@@ -1,0 +1,95 @@
+#pragma once
+// Mobile capture: the simulated world of one run (object, floor, robot, head camera) and the
+// geometry the loop, the oracle and the metrics share.
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "viewline/core/camera.h"
+#include "viewline/core/random.h"
+#include "viewline/runtime/frame_source.h"
+#include "viewline/scenarios/mobile_capture/config.h"
+#include "viewline/sim/physics.h"
+#include "viewline/tracking/unicycle_tracker.h"
+
+namespace viewline::scenarios::mobile_capture {
+
+/// Independent random streams of one run, all derived from the run seed.
+struct Streams {
+  core::Rng object, room, render, drive;
+  explicit Streams(std::uint64_t seed);
+};
+
+/// The camera that renders (truth: the rig's truth.yaml, or the inline pinhole) and the one the
+/// estimators use (the rig's calibration; the same perfect pinhole without a rig).
+core::Camera renderCamera(const MobileCaptureConfig& cfg);
+core::Camera estimatorCamera(const MobileCaptureConfig& cfg);
+/// c_M_w of the true head camera at joints q on the base pose (x, y, θ): the DH head.
+Eigen::Isometry3d trueCamera_c_M_w(const robots::MobilePanTilt& head, const robots::PanTiltJoints& q, double x,
+                                   double y, double theta);
+/// The estimators' camera pose from the same joints and pose: c'_M_w = c'_M_c · c_M_w (rig), else c_M_w.
+Eigen::Isometry3d estimatorCamera_c_M_w(const MobileCaptureConfig& cfg, const Eigen::Isometry3d& true_c_M_w);
+
+/// The object's motion ([K]'s profile) over `duration` s.
+sim::GroundTargetParams targetParams(const MobileCaptureConfig& cfg, sim::GroundProfile profile, double duration);
+/// How long the capture runs' object path must last (the run plus the planner's horizon).
+double targetDuration(const MobileCaptureConfig& cfg);
+
+/// A floor point in the robot frame (x forward, y left).
+Eigen::Vector2d toRobot(const robots::BasePose& pose, const Eigen::Vector2d& p_w);
+
+/// Control ticks i = 0..last at t = i · control_period (the product, not a running sum: every
+/// time stamp of the scenario is computed this one way).
+struct TickClock {
+  double period = 0.01;
+  long last = 0;
+  double time(long i) const { return static_cast<double>(i) * period; }
+  static TickClock of(const MobileCaptureConfig& cfg);
+  /// Control ticks per vision frame (vision_period / control_period, an integer).
+  static long visionEvery(const MobileCaptureConfig& cfg);
+};
+
+/// One simulated robot: base (wheels, PID, odometry) and rate-limited head joints.
+struct RobotSim {
+  const MobileCaptureConfig& cfg;
+  robots::MobilePanTilt head;
+  robots::DifferentialDrive base;
+  robots::PanTiltJoints q;
+  explicit RobotSim(const MobileCaptureConfig& c);
+  /// One control period of the head servo towards `target` (clamped to the joint limits).
+  void stepHead(const robots::PanTiltJoints& target);
+};
+
+/// The head camera as a frame source: the simulator's renderer drawing the floor and the object
+/// from where the head camera is when the frame is grabbed (`camera_pose`), with sensor noise and
+/// the configured blackout. Frames every vision_every control ticks (capture_time = stamp = that
+/// tick's time, zero exposure); the source ends after the last tick.
+class RenderedHeadCamera final : public runtime::FrameSource {
+public:
+  /// c_M_w of the true camera at the time of a grab.
+  using PoseProvider = std::function<Eigen::Isometry3d()>;
+  RenderedHeadCamera(const MobileCaptureConfig& cfg, const sim::GroundTarget& target, Streams& rng,
+                     PoseProvider camera_pose);
+  ~RenderedHeadCamera() override;
+  std::size_t cameraCount() const override { return 1; }
+  std::optional<core::Timestamp> nextReadyTime() const override;
+  std::optional<runtime::Frame> grab() override;
+
+private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// [K] eqs 27-29: the track's path over the planner's horizon, with the LS accelerations of its
+/// predictor once its window is full, clamped to plausible bounds (early slopes from a few noisy
+/// estimates are wild).
+std::vector<Eigen::Vector2d> predictPath(const tracking::UnicycleTracker& track, const MobileCaptureConfig& cfg);
+/// The object's true path at t + m T, m = 1..M (the oracle's knowledge).
+std::vector<Eigen::Vector2d> truePath(const sim::GroundTarget& target, double t, double T, int M);
+
+}  // namespace viewline::scenarios::mobile_capture

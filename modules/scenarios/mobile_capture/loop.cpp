@@ -1,0 +1,292 @@
+#include "viewline/scenarios/mobile_capture/loop.h"
+
+#include <cmath>
+#include <optional>
+
+#include "viewline/robots/mobile_ground_localization.h"
+#include "viewline/scenarios/mobile_capture/world.h"
+
+namespace viewline::scenarios {
+
+using Eigen::Vector2d;
+using Eigen::Vector3d;
+using Eigen::VectorXd;
+using namespace mobile_capture;
+
+namespace {
+
+// Tie order at one control tick: the gripper acts on the estimate of the previous frame, then
+// this instant's frame is grabbed and processed, then the base and head laws use it and the
+// plant advances over the period.
+constexpr int kGrasp = runtime::priority::Control;
+constexpr int kVision = runtime::priority::Capture;
+constexpr int kDrive = runtime::priority::Capture + 1;
+
+/// f(i, t) at the ticks i = first, first + stride, ... <= clock.last, each event scheduling the
+/// next at clock.time(i) (a product, as the hand loop computed it, so that every time stamp stays
+/// bit for bit what it was; Scheduler::every would accumulate t += period instead).
+class Ticks {
+public:
+  using Action = std::function<void(long i, double t)>;
+  Ticks(runtime::Scheduler& s, TickClock clock, long stride, int priority, Action f)
+      : s_(s), clock_(clock), stride_(stride), priority_(priority), f_(std::move(f)) {}
+  void start(long first) {
+    if (first > clock_.last) return;
+    s_.at(clock_.time(first), priority_, [this, first](double t) {
+      f_(first, t);
+      start(first + stride_);
+    });
+  }
+
+private:
+  runtime::Scheduler& s_;
+  TickClock clock_;
+  long stride_;
+  int priority_;
+  Action f_;
+};
+
+Eigen::VectorXd vec(std::initializer_list<double> v) {
+  Eigen::VectorXd x(static_cast<Eigen::Index>(v.size()));
+  Eigen::Index i = 0;
+  for (double d : v) x[i++] = d;
+  return x;
+}
+
+}  // namespace
+
+// ------------------------------------------------------------------------------------------------
+// Oracle: the same planner, base law, robot and capture rule fed the object's true position and
+// true future path.
+
+OracleResult runOracle(const MobileCaptureConfig& cfg, std::uint64_t seed) {
+  cfg.validate();
+  Streams rng(seed);
+  const sim::GroundTarget target(targetParams(cfg, sim::GroundProfile::Capture, targetDuration(cfg)), rng.object);
+  RobotSim robot(cfg);
+  const TickClock clock = TickClock::of(cfg);
+  runtime::Scheduler sched;
+  OracleResult result{false, cfg.max_time};
+  planning::CapturePlan plan;
+  Ticks capture(sched, clock, 1, kGrasp, [&](long, double t) {
+    const auto s = target.state(t);
+    if (cfg.trigger.contains(toRobot(robot.base.pose(), Vector2d(s.x, s.y)))) {
+      result = {true, t};
+      sched.requestStop();
+    }
+  });
+  Ticks planner(sched, clock, TickClock::visionEvery(cfg), kVision, [&](long, double t) {
+    const auto& p = robot.base.pose();
+    plan = planning::planCapture(truePath(target, t, cfg.vision_period, cfg.horizon_steps), {{p.x, p.y}, p.theta},
+                                 cfg.planner);
+  });
+  Ticks drive(sched, clock, 1, kDrive, [&](long, double) {
+    const control::BaseCommand c = control::goToPoint(robot.base.pose(), plan.point, cfg.go);
+    robot.base.setCommand(c.v, c.omega);
+    robot.base.step(rng.drive);
+  });
+  capture.start(0);
+  planner.start(0);
+  drive.start(0);
+  sched.runUntil(clock.time(clock.last));
+  return result;
+}
+
+// ------------------------------------------------------------------------------------------------
+// Our loop.
+
+MobileCaptureRun runMobileCapture(const MobileCaptureConfig& cfg, std::uint64_t seed, const MobileCaptureHooks* hooks) {
+  cfg.validate();
+  MobileCaptureRun run;
+  run.seed = seed;
+  Streams rng(seed);
+  const sim::GroundTarget target(targetParams(cfg, sim::GroundProfile::Capture, targetDuration(cfg)), rng.object);
+  RobotSim robot(cfg);
+  RenderedHeadCamera source(cfg, target, rng, [&] {
+    const robots::BasePose& p = robot.base.pose();
+    return trueCamera_c_M_w(robot.head, robot.q, p.x, p.y, p.theta);
+  });
+  vision::BallDetector detector(cfg.detector);
+  core::Camera camera = estimatorCamera(cfg);  // detection ROI, ground localisation
+  const robots::AnglePerPixel printed{cfg.hfov, cfg.vfov, robots::AngleRange::PrintedSlant};
+  const robots::AnglePerPixel horizontal{cfg.hfov, cfg.vfov, robots::AngleRange::Horizontal};
+  const double plane_z = 0.5 * cfg.object_height;
+  tracking::UnicycleTracker track(cfg.filter);
+  const control::SearchPattern search(cfg.search);
+  runtime::TelemetrySink* sink = hooks ? hooks->telemetry : nullptr;
+
+  double last_seen = -1.0, first_seen = -1.0, sweep_start = -1.0, last_grasp = -1e9;
+  double centre_bearing = 0.0;  // robot frame, for the search
+  bool have_bearing = false;
+  planning::CapturePlan plan;
+  std::vector<Vector2d> prediction;
+  control::SearchMode mode = control::SearchMode::Sweeping;
+
+  const TickClock clock = TickClock::of(cfg);
+  runtime::Scheduler sched;
+  if (hooks) sched.setPacing(hooks->pacing);
+
+  // Grasp: when the estimate lies in the trigger zone the gripper closes; it holds the object
+  // when the true object lies in the jaws.
+  Ticks grasp(sched, clock, 1, kGrasp, [&](long, double t) {
+    const robots::BasePose pose = robot.base.pose();
+    if (!track.valid() || t - last_grasp < cfg.grasp_cooldown ||
+        !cfg.trigger.contains(toRobot(pose, track.positionAt(t))))
+      return;
+    ++run.grasp_attempts;
+    last_grasp = t;
+    const auto truth = target.state(t);
+    if (cfg.jaws.contains(toRobot(pose, Vector2d(truth.x, truth.y)))) {
+      run.captured = true;
+      run.capture_time = t;
+      sched.requestStop();
+    }
+  });
+
+  // Vision: detection, ground back-projection, track update, prediction, plan.
+  auto process = [&](const runtime::Frame& frame) {
+    const double t = frame.stamp;
+    ++run.frames;
+    const auto truth = target.state(t);
+    const Vector2d obj(truth.x, truth.y);
+    const robots::BasePose pose = robot.base.pose();
+    // The estimators' camera from odometry and the joint encoders at the frame's time.
+    camera.c_M_w = estimatorCamera_c_M_w(cfg, trueCamera_c_M_w(robot.head, robot.q, pose.x, pose.y, pose.theta));
+    std::optional<Vector2d> predicted_px;
+    if (track.valid()) {
+      const Vector2d p = track.positionAt(t);
+      predicted_px = camera.project(Vector3d(p.x(), p.y(), plane_z));
+    }
+    const auto det = detector.detect(frame.image, t, predicted_px);
+    bool detected = false, fused = false;
+    double nis = std::numeric_limits<double>::quiet_NaN();
+    Vector2d pixel = Vector2d::Zero();
+    if (det.ok()) {
+      pixel = det.value().blob_center;
+      if (sink) sink->measurement({channel::kPixel, t, frame.sequence, pixel, vec({cfg.pixel_sigma, cfg.pixel_sigma})});
+      const auto exact = robots::groundPointExact(camera, pixel, plane_z);
+      const auto cov = robots::groundPointCovariance(
+          camera, pixel, cfg.pixel_sigma * cfg.pixel_sigma * Eigen::Matrix2d::Identity(), plane_z);
+      if (exact && cov) {
+        detected = true;
+        ++run.detections;
+        if (last_seen >= 0.0) run.longest_lost = std::max(run.longest_lost, t - last_seen);
+        if (first_seen < 0.0) first_seen = t;
+        last_seen = t;
+        const auto a = robots::groundPointAnglePerPixel(camera, pixel, printed, plane_z);
+        const auto h = robots::groundPointAnglePerPixel(camera, pixel, horizontal, plane_z);
+        if (a && h) {
+          run.localization.sse_exact += (*exact - obj).squaredNorm();
+          run.localization.sse_printed += (*a - obj).squaredNorm();
+          run.localization.sse_horizontal += (*h - obj).squaredNorm();
+          ++run.localization.count;
+        }
+        const Eigen::Matrix2d R = *cov + cfg.floor_sigma * cfg.floor_sigma * Eigen::Matrix2d::Identity();
+        const tracking::UnicycleUpdate u = track.update(t, *exact, R);
+        fused = u.fused;
+        nis = u.report.nis;
+        if (sink) {
+          const double nan = std::numeric_limits<double>::quiet_NaN();
+          sink->measurement({channel::kFloor, t, frame.sequence, *exact, R.diagonal().cwiseSqrt()});
+          sink->measurement({channel::kFloorAnglePerPixel, t, frame.sequence,
+                             vec({a ? a->x() : nan, a ? a->y() : nan, h ? h->x() : nan, h ? h->y() : nan}),
+                             {}});
+          if (u.decision) {
+            sink->innovation({channel::kObject, t, frame.sequence, 0, 2, u.report.innovation, u.report.S, u.report.nis,
+                              *u.decision});
+          }
+        }
+      }
+    }
+    track.predictTo(t);
+    if (track.valid()) {
+      prediction = predictPath(track, cfg);
+      plan = planning::planCapture(prediction, {{pose.x, pose.y}, pose.theta}, cfg.planner);
+      const Vector2d rel = toRobot(pose, track.state().x().head<2>());
+      centre_bearing = std::atan2(rel.y(), rel.x());
+      have_bearing = true;
+    }
+    if (sink) {
+      sink->estimate({channel::kTruthObject, t, vec({truth.x, truth.y, truth.theta, truth.v, truth.omega}), {}});
+      sink->estimate({channel::kTruthRobot, t, vec({pose.x, pose.y, pose.theta, robot.q.tilt, robot.q.pan}), {}});
+      if (track.valid()) sink->estimate({channel::kObject, t, track.state().x(), track.state().P()});
+      sink->command({channel::kPlan, t,
+                     vec({plan.reachable ? 1.0 : 0.0, static_cast<double>(plan.steps), plan.point.x(), plan.point.y(),
+                          static_cast<double>(static_cast<int>(mode))})});
+    }
+    if (hooks && hooks->on_frame) {
+      MobileCaptureFrame f;
+      f.t = t;
+      f.image = &frame.image;
+      f.detected = detected;
+      f.pixel = pixel;
+      f.robot = pose;
+      f.joints = robot.q;
+      f.object_true = obj;
+      f.fused = fused;
+      f.nis = nis;
+      f.estimate_valid = track.valid();
+      if (track.valid()) f.estimate = track.state().x();
+      f.prediction = prediction;
+      f.plan = plan;
+      f.mode = mode;
+      hooks->on_frame(f);
+    }
+    if (hooks && hooks->quit_requested && hooks->quit_requested()) sched.requestStop();
+  };
+  // Frames when the source has them (a renderer: every vision period, on the control ticks).
+  std::function<void()> next_frame = [&] {
+    const auto t = source.nextReadyTime();
+    if (!t) return;
+    sched.at(*t, kVision, [&](double) {
+      if (auto frame = source.grab()) process(*frame);
+      next_frame();
+    });
+  };
+
+  // Control: base law to the capture point and head towards the prediction, or the search.
+  Ticks drive(sched, clock, 1, kDrive, [&](long, double t) {
+    const robots::BasePose pose = robot.base.pose();
+    const control::SearchMode new_mode = track.valid() ? search.mode(t, last_seen) : control::SearchMode::Sweeping;
+    if (new_mode == control::SearchMode::Sweeping && mode != control::SearchMode::Sweeping) sweep_start = t;
+    if (sweep_start < 0.0) sweep_start = t;
+    mode = new_mode;
+    control::BaseCommand cmd;
+    robots::PanTiltJoints head_target = robot.q;
+    if (mode != control::SearchMode::Sweeping) {
+      cmd = control::goToPoint(pose, plan.point, cfg.go);
+      const Vector2d p = track.positionAt(t + cfg.control_period);
+      head_target = control::headSetPoint(robot.head, pose, Vector3d(p.x(), p.y(), plane_z));
+    } else {
+      head_target = search.sweep(robot.head, t, sweep_start, have_bearing ? centre_bearing : 0.0);
+      cmd = search.baseWhileSearching(centre_bearing, have_bearing);
+      if (have_bearing) {
+        // The base turns towards the bearing; it is expressed in the robot frame at the last
+        // estimate, so update it with the base's own rotation.
+        centre_bearing = std::remainder(centre_bearing - robot.base.turnRate() * cfg.control_period, 2.0 * M_PI);
+      }
+    }
+    robot.stepHead(head_target);
+    robot.base.setCommand(cmd.v, cmd.omega);
+    robot.base.step(rng.drive);
+    if (sink) {
+      sink->command({channel::kBase, t, vec({cmd.v, cmd.omega})});
+      sink->command({channel::kHead, t, vec({head_target.tilt, head_target.pan})});
+    }
+  });
+
+  grasp.start(0);
+  next_frame();
+  drive.start(0);
+  sched.runUntil(clock.time(clock.last));
+  if (!run.captured) run.capture_time = cfg.max_time;
+  run.gate = track.gate().counts();
+  if (sink) sink->flush();
+
+  const OracleResult oracle = runOracle(cfg, seed);
+  run.oracle_captured = oracle.captured;
+  run.oracle_time = oracle.time;
+  return run;
+}
+
+}  // namespace viewline::scenarios
