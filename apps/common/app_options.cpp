@@ -42,10 +42,20 @@ void addCommonOptions(CLI::App& cli, CommonOptions& opt) {
                  "given without a value or with --display; otherwise as fast as possible)")
       ->expected(0, 1)
       ->default_str("1")
-      ->check(CLI::NonNegativeNumber);
+      ->check(CLI::Range(0.0, 1000.0));
   cli.add_option("--log", opt.log_dir, "CSV logs of the run in this directory");
   cli.add_option("--summary", opt.summary_path, "the metrics as JSON in this file (written atomically)");
   cli.add_flag("--quiet", opt.quiet, "no progress output");
+}
+
+std::optional<int> parseCommandLine(CLI::App& cli, int argc, char** argv) {
+  try {
+    cli.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = cli.exit(e);  // prints help, or the error and "Run with --help"
+    return code == 0 ? 0 : 2;
+  }
+  return std::nullopt;
 }
 
 int runGuarded(const std::string& app_name, const std::function<int()>& body) {

@@ -7,7 +7,7 @@
 //     CLI::App cli{"..."};
 //     apps::CommonOptions opt{"config/ball_catching.yaml"};
 //     apps::addCommonOptions(cli, opt);
-//     CLI11_PARSE(cli, argc, argv);
+//     if (const auto code = apps::parseCommandLine(cli, argc, argv)) return *code;
 //     return apps::runGuarded("ball_catching", [&] { ...; return 0; });
 //   }
 //
@@ -16,6 +16,7 @@
 #include <CLI/CLI.hpp>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -43,6 +44,11 @@ struct CommonOptions {
 
 /// Adds the common flags to `cli` (with --headless/--display excluding each other).
 void addCommonOptions(CLI::App& cli, CommonOptions& opt);
+
+/// Parses the command line. nullopt: go on; otherwise the exit status to return at once: 0 after
+/// --help, 2 for a usage error (unknown flag, bad value, excluded pair), with CLI11's message.
+/// (CLI11_PARSE would return CLI11's own codes, e.g. 105/108, instead of 2.)
+std::optional<int> parseCommandLine(CLI::App& cli, int argc, char** argv);
 
 /// Runs `body` and maps exceptions to exit codes: viewline::core::InvalidInput and other
 /// core::Error → 1 with "<app>: <message>" on stderr; anything else → 1 with its what().

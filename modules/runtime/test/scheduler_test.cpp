@@ -85,7 +85,7 @@ TEST(Scheduler, StopRequestReturnsBeforeTheNextEvent) {
   int n = 0;
   s.every(0.0, 1.0, 0, [&](double t) {
     ++n;
-    if (t >= 2.0) s.requestStop();
+    if (t == 2.0) s.requestStop();
   });
   s.runUntil(10.0);
   EXPECT_EQ(n, 3);

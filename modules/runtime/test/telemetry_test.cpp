@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <string>
 
 #include "viewline/io/log.h"
@@ -28,7 +29,9 @@ InnovationRecord innov(const std::string& ch, double t, GateDecision d, double n
 }
 std::string slurp(const std::filesystem::path& p) {
   std::ifstream in(p);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
 }
 }  // namespace
 

@@ -1,6 +1,6 @@
 #include "viewline/viz/display_controls.h"
 
-#include <cstring>
+#include <string>
 #include <visp3/core/vpDisplay.h>
 #include <visp3/core/vpTime.h>
 
@@ -10,29 +10,28 @@ namespace {
 bool hasDisplay(const vpImage<vpRGBa>& I) { return I.display != nullptr; }
 }  // namespace
 
-bool DisplayControls::handle(const char* key) {
-  if (std::strcmp(key, "q") == 0 || std::strcmp(key, "Q") == 0 || std::strcmp(key, "\x1b") == 0 ||
-      std::strcmp(key, "Escape") == 0) {
+bool DisplayControls::handle(const std::string& key) {
+  if (key == "q" || key == "Q" || key == "\x1b" || key == "Escape") {
     quit_ = true;
     paused_ = false;
     return true;
   }
-  if (std::strcmp(key, " ") == 0 || std::strcmp(key, "space") == 0) {
+  if (key == " " || key == "space") {
     paused_ = !paused_;
     return true;
   }
-  if (std::strcmp(key, "n") == 0 || std::strcmp(key, "N") == 0) return paused_;  // one step: leave the wait
+  if (key == "n" || key == "N") return paused_;  // one step: leave the wait
   return false;
 }
 
 bool DisplayControls::poll(const vpImage<vpRGBa>& I) {
   if (quit_) return false;
   if (!hasDisplay(I)) return true;
-  char key[64] = {0};
-  if (vpDisplay::getKeyboardEvent(I, key, sizeof key, false)) handle(key);
+  std::string key;
+  if (vpDisplay::getKeyboardEvent(I, key, false)) handle(key);
   while (paused_ && !quit_) {
-    std::memset(key, 0, sizeof key);
-    if (vpDisplay::getKeyboardEvent(I, key, sizeof key, false)) {
+    key.clear();
+    if (vpDisplay::getKeyboardEvent(I, key, false)) {
       const bool was_paused = paused_;
       if (handle(key) && was_paused && paused_) break;  // 'n': one frame, still paused
       continue;
@@ -54,10 +53,9 @@ void DisplayControls::waitForClose(const vpImage<vpRGBa>& I) const {
   if (quit_ || !hasDisplay(I)) return;
   vpDisplay::displayText(I, 14 + 16 * 3, 8, "run finished: click or press a key to close", vpColor::orange);
   vpDisplay::flush(I);
-  char key[64] = {0};
   while (true) {
     if (vpDisplay::getClick(I, false)) return;
-    if (vpDisplay::getKeyboardEvent(I, key, sizeof key, false)) return;
+    if (vpDisplay::getKeyboardEvent(I, false)) return;
     vpTime::wait(20);
   }
 }

@@ -14,6 +14,7 @@
 //
 // The legend is drawn by drawLegend(I) before the flush. With no X display nothing here blocks.
 
+#include <string>
 #include <visp3/core/vpImage.h>
 #include <visp3/core/vpRGBa.h>
 
@@ -34,7 +35,7 @@ public:
   bool quitRequested() const { return quit_; }
 
 private:
-  bool handle(const char* key);
+  bool handle(const std::string& key);
   bool paused_ = false;
   bool quit_ = false;
 };
