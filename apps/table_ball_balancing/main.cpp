@@ -1,7 +1,9 @@
 // table_ball_balancing: [M]'s table-ball observer in the closed loop it was built for.
 // Thin main: the common flags (apps/common), the YAML scenario, scenarios::runTableBall, the
-// summary. --duration D is the common "simulated seconds" flag: the same as --set duration=D.
+// summary. --duration S is the common "simulated seconds" flag (as --set duration=S, which also
+// works; the flag keeps the config file's relative paths as written in the summary).
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -20,16 +22,15 @@ using namespace viewline;
 int main(int argc, char** argv) {
   CLI::App cli{"Table-ball balancing: [M]'s observer (table PnP, ball on table, rolling-ball Kalman filter) "
                "and an LQR that tilts the table, on a rendered head-camera view"};
-  apps::CommonOptions opt{"config/table_ball.yaml"};
+  apps::CommonOptions opt;
+  opt.config_path = "config/table_ball.yaml";
   apps::addCommonOptions(cli, opt);
-  std::string duration;
-  cli.add_option("--duration", duration, "simulated seconds (the same as --set duration=S)")
-      ->check(CLI::PositiveNumber);
-  CLI11_PARSE(cli, argc, argv);
+  double duration = 0.0;
+  cli.add_option("--duration", duration, "simulated seconds (default: the config's duration)")->check(CLI::PositiveNumber);
+  if (const auto code = apps::parseCommandLine(cli, argc, argv)) return *code;
   return apps::runGuarded("table_ball_balancing", [&] {
-    std::vector<std::string> sets = opt.sets;
-    if (!duration.empty()) sets.push_back("duration=" + duration);
-    const scenarios::TableBallConfig cfg = scenarios::tableBallConfigFromYaml(io::loadConfigWithValues(opt.config_path, sets));
+    scenarios::TableBallConfig cfg = scenarios::tableBallConfigFromYaml(io::loadConfigWithValues(opt.config_path, opt.sets));
+    if (duration > 0.0) cfg.duration = duration;  // > 0 checked by CLI11: the config stays valid
     io::LogDirectory log(opt.log_dir);
     runtime::CsvSink csv(log);
     scenarios::TableBallHooks hooks;
@@ -40,11 +41,11 @@ int main(int argc, char** argv) {
       view = std::make_unique<viz::TableBallDisplay>(cfg.table_side, cfg.ball_radius);
       hooks.on_frame = [&](const scenarios::TableBallFrameView& v) { return view->show(v); };
     }
-    runtime::Progress progress =
-        opt.quiet ? runtime::Progress::quiet() : runtime::Progress("simulated s", std::lround(cfg.duration));
+    const long total = std::max(1L, std::lround(std::ceil(cfg.duration)));
+    runtime::Progress progress = opt.quiet ? runtime::Progress::quiet() : runtime::Progress("simulated s", total);
     hooks.on_progress = [&](double t, double) { progress.update(static_cast<long>(t)); };
     const scenarios::TableBallResult r = scenarios::runTableBall(cfg, opt.seed, hooks);
-    if (!r.stopped_early) progress.update(std::lround(cfg.duration));
+    if (!r.stopped_early) progress.update(total);
     progress.finish();
     nlohmann::json j = scenarios::toJson(r);
     j["rig"] = cfg.rig ? nlohmann::json(cfg.rig->folder) : nlohmann::json(nullptr);

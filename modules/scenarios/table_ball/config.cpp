@@ -4,6 +4,7 @@
 
 #include "viewline/core/checks.h"
 #include "viewline/core/error.h"
+#include "viewline/core/frames.h"
 #include "viewline/io/camera_fields.h"
 #include "viewline/scenarios/simulated_rig.h"
 

@@ -246,11 +246,11 @@ nlohmann::json toJson(const TableBallResult& r) {
 namespace {
 
 /// printf of a finite figure; otherwise why it has no value.
-std::string figure(double v, const char* format, const std::string& why_missing) {
+std::string figure(double v, int decimals, const std::string& why_missing) {
   if (std::isinf(v)) return "never (within its window)";
   if (std::isnan(v)) return why_missing;
   char buf[64];
-  std::snprintf(buf, sizeof buf, format, v);
+  std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
   return buf;
 }
 
@@ -259,12 +259,12 @@ std::string figure(double v, const char* format, const std::string& why_missing)
 void printTableBallSummary(std::FILE* out, const TableBallResult& r, const TableBallConfig& cfg) {
   const std::string unscored = r.duration <= cfg.warmup
                                    ? "not scored (run shorter than the warm-up, metrics.warmup = " +
-                                         figure(cfg.warmup, "%g", "?") + " s)"
+                                         figure(cfg.warmup, 2, "?") + " s)"
                                    : std::string("not scored (nothing measured after the warm-up)");
   const std::string no_side = cfg.compare_tunings ? unscored : "not run (metrics.compare_tunings: false)";
   const std::string no_steps = "not scored (no set-point step of at least metrics.min_step in the run)";
   const std::string no_timing = cfg.time_reference ? "not timed (no frame)" : "not timed (metrics.time_reference: false)";
-  auto f = [](double v, const char* format, const std::string& why) { return figure(v, format, why); };
+  auto f = [](double v, int decimals, const std::string& why) { return figure(v, decimals, why); };
 
   std::fprintf(out, "table_ball_balancing: %.1f s, seed %llu, %d frames (%d dropped), table found %d, ball found %d%s\n",
                r.duration, static_cast<unsigned long long>(r.seed), r.frames, r.frames_dropped, r.table_detections,
@@ -275,26 +275,42 @@ void printTableBallSummary(std::FILE* out, const TableBallResult& r, const Table
   } else {
     std::fprintf(out, "  camera: inline config keys (one perfect camera)\n");
   }
-  std::fprintf(out, "  observer RMSE %s mm (measurements %s mm); [M] tunings: sw=1,sv=0.005 %s mm, sw=sv=1 %s mm; "
-               "stationary gain %s mm\n",
-               f(r.observer_rmse_mm, "%.2f", unscored).c_str(), f(r.measurement_rmse_mm, "%.2f", unscored).c_str(),
-               f(r.observer_rmse_mm_M_sw1_sv0005, "%.2f", no_side).c_str(),
-               f(r.observer_rmse_mm_M_sw1_sv1, "%.2f", no_side).c_str(),
-               f(r.observer_rmse_mm_stationary, "%.2f", no_side).c_str());
-  std::fprintf(out, "  10-step prediction RMSE %s mm, tilt RMSE %s deg, NIS mean %s\n",
-               f(r.prediction_rmse_mm_10, "%.2f", unscored).c_str(), f(r.tilt_rmse_deg, "%.3f", unscored).c_str(),
-               f(r.nis_mean, "%.2f", unscored).c_str());
-  std::fprintf(out, "  steps (worst): overshoot %s %%, settling %s s, steady-state error %s mm; push recovery %s s\n",
-               f(r.overshoot_pct, "%.1f", no_steps).c_str(), f(r.settling_time_s, "%.2f", no_steps).c_str(),
-               f(r.steady_state_error_mm, "%.2f", no_steps).c_str(),
-               f(r.push_recovery_s, "%.2f", "not scored (no push in the run)").c_str());
-  std::fprintf(out, "  frame cost: observer %s ms, plain OpenCV reference %s ms, ratio %s\n",
-               f(r.observer_frame_ms, "%.3f", no_timing).c_str(), f(r.reference_frame_ms, "%.3f", no_timing).c_str(),
-               f(r.frame_time_ratio_to_reference, "%.3f", no_timing).c_str());
-  std::fprintf(out, "  fast path (edge tracking) on %d of %d frames\n", r.tracked_frames, r.frames);
-  std::fprintf(out, "  frame CPU time (this thread): observer %s ms, reference %s ms, ratio %s\n",
-               f(r.observer_frame_cpu_ms, "%.3f", no_timing).c_str(), f(r.reference_frame_cpu_ms, "%.3f", no_timing).c_str(),
-               f(r.frame_cpu_ratio_to_reference, "%.3f", no_timing).c_str());
+  // A line whose figures were all not scored says why once.
+  if (std::isnan(r.observer_rmse_mm) && std::isnan(r.measurement_rmse_mm)) {
+    std::fprintf(out, "  observer and measurement RMSE: %s\n", unscored.c_str());
+  } else {
+    std::fprintf(out, "  observer RMSE %s mm (measurements %s mm); [M] tunings: sw=1,sv=0.005 %s mm, sw=sv=1 %s mm; "
+                 "stationary gain %s mm\n",
+                 f(r.observer_rmse_mm, 2, unscored).c_str(), f(r.measurement_rmse_mm, 2, unscored).c_str(),
+                 f(r.observer_rmse_mm_M_sw1_sv0005, 2, no_side).c_str(),
+                 f(r.observer_rmse_mm_M_sw1_sv1, 2, no_side).c_str(),
+                 f(r.observer_rmse_mm_stationary, 2, no_side).c_str());
+  }
+  if (std::isnan(r.prediction_rmse_mm_10) && std::isnan(r.tilt_rmse_deg) && std::isnan(r.nis_mean)) {
+    std::fprintf(out, "  prediction and tilt RMSE, NIS mean: %s\n", unscored.c_str());
+  } else {
+    std::fprintf(out, "  10-step prediction RMSE %s mm, tilt RMSE %s deg, NIS mean %s\n",
+                 f(r.prediction_rmse_mm_10, 2, unscored).c_str(), f(r.tilt_rmse_deg, 3, unscored).c_str(),
+                 f(r.nis_mean, 2, unscored).c_str());
+  }
+  const std::string push = f(r.push_recovery_s, 2, "not scored (no push in the run)");
+  if (r.steps.empty()) {
+    std::fprintf(out, "  steps: %s; push recovery %s%s\n", no_steps.c_str(), push.c_str(), r.pushes.empty() ? "" : " s");
+  } else {
+    std::fprintf(out, "  steps (worst): overshoot %s %%, settling %s s, steady-state error %s mm; push recovery %s%s\n",
+                 f(r.overshoot_pct, 1, no_steps).c_str(), f(r.settling_time_s, 2, no_steps).c_str(),
+                 f(r.steady_state_error_mm, 2, no_steps).c_str(), push.c_str(), r.pushes.empty() ? "" : " s");
+  }
+  if (std::isnan(r.observer_frame_ms)) {
+    std::fprintf(out, "  frame cost: %s\n", no_timing.c_str());
+    std::fprintf(out, "  fast path (edge tracking) on %d of %d frames\n", r.tracked_frames, r.frames);
+  } else {
+    std::fprintf(out, "  frame cost: observer %.3f ms, plain OpenCV reference %.3f ms, ratio %.3f\n", r.observer_frame_ms,
+                 r.reference_frame_ms, r.frame_time_ratio_to_reference);
+    std::fprintf(out, "  fast path (edge tracking) on %d of %d frames\n", r.tracked_frames, r.frames);
+    std::fprintf(out, "  frame CPU time (this thread): observer %.3f ms, reference %.3f ms, ratio %.3f\n",
+                 r.observer_frame_cpu_ms, r.reference_frame_cpu_ms, r.frame_cpu_ratio_to_reference);
+  }
   std::fprintf(out, "  commands: max |tilt| %.2f deg, max rate %.1f deg/s, limits %s; wall %.1f s\n",
                r.max_commanded_angle_deg, r.max_commanded_rate_deg_s, r.limits_respected ? "respected" : "VIOLATED",
                r.wall_seconds);

@@ -47,7 +47,7 @@ sim::TableAppearance appearance(const TableBallConfig& cfg) {
 }
 
 /// `camera` renders (the truth); with a rig, the observer believes in the calibrated one.
-core::Camera renderCamera(const TableBallConfig& cfg) {
+core::Camera makeRenderCamera(const TableBallConfig& cfg) {
   if (cfg.rig) return cfg.rig->truth;
   core::Camera camera;
   camera.name = "head";
@@ -117,7 +117,7 @@ TableBallWorld::TableBallWorld(const TableBallConfig& config, std::uint64_t seed
       table_(makeTable(cfg_)),
       wrist_(cfg_.wrist),
       scene_(table_, roomScene(room_rng_), appearance(cfg_)),
-      camera_(renderCamera(cfg_)),
+      camera_(makeRenderCamera(cfg_)),
       obs_camera_(cfg_.rig ? cfg_.rig->calibrated : camera_),
       sway_(makeSway()),
       rig_({simCamera(cfg_, camera_, sway_)}, rig_rng_, renderSettings(cfg_)) {
