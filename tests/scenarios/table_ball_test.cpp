@@ -63,29 +63,43 @@ TEST(TableBallScenario, ShortClosedLoopRunTracksAndSettles) {
   }
 }
 
+/// One short run as fast as possible with every record kept, shared by the tests below.
+struct RecordedRun {
+  scenarios::TableBallConfig cfg;
+  runtime::MemorySink sink;
+  scenarios::TableBallResult result;
+};
+const RecordedRun& recordedRun() {
+  static const RecordedRun* run = [] {
+    auto* r = new RecordedRun;
+    r->cfg = shortRun();
+    r->cfg.duration = 1.0;
+    scenarios::TableBallHooks hooks;
+    hooks.telemetry = &r->sink;
+    r->result = scenarios::runTableBall(r->cfg, 3, hooks);
+    return r;
+  }();
+  return *run;
+}
+
 // The scheduler only decides when events run on the wall clock, never what runs or in which
-// order: a run paced at 20x real time equals the one as fast as possible (same seed), bit for bit.
+// order: a run paced at 20x real time (and without a sink) equals the one as fast as possible
+// (same seed), bit for bit.
 TEST(TableBallScenario, PacedRunEqualsTheFastOne) {
-  scenarios::TableBallConfig cfg = shortRun();
-  cfg.duration = 1.0;
-  cfg.compare_tunings = false;
-  const auto fast = scenarios::runTableBall(cfg, 5);
+  const RecordedRun& fast = recordedRun();
   scenarios::TableBallHooks paced;
   paced.pacing = runtime::Pacing{20.0};
-  const auto slow = scenarios::runTableBall(cfg, 5, paced);
-  EXPECT_EQ(seeded(fast).dump(), seeded(slow).dump());
-  EXPECT_GE(slow.wall_seconds, 0.9 * cfg.duration / 20.0);  // it was paced
+  const auto slow = scenarios::runTableBall(fast.cfg, 3, paced);
+  EXPECT_EQ(seeded(fast.result).dump(), seeded(slow).dump());
+  EXPECT_GE(slow.wall_seconds, 0.9 * fast.cfg.duration / 20.0);  // it was paced
 }
 
 // The sink sees every update the observer's filter made, with its own NIS and gate decision:
 // the counts and the NIS mean match the summary.
 TEST(TableBallScenario, TelemetrySeesEveryObserverUpdate) {
-  scenarios::TableBallConfig cfg = shortRun();
-  cfg.duration = 1.0;
-  runtime::MemorySink sink;
-  scenarios::TableBallHooks hooks;
-  hooks.telemetry = &sink;
-  const auto r = scenarios::runTableBall(cfg, 11, hooks);
+  const RecordedRun& run = recordedRun();
+  const runtime::MemorySink& sink = run.sink;
+  const scenarios::TableBallResult& r = run.result;
   const auto updates = sink.innovationsOf("ball");
   ASSERT_EQ(updates.size(), static_cast<std::size_t>(r.ball_detections));
   EXPECT_EQ(sink.count(tracking::GateDecision::Start, "ball"), 1u);
@@ -99,7 +113,7 @@ TEST(TableBallScenario, TelemetrySeesEveryObserverUpdate) {
     ASSERT_EQ(u.innovation.size(), 2);
     ASSERT_EQ(u.S.rows(), 2);
     EXPECT_TRUE(std::isfinite(u.nis) && u.nis >= 0.0);
-    if (u.t >= cfg.warmup) {
+    if (u.t >= run.cfg.warmup) {
       nis_sum += u.nis;
       ++nis_n;
     }
@@ -125,7 +139,7 @@ TEST(TableBallScenario, ShortRunSaysWhatWasNotScored) {
   scenarios::TableBallConfig cfg = shortRun();
   cfg.duration = 0.2;
   cfg.compare_tunings = false;
-  const auto r = scenarios::runTableBall(cfg, 2);
+  const scenarios::TableBallResult r = scenarios::TableBallMetrics(cfg).result(2);  // nothing recorded
   EXPECT_TRUE(std::isnan(r.observer_rmse_mm));
   std::FILE* f = std::tmpfile();
   ASSERT_NE(f, nullptr);
