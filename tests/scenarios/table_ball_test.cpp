@@ -34,13 +34,56 @@ nlohmann::json seeded(const scenarios::TableBallResult& r) {
   return j;
 }
 
+/// The sink saw every update the observer's filter made, with its own NIS and gate decision:
+/// the counts and the NIS mean match the summary.
+void expectEveryUpdateReported(const runtime::MemorySink& sink, const scenarios::TableBallResult& r,
+                               const scenarios::TableBallConfig& cfg) {
+  const auto updates = sink.innovationsOf("ball");
+  ASSERT_EQ(updates.size(), static_cast<std::size_t>(r.ball_detections));
+  EXPECT_EQ(sink.count(tracking::GateDecision::Start, "ball"), 1u);
+  EXPECT_EQ(sink.count(tracking::GateDecision::Accept, "ball"), updates.size() - 1);
+  EXPECT_EQ(sink.count(tracking::GateDecision::Reject, "ball") + sink.count(tracking::GateDecision::Restart, "ball"), 0u);
+  double nis_sum = 0.0;
+  int nis_n = 0;
+  for (const auto& u : updates) {
+    EXPECT_EQ(u.rows, 2);
+    if (u.decision != tracking::GateDecision::Accept) continue;
+    ASSERT_EQ(u.innovation.size(), 2);
+    ASSERT_EQ(u.S.rows(), 2);
+    EXPECT_TRUE(std::isfinite(u.nis) && u.nis >= 0.0);
+    if (u.t >= cfg.warmup) {
+      nis_sum += u.nis;
+      ++nis_n;
+    }
+  }
+  ASSERT_GT(nis_n, 100);
+  EXPECT_EQ(nis_sum / nis_n, r.nis_mean);
+  std::size_t balls = 0, tilts = 0, inputs = 0, truths = 0;
+  for (const auto& m : sink.measurements) {
+    balls += m.channel == "ball";
+    tilts += m.channel == "table_tilt";
+    inputs += m.channel == "ball_acceleration";
+  }
+  for (const auto& e : sink.estimates) truths += e.channel == "truth";
+  EXPECT_EQ(balls, static_cast<std::size_t>(r.ball_detections));
+  EXPECT_EQ(tilts, static_cast<std::size_t>(r.table_detections));
+  EXPECT_EQ(inputs, static_cast<std::size_t>(r.frames));
+  EXPECT_EQ(truths, static_cast<std::size_t>(r.frames));
+  EXPECT_FALSE(sink.commands.empty());
+}
+
 const std::string kMinimal = "events: {setpoints: [{t: 0.0, xy: [0.0, 0.0]}]}\ntable: {}\nwrist: {}\nobserver: {}\n"
                              "controller: {}\n";
 }  // namespace
 
-TEST(TableBallScenario, ShortClosedLoopRunTracksAndSettles) {
+// The closed loop tracks and settles, and its telemetry sink sees every update of the observer.
+TEST(TableBallScenario, ShortClosedLoopRunTracksSettlesAndReportsEveryUpdate) {
   const scenarios::TableBallConfig cfg = shortRun();
-  const scenarios::TableBallResult r = scenarios::runTableBall(cfg, 7);
+  runtime::MemorySink sink;
+  scenarios::TableBallHooks hooks;
+  hooks.telemetry = &sink;
+  const scenarios::TableBallResult r = scenarios::runTableBall(cfg, 7, hooks);
+  expectEveryUpdateReported(sink, r, cfg);
   EXPECT_EQ(r.frames, 250);
   EXPECT_GE(r.ball_detections, 230);
   EXPECT_GE(r.table_detections, 230);
@@ -63,75 +106,19 @@ TEST(TableBallScenario, ShortClosedLoopRunTracksAndSettles) {
   }
 }
 
-/// One short run as fast as possible with every record kept, shared by the tests below.
-struct RecordedRun {
-  scenarios::TableBallConfig cfg;
-  runtime::MemorySink sink;
-  scenarios::TableBallResult result;
-};
-const RecordedRun& recordedRun() {
-  static const RecordedRun* run = [] {
-    auto* r = new RecordedRun;
-    r->cfg = shortRun();
-    r->cfg.duration = 1.0;
-    scenarios::TableBallHooks hooks;
-    hooks.telemetry = &r->sink;
-    r->result = scenarios::runTableBall(r->cfg, 3, hooks);
-    return r;
-  }();
-  return *run;
-}
-
 // The scheduler only decides when events run on the wall clock, never what runs or in which
 // order: a run paced at 20x real time (and without a sink) equals the one as fast as possible
 // (same seed), bit for bit.
 TEST(TableBallScenario, PacedRunEqualsTheFastOne) {
-  const RecordedRun& fast = recordedRun();
+  scenarios::TableBallConfig cfg = shortRun();
+  cfg.duration = 1.0;
+  cfg.compare_tunings = false;
+  const auto fast = scenarios::runTableBall(cfg, 3);
   scenarios::TableBallHooks paced;
   paced.pacing = runtime::Pacing{20.0};
-  const auto slow = scenarios::runTableBall(fast.cfg, 3, paced);
-  EXPECT_EQ(seeded(fast.result).dump(), seeded(slow).dump());
-  EXPECT_GE(slow.wall_seconds, 0.9 * fast.cfg.duration / 20.0);  // it was paced
-}
-
-// The sink sees every update the observer's filter made, with its own NIS and gate decision:
-// the counts and the NIS mean match the summary.
-TEST(TableBallScenario, TelemetrySeesEveryObserverUpdate) {
-  const RecordedRun& run = recordedRun();
-  const runtime::MemorySink& sink = run.sink;
-  const scenarios::TableBallResult& r = run.result;
-  const auto updates = sink.innovationsOf("ball");
-  ASSERT_EQ(updates.size(), static_cast<std::size_t>(r.ball_detections));
-  EXPECT_EQ(sink.count(tracking::GateDecision::Start, "ball"), 1u);
-  EXPECT_EQ(sink.count(tracking::GateDecision::Accept, "ball"), updates.size() - 1);
-  EXPECT_EQ(sink.count(tracking::GateDecision::Reject, "ball") + sink.count(tracking::GateDecision::Restart, "ball"), 0u);
-  double nis_sum = 0.0;
-  int nis_n = 0;
-  for (const auto& u : updates) {
-    EXPECT_EQ(u.rows, 2);
-    if (u.decision != tracking::GateDecision::Accept) continue;
-    ASSERT_EQ(u.innovation.size(), 2);
-    ASSERT_EQ(u.S.rows(), 2);
-    EXPECT_TRUE(std::isfinite(u.nis) && u.nis >= 0.0);
-    if (u.t >= run.cfg.warmup) {
-      nis_sum += u.nis;
-      ++nis_n;
-    }
-  }
-  ASSERT_GT(nis_n, 20);
-  EXPECT_EQ(nis_sum / nis_n, r.nis_mean);
-  std::size_t balls = 0, tilts = 0, inputs = 0, truths = 0;
-  for (const auto& m : sink.measurements) {
-    balls += m.channel == "ball";
-    tilts += m.channel == "table_tilt";
-    inputs += m.channel == "ball_acceleration";
-  }
-  for (const auto& e : sink.estimates) truths += e.channel == "truth";
-  EXPECT_EQ(balls, static_cast<std::size_t>(r.ball_detections));
-  EXPECT_EQ(tilts, static_cast<std::size_t>(r.table_detections));
-  EXPECT_EQ(inputs, static_cast<std::size_t>(r.frames));
-  EXPECT_EQ(truths, static_cast<std::size_t>(r.frames));
-  EXPECT_FALSE(sink.commands.empty());
+  const auto slow = scenarios::runTableBall(cfg, 3, paced);
+  EXPECT_EQ(seeded(fast).dump(), seeded(slow).dump());
+  EXPECT_GE(slow.wall_seconds, 0.9 * cfg.duration / 20.0);  // it was paced
 }
 
 // A run shorter than the warm-up scores no error: the summary says so instead of printing nan.
