@@ -88,12 +88,13 @@ RollingBallTrackerConfig TableBallConfig::trackerConfig() const {
   return c;
 }
 
-control::TableBalancerConfig TableBallConfig::controllerConfig() const {
+control::TableBalancerConfig TableBallConfig::controllerConfig(const robots::TableTilt& arm) const {
+  const robots::TableTiltLimits& limits = arm.limits();
   control::TableBalancerConfig k = controller;
   k.period = framePeriod();
-  k.delay = latency + wrist.delay;  // capture -> ramp start, then the wrist's own delay
-  k.max_angle = wrist.max_angle;
-  k.max_rate = wrist.max_rate;
+  k.delay = latency + limits.delay;  // capture -> ramp start, then the wrist's own delay
+  k.max_angle = limits.max_angle;
+  k.max_rate = limits.max_rate;
   return k;
 }
 

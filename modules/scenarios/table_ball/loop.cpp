@@ -126,7 +126,7 @@ TableBallResult runTableBall(const TableBallConfig& cfg, std::uint64_t seed, con
   TableBallObserver observer(obs_camera, ocfg);
   SideFilters side = makeSideFilters(cfg, ocfg.tracker);
   ReferencePipeline reference(obs_camera, ocfg);
-  control::TableBalancer controller(cfg.controllerConfig());
+  control::TableBalancer controller(cfg.controllerConfig(world.wrist()));
   TableBallMetrics metrics(cfg);
   runtime::TelemetrySink* sink = hooks.telemetry;
 

@@ -88,9 +88,9 @@ struct TableBallConfig {
   /// The rolling-ball filter as the observer runs it: the configured tuning on this table
   /// (L, r) with the camera's frame period as its nominal period.
   RollingBallTrackerConfig trackerConfig() const;
-  /// The controller: the configured weights, the camera's period, the wrist's limits, and as
-  /// model delay the processing latency plus the wrist's own delay.
-  control::TableBalancerConfig controllerConfig() const;
+  /// The controller: the configured weights, the camera's period, and what it asks the wrist
+  /// it commands: its limits, and its delay, which with the processing latency is the model delay.
+  control::TableBalancerConfig controllerConfig(const robots::TableTilt& wrist) const;
 };
 
 /// Reads the YAML scenario (documented in config/table_ball.yaml); unknown keys are errors.
