@@ -2,10 +2,13 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
+#include <string>
 
 #include "viewline/core/error.h"
 #include "viewline/core/frames.h"
 #include "viewline/io/config.h"
+#include "viewline/runtime/telemetry.h"
 #include "viewline/scenarios/table_ball.h"
 
 using namespace viewline;
@@ -20,13 +23,67 @@ scenarios::TableBallConfig shortRun() {
   c.pushes.clear();
   c.warmup = 0.5;
   c.time_reference = false;
+  c.validate();
   return c;
 }
+
+/// The summary without its wall-clock figure.
+nlohmann::json seeded(const scenarios::TableBallResult& r) {
+  nlohmann::json j = scenarios::toJson(r);
+  j.erase("wall_seconds");
+  return j;
+}
+
+/// The sink saw every update the observer's filter made, with its own NIS and gate decision:
+/// the counts and the NIS mean match the summary.
+void expectEveryUpdateReported(const runtime::MemorySink& sink, const scenarios::TableBallResult& r,
+                               const scenarios::TableBallConfig& cfg) {
+  const auto updates = sink.innovationsOf("ball");
+  ASSERT_EQ(updates.size(), static_cast<std::size_t>(r.ball_detections));
+  EXPECT_EQ(sink.count(tracking::GateDecision::Start, "ball"), 1u);
+  EXPECT_EQ(sink.count(tracking::GateDecision::Accept, "ball"), updates.size() - 1);
+  EXPECT_EQ(sink.count(tracking::GateDecision::Reject, "ball") + sink.count(tracking::GateDecision::Restart, "ball"), 0u);
+  double nis_sum = 0.0;
+  int nis_n = 0;
+  for (const auto& u : updates) {
+    EXPECT_EQ(u.rows, 2);
+    if (u.decision != tracking::GateDecision::Accept) continue;
+    ASSERT_EQ(u.innovation.size(), 2);
+    ASSERT_EQ(u.S.rows(), 2);
+    EXPECT_TRUE(std::isfinite(u.nis) && u.nis >= 0.0);
+    if (u.t >= cfg.warmup) {
+      nis_sum += u.nis;
+      ++nis_n;
+    }
+  }
+  ASSERT_GT(nis_n, 100);
+  EXPECT_EQ(nis_sum / nis_n, r.nis_mean);
+  std::size_t balls = 0, tilts = 0, inputs = 0, truths = 0;
+  for (const auto& m : sink.measurements) {
+    balls += m.channel == "ball";
+    tilts += m.channel == "table_tilt";
+    inputs += m.channel == "ball_acceleration";
+  }
+  for (const auto& e : sink.estimates) truths += e.channel == "truth";
+  EXPECT_EQ(balls, static_cast<std::size_t>(r.ball_detections));
+  EXPECT_EQ(tilts, static_cast<std::size_t>(r.table_detections));
+  EXPECT_EQ(inputs, static_cast<std::size_t>(r.frames));
+  EXPECT_EQ(truths, static_cast<std::size_t>(r.frames));
+  EXPECT_FALSE(sink.commands.empty());
+}
+
+const std::string kMinimal = "events: {setpoints: [{t: 0.0, xy: [0.0, 0.0]}]}\ntable: {}\nwrist: {}\nobserver: {}\n"
+                             "controller: {}\n";
 }  // namespace
 
-TEST(TableBallScenario, ShortClosedLoopRunTracksAndSettles) {
+// The closed loop tracks and settles, and its telemetry sink sees every update of the observer.
+TEST(TableBallScenario, ShortClosedLoopRunTracksSettlesAndReportsEveryUpdate) {
   const scenarios::TableBallConfig cfg = shortRun();
-  const scenarios::TableBallResult r = scenarios::runTableBall(cfg, 7);
+  runtime::MemorySink sink;
+  scenarios::TableBallHooks hooks;
+  hooks.telemetry = &sink;
+  const scenarios::TableBallResult r = scenarios::runTableBall(cfg, 7, hooks);
+  expectEveryUpdateReported(sink, r, cfg);
   EXPECT_EQ(r.frames, 250);
   EXPECT_GE(r.ball_detections, 230);
   EXPECT_GE(r.table_detections, 230);
@@ -49,21 +106,42 @@ TEST(TableBallScenario, ShortClosedLoopRunTracksAndSettles) {
   }
 }
 
-TEST(TableBallScenario, SameSeedSameRun) {
+// The scheduler only decides when events run on the wall clock, never what runs or in which
+// order: a run paced at 20x real time (and without a sink) equals the one as fast as possible
+// (same seed), bit for bit.
+TEST(TableBallScenario, PacedRunEqualsTheFastOne) {
   scenarios::TableBallConfig cfg = shortRun();
   cfg.duration = 1.0;
   cfg.compare_tunings = false;
-  const auto a = scenarios::runTableBall(cfg, 3);
-  const auto b = scenarios::runTableBall(cfg, 3);
-  EXPECT_EQ(a.ball_detections, b.ball_detections);
-  EXPECT_EQ(a.frames_dropped, b.frames_dropped);
-  EXPECT_EQ(a.observer_rmse_mm, b.observer_rmse_mm);
-  EXPECT_EQ(a.measurement_rmse_mm, b.measurement_rmse_mm);
+  const auto fast = scenarios::runTableBall(cfg, 3);
+  scenarios::TableBallHooks paced;
+  paced.pacing = runtime::Pacing{20.0};
+  const auto slow = scenarios::runTableBall(cfg, 3, paced);
+  EXPECT_EQ(seeded(fast).dump(), seeded(slow).dump());
+  EXPECT_GE(slow.wall_seconds, 0.9 * cfg.duration / 20.0);  // it was paced
+}
+
+// A run shorter than the warm-up scores no error: the summary says so instead of printing nan.
+TEST(TableBallScenario, ShortRunSaysWhatWasNotScored) {
+  scenarios::TableBallConfig cfg = shortRun();
+  cfg.duration = 0.2;
+  cfg.compare_tunings = false;
+  const scenarios::TableBallResult r = scenarios::TableBallMetrics(cfg).result(2);  // nothing recorded
+  EXPECT_TRUE(std::isnan(r.observer_rmse_mm));
+  std::FILE* f = std::tmpfile();
+  ASSERT_NE(f, nullptr);
+  scenarios::printTableBallSummary(f, r, cfg);
+  std::rewind(f);
+  std::string text;
+  char buf[512];
+  while (std::fgets(buf, sizeof buf, f) != nullptr) text += buf;
+  std::fclose(f);
+  EXPECT_EQ(text.find("nan"), std::string::npos) << text;
+  EXPECT_NE(text.find("not scored (run shorter than the warm-up"), std::string::npos) << text;
 }
 
 TEST(TableBallScenario, ConfigErrorsNameTheKey) {
-  const std::string base = "events: {setpoints: [{t: 0.0, xy: [0.0, 0.0]}]}\ntable: {}\nwrist: {}\ncamera: {}\n"
-                           "observer: {}\ncontroller: {}\n";
+  const std::string base = kMinimal + "camera: {}\n";
   EXPECT_NO_THROW(scenarios::tableBallConfigFromYaml(io::ConfigNode::fromString(base, "ok.yaml")));
   try {
     scenarios::tableBallConfigFromYaml(io::ConfigNode::fromString(base + "metrics: {warmpu: 1.0}\n", "typo.yaml"));
@@ -78,6 +156,25 @@ TEST(TableBallScenario, ConfigErrorsNameTheKey) {
     FAIL() << "unreachable set point accepted";
   } catch (const core::InvalidInput& e) {
     EXPECT_NE(std::string(e.what()).find("events.setpoints[0].xy"), std::string::npos) << e.what();
+  }
+}
+
+TEST(TableBallScenario, InlineCameraKeys) {
+  // Defaults: [M]'s 320x240 camera with a 90° field of view.
+  const auto d = scenarios::tableBallConfigFromYaml(io::ConfigNode::fromString(kMinimal + "camera: {}\n", "d.yaml"));
+  EXPECT_EQ(d.width, 320u);
+  EXPECT_EQ(d.hfov, core::deg2rad(90.0));
+  EXPECT_FALSE(d.cx.has_value());
+  const auto c = scenarios::tableBallConfigFromYaml(
+      io::ConfigNode::fromString(kMinimal + "camera: {width: 400, cx: 210.5, hfov_deg: 80}\n", "c.yaml"));
+  EXPECT_EQ(c.width, 400u);
+  EXPECT_EQ(*c.cx, 210.5);
+  EXPECT_DOUBLE_EQ(c.hfov, core::deg2rad(80.0));
+  try {
+    scenarios::tableBallConfigFromYaml(io::ConfigNode::fromString(kMinimal + "camera: {kud: 0.1}\n", "kud.yaml"));
+    FAIL() << "distortion accepted for the inline camera";
+  } catch (const core::InvalidInput& e) {
+    EXPECT_NE(std::string(e.what()).find("camera.kud"), std::string::npos) << e.what();
   }
 }
 

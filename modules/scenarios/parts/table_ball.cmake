@@ -1,5 +1,5 @@
-# Table-ball balancing scenario ([M], issue 7): observer, closed loop, metrics and the live view
-# as library code (the app main stays thin; the tuning tool runs runTableBall in-process).
-list(APPEND scenarios_sources src/table_ball_observer.cpp src/table_ball.cpp src/table_ball_display.cpp
-  src/table_edge_tracker.cpp)
+# Table-ball balancing ([M]): the observer and edge tracker, and the scenario in its folder
+# (config, world, loop on the runtime scheduler, metrics). The live view is in modules/viz.
+list(APPEND scenarios_sources src/table_ball_observer.cpp src/table_edge_tracker.cpp
+  table_ball/config.cpp table_ball/world.cpp table_ball/loop.cpp table_ball/metrics.cpp)
 list(APPEND scenarios_tests test/table_ball_observer_test.cpp)

@@ -1,7 +1,9 @@
 #include "viewline/scenarios/table_ball_observer.h"
 
+#include <Eigen/Cholesky>
 #include <chrono>
 #include <cmath>
+#include <limits>
 
 #include "viewline/core/checks.h"
 #include "viewline/core/error.h"
@@ -61,6 +63,7 @@ void RollingBallTracker::step(double t, const Eigen::Vector2d& a_xy, const std::
   core::requireFinite(t, "RollingBallTracker::step: t");
   core::requireFinite(a_xy, "RollingBallTracker::step: a_xy");
   const auto& model = config_.model;
+  last_update_.reset();
   if (!initialized_) {
     if (!y) return;
     core::requireFinite(*y, "RollingBallTracker::step: measurement");
@@ -77,6 +80,8 @@ void RollingBallTracker::step(double t, const Eigen::Vector2d& a_xy, const std::
     initialized_ = true;
     missed_ = 0;
     predictions_ = model.predictPositions(x_, last_dt_, a_xy);
+    last_update_ = BallUpdate{tracking::GateDecision::Start, {}};
+    last_update_->report.rows = 2;
     return;
   }
   if (!(t > t_)) throw core::InvalidInput("RollingBallTracker::step: time must increase");
@@ -84,6 +89,8 @@ void RollingBallTracker::step(double t, const Eigen::Vector2d& a_xy, const std::
   const estimation::LinearTransition tr = model.transition(dt, a_xy);  // rediscretised every frame
   if (stationary_) {
     if (y) {
+      last_update_ = BallUpdate{tracking::GateDecision::Accept, stationaryInnovation(tr, *y)};
+      nis_ = last_update_->report.nis;
       x_ = model.stationaryStep(*stationary_, tr, x_, *y);
     } else {
       x_ = tr.Phi * x_ + tr.Gamma * tr.u;
@@ -93,8 +100,8 @@ void RollingBallTracker::step(double t, const Eigen::Vector2d& a_xy, const std::
     estimation::predict(state_, tr);
     model.clampEstimate(state_);
     if (y) {
-      const estimation::UpdateReport rep = estimation::update(state_, model.measurement(*y));
-      nis_ = rep.nis;
+      last_update_ = BallUpdate{tracking::GateDecision::Accept, estimation::update(state_, model.measurement(*y))};
+      nis_ = last_update_->report.nis;
       model.clampEstimate(state_);
     }
     x_ = state_.x();
@@ -103,6 +110,23 @@ void RollingBallTracker::step(double t, const Eigen::Vector2d& a_xy, const std::
   t_ = t;
   last_dt_ = dt;
   predictions_ = model.predictPositions(x_, dt, a_xy);
+}
+
+estimation::UpdateReport RollingBallTracker::stationaryInnovation(const estimation::LinearTransition& tr,
+                                                                 const Eigen::Vector2d& y) const {
+  // The innovation RollingBallModel::stationaryStep fuses, with the stationary a-priori
+  // covariance (read only: the step itself stays the model's).
+  Eigen::VectorXd xp = tr.Phi * x_;
+  if (tr.u.size() > 0) xp += tr.Gamma * tr.u;
+  const estimation::LinearMeasurement m = config_.model.measurement(y);
+  estimation::UpdateReport rep;
+  rep.rows = 2;
+  rep.innovation = y - m.C * xp;
+  rep.S = m.C * stationary_->P * m.C.transpose() + m.R;
+  const Eigen::LLT<Eigen::MatrixXd> llt(rep.S);
+  rep.nis = llt.info() == Eigen::Success ? rep.innovation.dot(llt.solve(rep.innovation))
+                                         : std::numeric_limits<double>::quiet_NaN();
+  return rep;
 }
 
 // -------------------------------------------------------------------------------------------

@@ -111,7 +111,7 @@ TEST(TableBallObserver, StationaryGainMatchesTheTimeVaryingFilterInSteadyState) 
   EXPECT_LT((a.P() - b.P()).cwiseAbs().maxCoeff(), 1e-6);
 }
 
-// Issue 7: the AprilTag table pose. A tagged table rendered at a known tilt must come back at
+// The AprilTag table pose. A tagged table rendered at a known tilt must come back at
 // that pose. The layout has to be in vpDetectorAprilTag's tag frame (z out of the tag); with the
 // simulator's tag frame (z into the table) every tag's corners are mirrored and the pose came out
 // flipped (tilt error 179.8°).

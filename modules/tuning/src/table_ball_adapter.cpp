@@ -1,33 +1,28 @@
-// Table-ball scenario adapter ([M], issue 7): runs scenarios::runTableBall (rendered images,
-// table and ball detection, the rolling-ball observer, the LQR balancer) in-process, with the
-// config read by the scenario's own loader (tableBallConfigFromYaml: strict keys), so a config the
-// tuning tool accepts or writes is one table_ball_balancing reads.
+// Table-ball scenario adapter ([M]): runs scenarios::runTableBall (rendered images, table and
+// ball detection, the rolling-ball observer, the LQR balancer) in-process, with the config read
+// by the scenario's own loader (tableBallConfigFromYaml: strict keys), so a config the tuning
+// tool accepts or writes is one table_ball_balancing reads.
 //
-// Innovations. runTableBall reports every frame to its on_frame hook (capture time, the
-// observer's measured in-plane acceleration a_xy, the ball measurement y when found, the
-// observer's state, the true ball position). The observer's filter is the public
-// scenarios::RollingBallTracker, deterministic, so the adapter re-runs one built exactly as
-// runTableBall builds it (observer section of the config, the table's L and r, nominal period
-// 1 / camera.rate_hz) on the same (t, a_xy, y) sequence: its states equal the loop's (checked on
-// every frame; a difference > 1e-9 m fails the run). Before each update the innovation is
-//   d = y − C x̂(t|t−),  S = C P(t|t−) Cᵀ + σv² I  (2 dof, C selects (p_x, p_y)),
-// with x̂(t|t−), P(t|t−) from a copy of the tracker stepped without the measurement (the time
-// update incl. the border clamp, exactly what step() does before its update); with
-// observer.stationary_gain P(t|t−) is the DARE's a-priori covariance. NIS samples once the
-// track has `burn_in` measurements; NEES (2 dof, ball position on the table) against the truth
+// Innovations. The loop reports every update of the observer's filter to its telemetry sink
+// with the update's own diagnostics (runtime::InnovationRecord: d = y − C x̂(t|t−),
+// S = C P(t|t−) Cᵀ + σv² I, NIS, the gate decision); a run reads them from a runtime::MemorySink,
+// nothing is recomputed. NIS samples once the track has `burn_in` measurements; NEES (2 dof,
+// ball position on the table) of the observer's estimate (x̂, P from the sink) against the truth
 // at the capture instant, one sample every `nees_spacing_s` after metrics.warmup.
 //
 // Noise auto-tuning: the filter's measurements (y, a_xy, t) do not depend on σw, σv within a
 // replay (the closed loop changes the ball's path only in live runs), so the maximum-likelihood
-// search replays the logged measurements honestly: process σw (observer.sigma_w) and measurement
-// σv (observer.sigma_v). Gross outliers: uniform over the reachable square (L − 2r)².
-// From a log: the measurements.csv that table_ball_balancing --log writes (t, ball_found, mx, my,
-// ax, ay).
+// search replays the logged measurements through scenarios::RollingBallTracker built as the loop
+// builds it (TableBallConfig::trackerConfig) with other σw (observer.sigma_w) and σv
+// (observer.sigma_v), each replayed update reporting its own innovation, S and NIS (with the
+// stationary gain, S uses the DARE's a-priori covariance). Gross outliers: uniform over the
+// reachable square (L − 2r)². From a log: the files table_ball_balancing --log writes through
+// its runtime::CsvSink, measurements_ball_acceleration.csv (every frame: t, the filter's input
+// a_xy) and measurements_ball.csv (t, the ball on the table when found).
 //
 // Timing metrics (frame_time_ratio_to_reference) are wall-clock and would make results depend on
 // the machine load, so sweeps run with metrics.time_reference off.
 
-#include <Eigen/Cholesky>
 #include <cmath>
 #include <filesystem>
 #include <optional>
@@ -35,10 +30,11 @@
 #include "adapter_util.h"
 #include "viewline/core/error.h"
 #include "viewline/core/random.h"
+#include "viewline/runtime/telemetry.h"
 #include "viewline/scenarios/table_ball.h"
-#include "viewline/scenarios/table_ball_display.h"
 #include "viewline/scenarios/table_ball_observer.h"
 #include "viewline/tuning/scenario.h"
+#include "viewline/viz/table_ball_display.h"
 
 namespace viewline::tuning {
 
@@ -52,8 +48,7 @@ struct BallFrame {
   std::optional<Eigen::Vector2d> y;
   bool has_truth = false;
   Eigen::Vector2d truth = Eigen::Vector2d::Zero();
-  bool estimate_valid = false;               ///< the loop's observer (for the replay check)
-  Eigen::Vector2d estimate = Eigen::Vector2d::Zero();
+  std::optional<Eigen::Vector2d> prediction;  ///< the loop observer's N-th predicted position
 };
 
 class TableBallReplayData : public ReplayData {
@@ -82,7 +77,6 @@ struct Accum {
   double cost = 0.0;
   std::size_t terms = 0;
   Consistency nis, nees;
-  double max_replay_dev = 0.0;  ///< m, replayed vs loop estimate
 };
 
 class TableBallInstance final : public ScenarioInstance {
@@ -95,7 +89,8 @@ public:
 
   RunResult run(std::uint64_t seed, const RunOptions& ro) const override {
     std::vector<BallFrame> frames;
-    const scenarios::TableBallResult res = simulate(seed, ro, frames);
+    runtime::MemorySink telemetry;
+    const scenarios::TableBallResult res = simulate(seed, ro, frames, &telemetry);
     RunResult r;
     r.seed = seed;
     std::shared_ptr<RunSeries> series;
@@ -104,10 +99,7 @@ public:
     io::CsvWriter* inn = nullptr;
     if (ro.log != nullptr && ro.log->enabled())
       inn = &ro.log->stream("innovations", {"t", "d0", "d1", "S00", "S01", "S11", "nis", "in_statistics"});
-    replayRun(frames, cfg_.observer.tracker.model.sigma_w, cfg_.observer.tracker.model.sigma_v, 0.0, a, series.get(), inn);
-    if (a.max_replay_dev > 1e-9)
-      throw core::NumericalError("table_ball adapter: the replayed observer filter differs from the loop's by " +
-                                 std::to_string(1e3 * a.max_replay_dev) + " mm (scenario changed? see the adapter's note)");
+    consistency(frames, telemetry, a, series.get(), inn);
     r.nis = a.nis;
     r.nees = a.nees;
     auto& m = r.metrics;
@@ -145,30 +137,40 @@ public:
     auto d = std::make_unique<TableBallReplayData>();
     for (int i = 0; i < runs; ++i) {
       d->runs.emplace_back();
-      simulate(core::deriveSeed(seed, static_cast<std::uint64_t>(i)), {}, d->runs.back());
+      simulate(core::deriveSeed(seed, static_cast<std::uint64_t>(i)), {}, d->runs.back(), nullptr);
     }
     d->source = "live: " + std::to_string(runs) + " run(s) from seed " + std::to_string(seed);
     return d;
   }
 
   std::unique_ptr<ReplayData> loadLog(const std::string& dir) const override {
-    const std::string path = (fs::path(dir) / "measurements.csv").string();
-    const detail::CsvTable csv = detail::CsvTable::read(path, "the measurements.csv of table_ball_balancing --log");
-    const std::size_t ct = csv.col("t"), cb = csv.col("ball_found"), cx = csv.col("mx"), cy = csv.col("my"),
-                      ax = csv.col("ax"), ay = csv.col("ay");
+    const std::string inputs_path = (fs::path(dir) / "measurements_ball_acceleration.csv").string();
+    const std::string balls_path = (fs::path(dir) / "measurements_ball.csv").string();
+    const detail::CsvTable inputs =
+        detail::CsvTable::read(inputs_path, "the measurements_ball_acceleration.csv of table_ball_balancing --log");
+    const detail::CsvTable balls = detail::CsvTable::read(balls_path, "the measurements_ball.csv of table_ball_balancing --log");
+    const std::size_t it = inputs.col("t"), ax = inputs.col("z0"), ay = inputs.col("z1");
+    const std::size_t bt = balls.col("t"), bx = balls.col("z0"), by = balls.col("z1");
     auto d = std::make_unique<TableBallReplayData>();
     d->runs.emplace_back();
-    for (std::size_t row = 0; row < csv.rows(); ++row) {
+    auto& run = d->runs.back();
+    std::size_t b = 0;  // every frame has an input row; a found ball has a row with the same t
+    for (std::size_t row = 0; row < inputs.rows(); ++row) {
       BallFrame f;
-      f.t = csv.number(row, ct);
-      f.a_xy = Eigen::Vector2d(csv.number(row, ax), csv.number(row, ay));
-      if (csv.number(row, cb) > 0.5) f.y = Eigen::Vector2d(csv.number(row, cx), csv.number(row, cy));
-      if (!d->runs.back().empty() && !(f.t > d->runs.back().back().t))
-        throw core::InvalidInput(csv.where(row) + ": time stamps must increase");
-      d->runs.back().push_back(f);
+      f.t = inputs.number(row, it);
+      f.a_xy = Eigen::Vector2d(inputs.number(row, ax), inputs.number(row, ay));
+      if (!run.empty() && !(f.t > run.back().t)) throw core::InvalidInput(inputs.where(row) + ": time stamps must increase");
+      if (b < balls.rows() && balls.number(b, bt) < f.t)
+        throw core::InvalidInput(balls.where(b) + ": a ball measurement without its frame in " + inputs_path);
+      if (b < balls.rows() && balls.number(b, bt) == f.t) {
+        f.y = Eigen::Vector2d(balls.number(b, bx), balls.number(b, by));
+        ++b;
+      }
+      run.push_back(f);
     }
-    if (d->measurements() == 0) throw core::InvalidInput(path + ": no ball measurements");
-    d->source = path;
+    if (b < balls.rows()) throw core::InvalidInput(balls.where(b) + ": a ball measurement without its frame in " + inputs_path);
+    if (d->measurements() == 0) throw core::InvalidInput(balls_path + ": no ball measurements");
+    d->source = balls_path;
     return d;
   }
 
@@ -178,7 +180,7 @@ public:
     Accum a;
     std::shared_ptr<RunSeries> series;
     if (want_series) series = makeSeries();
-    for (const auto& run : d.runs) replayRun(run, noise[0], noise[1], outlier_prior, a, series.get(), nullptr);
+    for (const auto& run : d.runs) replayRun(run, noise[0], noise[1], outlier_prior, a, series.get());
     return detail::replayResult(a.cost, a.terms, a.nis, series);
   }
 
@@ -191,28 +193,30 @@ public:
   }
 
 private:
-  /// The observer's filter configuration as runTableBall builds it.
+  /// The observer's filter as the loop builds it, with other noise intensities.
   scenarios::RollingBallTrackerConfig trackerConfig(double sigma_w, double sigma_v) const {
-    scenarios::RollingBallTrackerConfig tc = cfg_.observer.tracker;
-    tc.model.table_side = cfg_.table_side;
-    tc.model.ball_radius = cfg_.ball_radius;
+    scenarios::RollingBallTrackerConfig tc = cfg_.trackerConfig();
     tc.model.sigma_w = sigma_w;
     tc.model.sigma_v = sigma_v;
-    tc.nominal_period = 1.0 / cfg_.rate_hz;
     return tc;
   }
 
-  scenarios::TableBallResult simulate(std::uint64_t seed, const RunOptions& ro, std::vector<BallFrame>& frames) const {
-    std::unique_ptr<scenarios::TableBallDisplay> view;
+  scenarios::TableBallResult simulate(std::uint64_t seed, const RunOptions& ro, std::vector<BallFrame>& frames,
+                                      runtime::MemorySink* telemetry) const {
+    std::unique_ptr<viz::TableBallDisplay> view;
     if (ro.display && detail::xDisplayAvailable()) {
       try {
-        view = std::make_unique<scenarios::TableBallDisplay>(cfg_.table_side, cfg_.ball_radius);
+        view = std::make_unique<viz::TableBallDisplay>(cfg_.table_side, cfg_.ball_radius);
       } catch (const std::exception&) {
         view.reset();  // no X display: headless
       }
     }
+    std::optional<runtime::CsvSink> csv;
+    runtime::FanoutSink sinks;
+    sinks.add(telemetry);
+    if (ro.log != nullptr && ro.log->enabled()) sinks.add(&csv.emplace(*ro.log));
     scenarios::TableBallHooks hooks;
-    hooks.log = ro.log != nullptr && ro.log->enabled() ? ro.log : nullptr;
+    hooks.telemetry = &sinks;
     hooks.on_frame = [&](const scenarios::TableBallFrameView& v) {
       const scenarios::ObserverFrame& of = *v.observer;
       BallFrame f;
@@ -221,17 +225,87 @@ private:
       if (of.ball_found) f.y = of.measured;
       f.has_truth = true;
       f.truth = v.truth;
-      f.estimate_valid = of.estimate_valid;
-      if (of.estimate_valid) f.estimate = Eigen::Vector2d(of.x[0], of.x[2]);
+      if (of.estimate_valid && !of.predictions.empty()) f.prediction = of.predictions.back();
       frames.push_back(f);
-      if (view) view->show(v);
+      const bool go = !view || view->show(v);
       if (ro.live) {
-        const double e = of.estimate_valid ? 1e3 * (f.estimate - v.truth).norm() : std::nan("");
+        const double e = of.estimate_valid ? 1e3 * (Eigen::Vector2d(of.x[0], of.x[2]) - v.truth).norm() : std::nan("");
         ro.live({of.t, e, -1.0});
       }
+      return go;
     };
     if (ro.progress) hooks.on_progress = [&ro](double t, double duration) { ro.progress(t / duration); };
     return scenarios::runTableBall(cfg_, seed, hooks);
+  }
+
+  /// NIS from the loop observer's own update reports, NEES and the curves from its estimates.
+  void consistency(const std::vector<BallFrame>& frames, const runtime::MemorySink& telemetry, Accum& a,
+                   RunSeries* series, io::CsvWriter* inn) const {
+    const double side = cfg_.table_side - 2.0 * cfg_.ball_radius;
+    const double log_u = -std::log(side * side);
+    std::size_t k = 0;
+    for (const runtime::InnovationRecord& u : telemetry.innovationsOf("ball")) {
+      const bool counted = k++ >= static_cast<std::size_t>(opt_.burn_in) && u.decision == tracking::GateDecision::Accept &&
+                           u.S.rows() == 2 && u.S.cols() == 2 && std::isfinite(u.nis);
+      const Eigen::Matrix2d S = counted ? Eigen::Matrix2d(u.S) : Eigen::Matrix2d::Constant(std::nan(""));
+      if (counted) {
+        a.cost += detail::innovationCost(u.nis, std::log(S.determinant()), 2, 0.0, log_u);
+        ++a.terms;
+        a.nis.add(u.nis, 2.0);
+        if (series != nullptr) {
+          series->nis_t.push_back(u.t);
+          series->nis.push_back(u.nis);
+        }
+      }
+      if (inn != nullptr)
+        inn->row({u.t, counted ? u.innovation[0] : std::nan(""), counted ? u.innovation[1] : std::nan(""), S(0, 0),
+                  S(0, 1), S(1, 1), counted ? u.nis : std::nan(""), counted ? 1.0 : 0.0});
+    }
+    std::vector<const runtime::EstimateRecord*> estimates;
+    for (const auto& e : telemetry.estimates)
+      if (e.channel == "ball") estimates.push_back(&e);
+    Curve err{"error", {}, {}}, tru{"truth", {}, {}}, est{"estimate", {}, {}}, pre{"prediction", {}, {}};
+    int measured = 0;
+    double next_nees = cfg_.warmup;
+    std::size_t e = 0;
+    for (const BallFrame& f : frames) {
+      if (f.y) ++measured;
+      while (e < estimates.size() && estimates[e]->t < f.t) ++e;
+      if (e == estimates.size() || estimates[e]->t != f.t) continue;  // no track yet
+      const Eigen::VectorXd& x = estimates[e]->x;
+      const Eigen::MatrixXd& P = estimates[e]->P;
+      const Eigen::Vector2d p(x[0], x[2]);
+      if (f.has_truth && f.t >= next_nees && measured >= opt_.burn_in) {
+        Eigen::Matrix2d Pp;
+        Pp << P(0, 0), P(0, 2), P(2, 0), P(2, 2);
+        const Eigen::Vector2d d = p - f.truth;
+        a.nees.add(d.dot(Pp.ldlt().solve(d)), 2.0);
+        next_nees = f.t + opt_.nees_spacing;
+      }
+      if (series != nullptr) {
+        if (f.has_truth) {
+          err.x.push_back(f.t);
+          err.y.push_back(1e3 * (p - f.truth).norm());
+          tru.x.push_back(f.truth.x());
+          tru.y.push_back(f.truth.y());
+        }
+        est.x.push_back(p.x());
+        est.y.push_back(p.y());
+        if (f.prediction) {
+          pre.x.push_back(f.prediction->x());
+          pre.y.push_back(f.prediction->y());
+        }
+      }
+    }
+    if (series != nullptr) finishSeries(*series, err, tru, est, pre);
+  }
+
+  void finishSeries(RunSeries& series, Curve& err, Curve& tru, Curve& est, Curve& pre) const {
+    if (!err.x.empty()) series.error.push_back(err);
+    if (!tru.x.empty()) series.truth.push_back(tru);
+    series.estimate.push_back(est);
+    pre.name = "prediction " + std::to_string(cfg_.observer.tracker.model.prediction_steps) + " frames ahead";
+    series.prediction.push_back(pre);
   }
 
   std::shared_ptr<RunSeries> makeSeries() const {
@@ -243,41 +317,26 @@ private:
     return s;
   }
 
+  /// Replays logged measurements through the observer's filter with (σw, σv).
   void replayRun(const std::vector<BallFrame>& frames, double sigma_w, double sigma_v, double eps, Accum& a,
-                 RunSeries* series, io::CsvWriter* inn) const {
+                 RunSeries* series) const {
     const scenarios::RollingBallTrackerConfig tc = trackerConfig(sigma_w, sigma_v);
     scenarios::RollingBallTracker trk(tc);
-    std::optional<estimation::StationaryFilter> sf;
-    if (tc.stationary_gain) sf = tc.model.stationaryFilter(tc.nominal_period);
     const double side = tc.model.table_side - 2.0 * tc.model.ball_radius;
     const double log_u = -std::log(side * side);
-    const Eigen::Matrix2d R = sigma_v * sigma_v * Eigen::Matrix2d::Identity();
     Curve err{"error", {}, {}}, tru{"truth", {}, {}}, est{"estimate", {}, {}}, pre{"prediction", {}, {}};
     int measured = 0;
     double next_nees = cfg_.warmup;
     for (const BallFrame& f : frames) {
-      bool have = false;
-      double nis = 0.0;
-      Eigen::Vector2d d = Eigen::Vector2d::Zero();
-      Eigen::Matrix2d S = Eigen::Matrix2d::Identity();
-      if (f.y && trk.initialized() && measured >= opt_.burn_in) {
-        scenarios::RollingBallTracker prior = trk;  // the time update step() performs before its update
-        prior.step(f.t, f.a_xy, std::nullopt);
-        const Eigen::MatrixXd P = sf ? sf->P : prior.P();
-        Eigen::Matrix2d Pp;
-        Pp << P(0, 0), P(0, 2), P(2, 0), P(2, 2);
-        d = *f.y - prior.position();
-        S = Pp + R;
-        const Eigen::LLT<Eigen::Matrix2d> llt(S);
-        if (llt.info() == Eigen::Success) {
-          nis = d.dot(llt.solve(d));
-          have = std::isfinite(nis);
-        }
-      }
+      // The update's own innovation, S and NIS (RollingBallTracker::lastUpdate), once the track
+      // has burn_in measurements.
+      const bool counted_track = f.y && measured >= opt_.burn_in;
       trk.step(f.t, f.a_xy, f.y);
       if (f.y) ++measured;
-      if (have) {
-        a.cost += detail::innovationCost(nis, std::log(S.determinant()), 2, eps, log_u);
+      const auto& u = trk.lastUpdate();
+      if (counted_track && u && u->decision == tracking::GateDecision::Accept && std::isfinite(u->report.nis)) {
+        const double nis = u->report.nis;
+        a.cost += detail::innovationCost(nis, std::log(Eigen::Matrix2d(u->report.S).determinant()), 2, eps, log_u);
         ++a.terms;
         a.nis.add(nis, 2.0);
         if (series != nullptr) {
@@ -285,12 +344,7 @@ private:
           series->nis.push_back(nis);
         }
       }
-      if (inn != nullptr)
-        inn->row({f.t, have ? d(0) : std::nan(""), have ? d(1) : std::nan(""), have ? S(0, 0) : std::nan(""),
-                  have ? S(0, 1) : std::nan(""), have ? S(1, 1) : std::nan(""), have ? nis : std::nan(""),
-                  have ? 1.0 : 0.0});
       if (!trk.initialized()) continue;
-      if (f.estimate_valid) a.max_replay_dev = std::max(a.max_replay_dev, (trk.position() - f.estimate).norm());
       if (f.has_truth && f.t >= next_nees && measured >= opt_.burn_in) {
         const Eigen::MatrixXd P = trk.P();
         Eigen::Matrix2d Pp;
@@ -314,13 +368,7 @@ private:
         }
       }
     }
-    if (series != nullptr) {
-      if (!err.x.empty()) series->error.push_back(err);
-      if (!tru.x.empty()) series->truth.push_back(tru);
-      series->estimate.push_back(est);
-      pre.name = "prediction " + std::to_string(tc.model.prediction_steps) + " frames ahead";
-      series->prediction.push_back(pre);
-    }
+    if (series != nullptr) finishSeries(*series, err, tru, est, pre);
   }
 
   scenarios::TableBallConfig cfg_;

@@ -1,2 +1,3 @@
-# Table-ball balancing ([M], issue 7): a short seeded closed-loop run of runTableBall.
+# Table-ball balancing ([M]): short seeded closed-loop runs of runTableBall (as fast as possible
+# and paced, telemetry counts against the summary).
 list(APPEND scenarios_tests table_ball_test.cpp)

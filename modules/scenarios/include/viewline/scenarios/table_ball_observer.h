@@ -40,8 +40,10 @@
 #include <vector>
 
 #include "viewline/core/camera.h"
+#include "viewline/estimation/kalman_filter.h"
 #include "viewline/estimation/models/rolling_ball.h"
 #include "viewline/estimation/state.h"
+#include "viewline/tracking/track_gate.h"
 #include "viewline/vision/apriltag_detector.h"
 #include "viewline/scenarios/table_edge_tracker.h"
 #include "viewline/vision/table_detector.h"
@@ -65,6 +67,15 @@ struct RollingBallTrackerConfig {
   double initial_velocity_std = 0.5;       ///< m/s, prior on the velocity at the first detection
 };
 
+/// What one step did with its measurement. The filter has no gate: the first measurement starts
+/// the track (Start, no innovation), every later one is fused (Accept). The report is the
+/// update's own: d = y − C x̂(t|t−), S = C P(t|t−) Cᵀ + σv² I (with the stationary gain, P(t|t−)
+/// is the DARE's a-priori covariance), NIS = dᵀ S⁻¹ d with 2 degrees of freedom.
+struct BallUpdate {
+  tracking::GateDecision decision = tracking::GateDecision::Accept;
+  estimation::UpdateReport report;
+};
+
 /// The filter part of the observer (steps 3-5).
 class RollingBallTracker {
 public:
@@ -83,11 +94,15 @@ public:
   Eigen::MatrixXd P() const;
   /// The N predicted positions after the last step (one frame interval apart).
   const std::vector<Eigen::Vector2d>& predictions() const { return predictions_; }
+  /// NIS of the last fused measurement (0 before any).
   double lastNis() const { return nis_; }
+  /// The last step's measurement update; empty when that step had no measurement.
+  const std::optional<BallUpdate>& lastUpdate() const { return last_update_; }
   int missedStreak() const { return missed_; }
   const RollingBallTrackerConfig& config() const { return config_; }
 
 private:
+  estimation::UpdateReport stationaryInnovation(const estimation::LinearTransition& tr, const Eigen::Vector2d& y) const;
   RollingBallTrackerConfig config_;
   bool initialized_ = false;
   double t_ = 0.0;
@@ -98,6 +113,7 @@ private:
   std::vector<Eigen::Vector2d> predictions_;
   double nis_ = 0.0;
   int missed_ = 0;
+  std::optional<BallUpdate> last_update_;
 };
 
 enum class TablePoseSource { Corners, AprilTag };

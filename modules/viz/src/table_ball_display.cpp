@@ -1,4 +1,4 @@
-#include "viewline/scenarios/table_ball_display.h"
+#include "viewline/viz/table_ball_display.h"
 
 #include <cmath>
 #include <visp3/core/vpConfig.h>
@@ -9,8 +9,9 @@
 
 #include "viewline/core/error.h"
 #include "viewline/core/frames.h"
+#include "viewline/viz/display_controls.h"
 
-namespace viewline::scenarios {
+namespace viewline::viz {
 
 struct TableBallDisplay::Impl {
   double side, radius;
@@ -21,6 +22,7 @@ struct TableBallDisplay::Impl {
   vpDisplayX camera_display, top_display;
 #endif
   bool initialised = false;
+  DisplayControls controls;
   std::deque<Eigen::Vector2d> measured, filtered, truth;
 
   vpImagePoint topPixel(const Eigen::Vector2d& p) const {
@@ -48,13 +50,13 @@ TableBallDisplay::TableBallDisplay(double table_side, double ball_radius, int to
 
 TableBallDisplay::~TableBallDisplay() = default;
 
-void TableBallDisplay::show(const TableBallFrameView& view) {
+bool TableBallDisplay::show(const scenarios::TableBallFrameView& view) {
 #if defined(VISP_HAVE_X11)
   Impl& d = *impl_;
-  const ObserverFrame& of = *view.observer;
+  const scenarios::ObserverFrame& of = *view.observer;
   if (view.image != nullptr) vpImageConvert::convert(*view.image, d.camera_image);
   if (!d.initialised) {
-    if (view.image == nullptr) return;
+    if (view.image == nullptr) return true;
     d.camera_display.init(d.camera_image, 50, 50, "table_ball_balancing: head camera");
     d.top_display.init(d.top_image, 80 + static_cast<int>(d.camera_image.getWidth()), 50, "top view: measured (red), filtered (green), truth (blue)");
     d.initialised = true;
@@ -81,6 +83,7 @@ void TableBallDisplay::show(const TableBallFrameView& view) {
   }
   vpDisplay::displayText(d.camera_image, 12, 8, of.ball_found ? "ball found" : ("no ball: " + of.failure).c_str(),
                          vpColor::white);
+  d.controls.drawLegend(d.camera_image);
   vpDisplay::flush(d.camera_image);
 
   // --- top view ---
@@ -106,9 +109,15 @@ void TableBallDisplay::show(const TableBallFrameView& view) {
                 core::rad2deg(view.tilt.y()));
   vpDisplay::displayText(d.top_image, 14, 8, text, vpColor::black);
   vpDisplay::flush(d.top_image);
+  return d.controls.poll(d.camera_image);
 #else
   (void)view;
+  return true;
 #endif
 }
 
-}  // namespace viewline::scenarios
+void TableBallDisplay::waitForClose() {
+  if (impl_->initialised) impl_->controls.waitForClose(impl_->camera_image);
+}
+
+}  // namespace viewline::viz

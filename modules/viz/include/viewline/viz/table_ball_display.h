@@ -4,13 +4,19 @@
 // table axes (from the estimated pose), the detected ball circle, the filtered ball centre and
 // the N predicted positions projected back into the image. Window 2: a top view of the table
 // with the measured (red) and filtered (green) tracks, the true ball (blue) and the set point.
+// Keys in the camera window (viz::DisplayControls): space pause, n step, q quit.
+//
+//   viz::TableBallDisplay view(cfg.table_side, cfg.ball_radius);
+//   hooks.on_frame = [&](const scenarios::TableBallFrameView& v) { return view.show(v); };
+//   ... run ...
+//   view.waitForClose();
 
 #include <deque>
 #include <memory>
 
-#include "viewline/scenarios/table_ball.h"
+#include "viewline/scenarios/table_ball/loop.h"
 
-namespace viewline::scenarios {
+namespace viewline::viz {
 
 class TableBallDisplay {
 public:
@@ -18,11 +24,14 @@ public:
   ~TableBallDisplay();
   TableBallDisplay(const TableBallDisplay&) = delete;
   TableBallDisplay& operator=(const TableBallDisplay&) = delete;
-  void show(const TableBallFrameView& view);
+  /// Draws one frame; false once the person asked to quit.
+  bool show(const scenarios::TableBallFrameView& view);
+  /// After the run: keeps the windows open until a click or a key (not after a quit).
+  void waitForClose();
 
 private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
 
-}  // namespace viewline::scenarios
+}  // namespace viewline::viz

@@ -1,0 +1,106 @@
+#pragma once
+// The table-ball scenario's configuration: one struct, one YAML reader (config/table_ball.yaml
+// documents every key), validated once when read. Values other parts need are asked from here
+// (frame period, the controller's model delay, the observer's filter) instead of being copied.
+
+#include <Eigen/Core>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "viewline/control/table_balancer.h"
+#include "viewline/core/camera.h"
+#include "viewline/io/config.h"
+#include "viewline/robots/table_tilt.h"
+#include "viewline/scenarios/table_ball_observer.h"
+
+namespace viewline::scenarios {
+
+struct TableBallSetpoint {
+  double t = 0.0;
+  Eigen::Vector2d xy = Eigen::Vector2d::Zero();  ///< table frame, m
+};
+struct TableBallPush {
+  double t = 0.0;
+  Eigen::Vector2d dv = Eigen::Vector2d::Zero();  ///< added to the ball velocity, m/s
+};
+
+struct TableBallConfig {
+  // World
+  double table_side = 0.3;                                     ///< L, m
+  double ball_radius = 0.025;                                  ///< r, m
+  Eigen::Vector3d table_center = Eigen::Vector3d(0.0, 0.0, 0.9);  ///< untilted table centre, world, m
+  Eigen::Vector2d initial_ball = Eigen::Vector2d(0.06, 0.04);  ///< m
+  Eigen::Vector2d initial_velocity = Eigen::Vector2d::Zero();  ///< m/s
+  double border_height = 0.02;                                 ///< m, raised black borders (width 0.02 m)
+  bool table_tags = false;                                     ///< tags around the borders (AprilTag pose)
+  double tag_size = 0.05;                                      ///< m
+  robots::TableTiltLimits wrist;                               ///< angle/rate limits, delay
+  // Camera
+  unsigned width = 320, height = 240;
+  double hfov = 1.5707963267948966;                            ///< rad (90°)
+  std::optional<double> cx, cy;                                ///< principal point, px (absent: image centre)
+  double rate_hz = 50.0;
+  Eigen::Vector3d camera_position = Eigen::Vector3d(0.0, -0.3, 1.3);
+  Eigen::Vector3d camera_look_at = Eigen::Vector3d(0.0, 0.0, 0.9);
+  double sway = 0.0087;                                        ///< head rotation amplitude, rad
+  double sway_hz = 0.3;
+  double sway_translation = 0.003;                             ///< m
+  double ground_rotation_noise = 0.0;                          ///< rad (std per axis, per frame)
+  double sensor_noise = 2.0;                                   ///< grey levels
+  double exposure = 0.004;                                     ///< s (motion blur)
+  int blur_samples = 3;
+  double drop_probability = 0.0;
+  int supersampling = 3;
+  /// Calibrated rig (key `rig`): when set, it replaces width, height, hfov, cx, cy,
+  /// camera_position and camera_look_at (see table_ball.h).
+  struct RigCameras {
+    std::string folder;
+    core::Camera truth;       ///< renders; c_M_w = rest pose (before the sway)
+    core::Camera calibrated;  ///< the observer's; c_M_w = calibrated rest pose, rotation from ground.yaml
+  };
+  std::optional<RigCameras> rig;
+  // Observer, controller
+  TableBallObserverConfig observer;                            ///< as read; observerConfig() completes it
+  bool border_aware_pnp = true;                                ///< correct the PnP for the border occlusion
+  double latency = 0.01;                                       ///< s, capture -> command
+  control::TableBalancerConfig controller;                     ///< as read; controllerConfig() completes it
+  // Events and metrics
+  std::vector<TableBallSetpoint> setpoints;                    ///< sorted by t; first at t = 0
+  std::vector<TableBallPush> pushes;
+  double duration = 30.0;                                      ///< s
+  double warmup = 1.0;                                         ///< s, excluded from the RMSEs
+  double min_step = 0.05;                                      ///< m, set-point changes scored as steps
+  double settle_fraction = 0.02;
+  double steady_window = 1.0;                                  ///< s
+  double push_band = 0.005;                                    ///< m
+  bool compare_tunings = true;                                 ///< run the side filters
+  bool time_reference = true;                                  ///< time the plain OpenCV reference
+
+  /// Throws core::InvalidInput naming the field. tableBallConfigFromYaml calls it; code that
+  /// edits a config afterwards (tests, the tuning tool) calls it again.
+  void validate() const;
+
+  /// The camera frame period, s.
+  double framePeriod() const { return 1.0 / rate_hz; }
+  /// The set point in force at time t (the last one with t_i <= t).
+  Eigen::Vector2d setpointAt(double t) const;
+  /// The rolling-ball filter as the observer runs it: the configured tuning on this table
+  /// (L, r) with the camera's frame period as its nominal period.
+  RollingBallTrackerConfig trackerConfig() const;
+  /// The controller: the configured weights, the camera's period, and what it asks the wrist
+  /// it commands: its limits, and its delay, which with the processing latency is the model delay.
+  control::TableBalancerConfig controllerConfig(const robots::TableTilt& wrist) const;
+};
+
+/// Reads the YAML scenario (documented in config/table_ball.yaml); unknown keys are errors.
+/// `rig:` (a folder relative to the config file) loads the rig's truth.yaml, rig.yaml and
+/// ground.yaml; with it the inline camera geometry keys are errors (one source of truth).
+TableBallConfig tableBallConfigFromYaml(const io::ConfigNode& root);
+
+/// Loads the head camera of a table rig folder: truth.yaml (renders), rig.yaml (calibrated
+/// intrinsics and rest pose) and ground.yaml (calibrated camera-to-ground rotation g_R_c, which
+/// must agree with rig.yaml's within 0.01°). Errors name the file.
+TableBallConfig::RigCameras loadTableRig(const std::string& folder);
+
+}  // namespace viewline::scenarios

@@ -1,0 +1,56 @@
+#pragma once
+// The table-ball closed loop on one runtime::Scheduler (timing in table_ball.h):
+//
+//   physics tick     every 1 ms at k · kTick: the wrist takes the interpolated ramp command,
+//                    the table and ball advance one tick
+//   frame ready      capture_time + exposure / 2 (RenderedHeadCamera): detection, observer,
+//                    side filters, metrics, controller; the new tilt ramp goes down a
+//                    DelayLine to the arm, available at capture_time + latency
+//
+// At equal times a frame runs before a physics tick: the frame shows the world up to its ready
+// time, and a tick starting there simulates what comes after.
+
+#include <cstdint>
+#include <functional>
+
+#include "viewline/core/camera.h"
+#include "viewline/runtime/scheduler.h"
+#include "viewline/runtime/telemetry.h"
+#include "viewline/scenarios/table_ball/config.h"
+#include "viewline/scenarios/table_ball/metrics.h"
+#include "viewline/scenarios/table_ball_observer.h"
+
+namespace viewline::scenarios {
+
+/// Everything a viewer needs about one processed frame.
+struct TableBallFrameView {
+  const cv::Mat* image = nullptr;        ///< the camera image (null for a dropped frame)
+  const core::Camera* camera = nullptr;  ///< the observer's camera at capture (calibrated with a rig)
+  const ObserverFrame* observer = nullptr;
+  Eigen::Vector2d truth = Eigen::Vector2d::Zero();
+  Eigen::Vector2d setpoint = Eigen::Vector2d::Zero();
+  Eigen::Vector2d tilt = Eigen::Vector2d::Zero();  ///< true table tilt
+};
+
+struct TableBallHooks {
+  /// Called after every frame (e.g. a display); returning false stops the run (quit key).
+  std::function<bool(const TableBallFrameView&)> on_frame;
+  /// Simulated time and duration, about once per simulated second.
+  std::function<void(double t, double duration)> on_progress;
+  /// Receives the run's records when non-null (channels: measurements "ball" (table frame, m),
+  /// "table_tilt" (rad), "ball_acceleration" (the filter's input a_xy, m/s², every frame);
+  /// innovations "ball"; estimates "ball" (x, P), "ball_prediction" (the N-th predicted
+  /// position), "truth" (p, v, tilt at the capture instant) and one per side filter; commands
+  /// "setpoint", "tilt_ramp" (start θ, rate θ̇, from the controller) and "wrist" (the
+  /// interpolated position command, every 5th tick)).
+  runtime::TelemetrySink* telemetry = nullptr;
+  /// Wall-clock pacing (0: as fast as possible); results do not depend on it.
+  runtime::Pacing pacing;
+};
+
+/// Runs the closed loop for `config.duration` seconds with all randomness from `seed`. The
+/// config must be valid (tableBallConfigFromYaml validates it; code editing a config calls
+/// validate()).
+TableBallResult runTableBall(const TableBallConfig& config, std::uint64_t seed, const TableBallHooks& hooks = {});
+
+}  // namespace viewline::scenarios

@@ -1,0 +1,115 @@
+#pragma once
+// The table-ball scenario's figures (definitions in table_ball.h): the accumulators the loop
+// feeds as the run goes (commands, physics ticks, frames), the scoring of set-point steps and
+// pushes at the end, the JSON summary and the human one.
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <cstdio>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "viewline/scenarios/table_ball/config.h"
+#include "viewline/scenarios/table_ball_observer.h"
+#include "viewline/sim/physics.h"
+
+namespace viewline::scenarios {
+
+struct StepMetrics {
+  double t = 0.0;
+  double size_m = 0.0;
+  double overshoot_pct = 0.0;
+  double settling_time_s = 0.0;   ///< step axis (the stepped coordinate); +inf when it never settles
+  double settling_time_2d_s = 0.0;  ///< same with the 2-D distance (includes the cross axis)
+  double steady_state_error_mm = 0.0;
+};
+struct PushMetrics {
+  double t = 0.0;
+  double speed = 0.0;             ///< |Δv|, m/s
+  double recovery_s = 0.0;        ///< +inf when it never recovers in its window
+  double peak_excursion_mm = 0.0;
+};
+
+struct TableBallResult {
+  std::uint64_t seed = 0;
+  double duration = 0.0;
+  int frames = 0, frames_dropped = 0, table_detections = 0, ball_detections = 0;
+  int tracked_frames = 0;  ///< frames measured by the fast path (edge tracking), not [M]'s full pipeline
+  double observer_rmse_mm = 0.0;
+  double measurement_rmse_mm = 0.0;
+  double observer_rmse_mm_M_sw1_sv0005 = 0.0;   ///< [M]'s best tuning (side filter)
+  double observer_rmse_mm_M_sw1_sv1 = 0.0;      ///< [M]'s lagging tuning (side filter)
+  double observer_rmse_mm_stationary = 0.0;     ///< stationary (DARE) gain, configured σ
+  double prediction_rmse_mm_10 = 0.0;           ///< 10-step (0.2 s) prediction vs truth
+  double tilt_rmse_deg = 0.0;                   ///< measured table tilt vs truth
+  double nis_mean = 0.0;
+  std::vector<StepMetrics> steps;
+  std::vector<PushMetrics> pushes;
+  double overshoot_pct = 0.0, settling_time_s = 0.0, steady_state_error_mm = 0.0, push_recovery_s = 0.0;
+  double observer_frame_ms = 0.0, reference_frame_ms = 0.0, frame_time_ratio_to_reference = 0.0;
+  double observer_frame_cpu_ms = 0.0, reference_frame_cpu_ms = 0.0, frame_cpu_ratio_to_reference = 0.0;
+  double max_commanded_angle_deg = 0.0, max_commanded_rate_deg_s = 0.0;
+  bool limits_respected = true;
+  bool stopped_early = false;  ///< the run was stopped before its duration (a display's quit key)
+  double wall_seconds = 0.0;
+};
+
+nlohmann::json toJson(const TableBallResult& r);
+
+/// The summary a person reads (stdout of the app). A figure the run could not score says why
+/// ("not scored (run shorter than the warm-up ...)") instead of printing nan.
+void printTableBallSummary(std::FILE* out, const TableBallResult& r, const TableBallConfig& cfg);
+
+/// The side filters run beside the loop on the same measurements ([M]'s two tunings and the
+/// stationary gain), in the order of the result's fields.
+using SideFilters = std::vector<std::pair<std::string, RollingBallTracker>>;
+
+class TableBallMetrics {
+public:
+  explicit TableBallMetrics(const TableBallConfig& config);
+
+  /// A position command sent to the wrist (one per physics tick, kTick apart).
+  void command(const Eigen::Vector2d& cmd);
+  /// The ball position at time t, the end of a physics tick.
+  void tick(double t, const Eigen::Vector2d& p);
+  /// One frame (stamp t), with the truth at its capture instant, what the observer made of it
+  /// (dropped frames: its prediction), its filter, and the side filters after their step.
+  void frame(double t, const sim::TiltTableState& truth, const ObserverFrame& of, const RollingBallTracker& tracker,
+             const SideFilters& side);
+  /// Wall-clock and thread-CPU seconds of the observer and of the plain reference on one frame.
+  void timing(double observer_s, double reference_s, double observer_cpu_s, double reference_cpu_s);
+
+  /// The figures of the run so far (steps and pushes scored on the ticks recorded).
+  TableBallResult result(std::uint64_t seed) const;
+
+private:
+  struct Accumulator {
+    double sum_sq = 0.0;
+    long n = 0;
+    void add(const Eigen::Vector2d& e) {
+      sum_sq += e.squaredNorm();
+      ++n;
+    }
+    double rmsMm() const;
+  };
+  void scoreEvents(TableBallResult& res) const;
+
+  const TableBallConfig& cfg_;
+  double period_;
+  TableBallResult counts_;  ///< frame counts and command limits, as they accumulate
+  bool have_cmd_ = false;
+  Eigen::Vector2d last_cmd_ = Eigen::Vector2d::Zero();
+  std::vector<double> tick_t_;
+  std::vector<Eigen::Vector2d> tick_p_;
+  Accumulator obs_, meas_, pred_, tilt_;
+  std::vector<Accumulator> side_;
+  std::vector<std::pair<double, Eigen::Vector2d>> pending_pred_;  // (time, predicted position N frames ahead)
+  double nis_sum_ = 0.0;
+  int nis_n_ = 0;
+  double obs_time_ = 0.0, ref_time_ = 0.0, obs_cpu_ = 0.0, ref_cpu_ = 0.0;
+  int timed_ = 0;
+};
+
+}  // namespace viewline::scenarios
