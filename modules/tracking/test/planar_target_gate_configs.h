@@ -1,5 +1,5 @@
 #pragma once
-// The filter settings the gate-decision test runs (shared by the recorder and the test).
+// The filter settings the gate-decision test runs: every model and part of the planar target filter.
 #include <Eigen/Core>
 #include <optional>
 #include <string>
