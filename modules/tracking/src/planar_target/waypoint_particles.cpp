@@ -1,5 +1,5 @@
 // Waypoint particle filter: model and equations in the header.
-#include "viewline/control/waypoint_particle_filter.h"
+#include "viewline/tracking/planar_target/waypoint_particles.h"
 
 #include <Eigen/Cholesky>
 
@@ -12,7 +12,7 @@
 #include "viewline/core/error.h"
 #include "viewline/core/frames.h"
 
-namespace viewline::control {
+namespace viewline::tracking {
 
 using Eigen::Matrix2d;
 using Eigen::Vector2d;
@@ -33,10 +33,17 @@ void WaypointParticleConfig::validate() const {
   if (reinit_after < 1) throw core::InvalidInput("waypoint particle filter: reinit_after must be >= 1");
 }
 
-WaypointParticleFilter::WaypointParticleFilter(const WaypointParticleConfig& config)
-    : cfg_(config), rng_(core::makeRng(config.seed)) {
-  cfg_.validate();
+namespace {
+const WaypointParticleConfig& validated(const WaypointParticleConfig& c) {
+  c.validate();
+  return c;
 }
+}  // namespace
+
+// The gate's NIS is a pass/fail here (0: some particle explains the measurement better than an outlier,
+// infinity: none does), so only its restart count matters; its probability is not used.
+WaypointParticleFilter::WaypointParticleFilter(const WaypointParticleConfig& config)
+    : cfg_(validated(config)), rng_(core::makeRng(config.seed)), gate_(2, {0.999, config.reinit_after}) {}
 
 Vector2d WaypointParticleFilter::drawWaypoint(const Vector2d& from, core::Rng& rng) const {
   const Vector2d h = 0.5 * cfg_.region_size;
@@ -76,6 +83,7 @@ void WaypointParticleFilter::update(double t, const Vector2d& z, const Matrix2d&
     throw core::InvalidInput("waypoint particle filter: non-finite measurement or covariance not positive definite");
   const std::size_t n = cfg_.particles;
   if (!initialized_) {
+    gate_.decide(t, 0.0);  // Start
     drawPrior(t, z, R);
     return;
   }
@@ -100,14 +108,11 @@ void WaypointParticleFilter::update(double t, const Vector2d& z, const Matrix2d&
   // No particle explains the measurement better than an outlier does: after reinit_after of these in a
   // row the cloud has lost the target (e.g. it turned during an occlusion), and starts again from the
   // measurement.
-  if (best_in < log_out) {
-    if (++far_in_a_row_ >= cfg_.reinit_after) {
-      drawPrior(t, z, R);
-      ++reinitialisations_;
-      return;
-    }
-  } else {
-    far_in_a_row_ = 0;
+  const bool explained = !(best_in < log_out);
+  if (gate_.decide(t, explained ? 0.0 : std::numeric_limits<double>::infinity()) == GateDecision::Restart) {
+    drawPrior(t, z, R);
+    ++reinitialisations_;
+    return;
   }
   w_.resize(n);
   w_sum_ = 0.0;
@@ -163,7 +168,6 @@ void WaypointParticleFilter::drawPrior(double t, const Vector2d& z, const Matrix
   }
   resetWeights();
   initialized_ = true;
-  far_in_a_row_ = 0;
   t_ = t;
   ++updates_;
 }
@@ -209,4 +213,4 @@ double WaypointParticleFilter::speedMean() const {
   return sum / w_sum_;
 }
 
-}  // namespace viewline::control
+}  // namespace viewline::tracking

@@ -1,0 +1,156 @@
+#pragma once
+// The planar target filter: a target moving on a known plane, estimated in plane coordinates (m).
+//
+// Kalman filter of a target moving on a plane, state (p, v[, a]) in plane coordinates (m),
+// models built as continuous-time systems and discretised exactly (estimation::discretize,
+// Van Loan) for the actual interval of every step:
+//   CV:     ṗ = v, v̇ = w,                 w ~ q I₂
+//   CA:     ṗ = v, v̇ = a, ȧ = w,          w ~ q I₂
+//   Singer: ṗ = v, v̇ = a, ȧ = −a/τ + w,   w ~ (2 σm² / τ) I₂
+//   CT:     state (p, v, ω), coordinated turn (estimation/models/coordinated_turn.h), EKF
+//   IMM:    state (p, v, ω), three modes (estimation/imm.h): "cv" = CV with density q (ω kept,
+//           random walk ct_q_omega), "ct" = CT (ct_q_accel, ct_q_omega), "maneuver" = CV with
+//           density maneuver_q; mean sojourn times imm_sojourn, jumps uniform to the other modes.
+//           (CT alone is the one-mode IMM, i.e. a plain EKF.)
+// Measurement: the position, y = [I 0] x + e, cov e = R.
+// Gate (tracking::TrackGate, 2 dof): a measurement whose NIS exceeds χ²₂(gate_probability) is not
+// fused; reinit_after of them in a row re-initialise the filter at the last one. update() reports the
+// decision with the NIS it was taken on.
+// The parts, each in its own header:
+//   corner_detector.h  jump detection (a corner of a polyline), the soft jump mixture, "auto" corner settings;
+//   speed_legs.h       constant-speed legs after each corner, the learnt speed and turn angles;
+//   waypoint_region.h  the box the waypoints lie in (direction prior, turn odds, coasting stops at its edge);
+//   waypoint_particles.h  the Bayes reference of the random path (model waypoint_particles, below).
+// Waypoint particles (model waypoint_particles; needs the region): instead of a Kalman filter, the
+// waypoint particle filter (waypoint_particles.h), the posterior of the random path's own
+// generator (waypoints uniform in the region, one speed). state() and estimate() are its posterior
+// moments of (p, v) at the last measurement, at() its moments run ahead; its outlier term replaces
+// the gate (every measurement is accepted; NIS against the predicted moments), and a reset() draws
+// a fresh cloud from the next stream. The Kalman keys (q, jumps, legs, turns) are not used. It is
+// the Bayes reference of the replays put in the loop, for targets whose generator is known.
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <utility>
+#include <vector>
+
+#include "viewline/core/time.h"
+#include "viewline/estimation/discretization.h"
+#include "viewline/estimation/imm.h"
+#include "viewline/estimation/state.h"
+#include "viewline/tracking/planar_target/config.h"
+#include "viewline/tracking/planar_target/corner_detector.h"
+#include "viewline/tracking/planar_target/history.h"
+#include "viewline/tracking/planar_target/speed_legs.h"
+#include "viewline/tracking/planar_target/waypoint_particles.h"
+#include "viewline/tracking/planar_target/waypoint_region.h"
+#include "viewline/tracking/track_gate.h"
+
+namespace viewline::tracking {
+
+class PlanarTargetFilter {
+public:
+  explicit PlanarTargetFilter(const TargetFilterConfig& config = {});
+
+  struct Update {
+    bool accepted = false;
+    bool reinitialized = false;
+    bool jump = false;  ///< a velocity jump was detected and the recent measurements processed again
+    double nis = 0.0;   ///< of the innovation the gate tested (0 when the measurement started the track)
+    std::optional<GateDecision> decision;  ///< the gate's decision (nullopt: no measurement)
+  };
+  bool initialized() const { return initialized_; }
+  /// (Re)initialises at the measurement: the gate's Start.
+  void reset(core::Timestamp t, const Eigen::Vector2d& z, const Eigen::Matrix2d& R);
+  /// Predicts to t (>= the state's time) and fuses z (gated). Initialises on the first call.
+  Update update(core::Timestamp t, const Eigen::Vector2d& z, const Eigen::Matrix2d& R);
+
+  struct Kinematics {
+    Eigen::Vector2d p = Eigen::Vector2d::Zero(), v = Eigen::Vector2d::Zero(), a = Eigen::Vector2d::Zero();
+    Eigen::Matrix2d P_pos = Eigen::Matrix2d::Zero();
+  };
+  /// The state extrapolated to t (no change to the filter); t may be before the state's time
+  /// only by rounding (it is then evaluated at the state's time). With an active waypoint region, an
+  /// extrapolation that would leave the box stops on its boundary with v = a = 0 (the model's target
+  /// never leaves it; it turns there, direction unknown): what coasting through an occlusion follows.
+  Kinematics at(core::Timestamp t) const;
+  const estimation::StateEstimate& state() const { return state_; }
+  /// The output estimate at the last measurement: the soft jump mixture when it applies, else state().
+  const estimation::StateEstimate& estimate() const { return output_ ? *output_ : state_; }
+  const TargetFilterConfig& config() const { return config_; }
+  int stateDim() const;
+  /// IMM mode probabilities (cv, ct, maneuver); empty for the other models.
+  Eigen::VectorXd modeProbabilities() const;
+  /// Velocity jumps detected since construction.
+  std::size_t jumps() const { return jumps_; }
+  /// The gate's decisions reported by update() and reset() since construction (the measurements a
+  /// detected jump processes again are not counted twice).
+  const GateCounts& gateCounts() const { return counts_; }
+  /// The NIS threshold χ²₂(gate_probability).
+  double gateThreshold() const { return gate_.threshold(); }
+  /// Starts a constant-speed leg at t_c (>= the last measurement time) from the estimate there: a
+  /// jump known from outside (e.g. the corner times of a known path, for a bound). Needs constant_speed
+  /// and a known speed.
+  void startLeg(core::Timestamp t_c);
+  /// Sets ŝ and its variance (instead of learning them from the legs).
+  void setSpeed(double speed, double variance);
+  /// The corner settings in force now: the configured values, or the "auto" ones (corner_detector.h).
+  int minSamples() const;
+  double cornerSigma() const;
+  /// The learnt speed ŝ (m/s) and its variance; 0 / 1e300 before the first segment has ended.
+  double speedEstimate() const { return speed_.estimate(); }
+  double speedVariance() const { return speed_.variance(); }
+  /// The configured waypoint region was dropped because the measurements left it (waypoint_region.h).
+  bool regionDropped() const { return region_.dropped(); }
+  /// The turn angles (rad, in [−π, π], oldest first) learnt at the last corners (turn_prior_weight > 0).
+  const std::vector<double>& learntTurns() const { return turns_.turns(); }
+
+private:
+  using Snapshot = PlanarSnapshot;
+  /// The old state is dropped: x = (z, 0...), P = diag(R, the motion prior), the gate started at t.
+  void start(core::Timestamp t, const Eigen::Vector2d& z, const Eigen::Matrix2d& R);
+  Update step(core::Timestamp t, const Eigen::Vector2d& z, const Eigen::Matrix2d& R);
+  /// The gate on out.nis: true to fuse. Otherwise the state becomes `coast` (if given) and a restart
+  /// re-initialises at the measurement.
+  bool admit(Update& out, core::Timestamp t, const Eigen::Vector2d& z, const Eigen::Matrix2d& R,
+             const estimation::StateEstimate* coast = nullptr);
+  void count(const Update& u);
+  Snapshot snapshot(core::Timestamp t, const Eigen::Vector2d& z, const Eigen::Matrix2d& R) const;
+  bool detectJump();
+  void applyJump(int j);  ///< restart from history_[j] with the motion prior re-opened, re-process the rest
+  void softMixture(std::vector<std::pair<double, int>>& log_odds);
+  /// The constant-speed leg from the corner (t_c, c ~ N(c, P_c)) under the current speed, turn and
+  /// region priors; from_direction: the direction (rad) of the leg that ended there (NaN: θ uniform).
+  ConstantSpeedLeg makeLeg(core::Timestamp t_c, const Eigen::Vector2d& c, const Eigen::Matrix2d& P_c,
+                           double from_direction) const;
+  LegFactory legFactory() const;  ///< makeLeg with the priors at the time of the call
+  estimation::StateEstimate reopened(const Snapshot& sj) const;  ///< x(j|j) with the motion prior re-opened
+  estimation::StateEstimate alternative(int j) const;            ///< the state now after a jump at history_[j]
+  bool legEvidenceMixture() const;    ///< the soft mixture's Bayes factors from constant-speed legs
+  /// log prior odds of a turn at each soft-mixture candidate from the waypoint region; empty if none.
+  std::vector<double> regionJumpOdds() const;
+  bool usesImm() const { return config_.model == TargetModel::CoordinatedTurn || config_.model == TargetModel::Imm; }
+  void setParticleState();  ///< state_ from the particles' moments at their time
+
+  TargetFilterConfig config_;
+  TrackGate gate_;
+  GateCounts counts_;
+  CornerSettings corners_;
+  LegSpeed speed_;
+  LearntTurns turns_;
+  WaypointRegion region_;
+  std::shared_ptr<const ConstantSpeedLeg> leg_;  ///< the current leg (immutable: copies share it until it changes)
+  std::optional<estimation::StateEstimate> output_;  ///< the soft mixture, when it differs from state_
+  PlanarHistory history_;  ///< measurements of the last jump_window s (since the last jump)
+  std::size_t jumps_ = 0;
+  std::optional<estimation::Imm> imm_;
+  std::optional<WaypointParticleFilter> particles_;  ///< model waypoint_particles
+  std::uint64_t particle_resets_ = 0;
+  estimation::ContinuousLinearModel model_;
+  estimation::StateEstimate state_;
+  bool initialized_ = false;
+};
+
+}  // namespace viewline::tracking

@@ -1,0 +1,32 @@
+#pragma once
+// The planar target filter's recent past: one snapshot per measurement of the jump window (the
+// measurement and the filter's x(t|t) after it), which the corner detector scans and a detected jump
+// re-processes; and the motions those states extrapolate by.
+
+#include <Eigen/Core>
+#include <optional>
+#include <vector>
+
+#include "viewline/core/time.h"
+#include "viewline/estimation/imm.h"
+#include "viewline/estimation/state.h"
+
+namespace viewline::tracking {
+
+struct PlanarSnapshot {
+  core::Timestamp t = 0.0;
+  Eigen::Vector2d z = Eigen::Vector2d::Zero();
+  Eigen::Matrix2d R = Eigen::Matrix2d::Identity();
+  estimation::StateEstimate state;       ///< x(t|t) after this measurement
+  std::optional<estimation::Imm> imm;
+};
+using PlanarHistory = std::vector<PlanarSnapshot>;
+
+/// The position of state x run by its own model for τ (either sign): (p, v) constant velocity,
+/// (p, v, a) constant acceleration, (p, v, ω) coordinated turn.
+Eigen::Vector2d extrapolatePosition(const Eigen::VectorXd& x, double tau);
+
+/// atan2 of the state's velocity (rad), NaN when the velocity is ~0.
+double velocityDirection(const estimation::StateEstimate& s);
+
+}  // namespace viewline::tracking

@@ -1,0 +1,387 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <iostream>
+#include <memory>
+
+#include "planar_target_tracks.h"
+#include "viewline/core/error.h"
+#include "viewline/core/frames.h"
+#include "viewline/core/random.h"
+#include "viewline/tracking/planar_target/filter.h"
+#include "viewline/tracking/planar_target/waypoint_particles.h"
+
+using namespace viewline;
+using namespace viewline::tracking::planar_test;
+
+TEST(PlanarTargetFilter, ConstantVelocityTrackIsConsistent) {
+  for (const auto model : {tracking::TargetModel::ConstantVelocity, tracking::TargetModel::ConstantAcceleration,
+                           tracking::TargetModel::Singer}) {
+    tracking::TargetFilterConfig cfg;
+    cfg.model = model;
+    cfg.q = 1e-4;
+    // Same process-noise intensity for every model: Singer's acceleration noise has spectral
+    // density 2 σm² / τ, so σm = sqrt(q τ / 2) (its default σm = 0.2 m/s² is ~400x more noise,
+    // a filter tuned for manoeuvres, not for this straight track).
+    cfg.singer_sigma = std::sqrt(cfg.q * cfg.singer_tau / 2.0);
+    tracking::PlanarTargetFilter f(cfg);
+    core::Rng rng = core::makeRng(11);
+    const double sigma = 0.02;
+    const Eigen::Matrix2d R = sigma * sigma * Eigen::Matrix2d::Identity();
+    const Eigen::Vector2d v(0.15, -0.05);
+    double nis_sum = 0.0;
+    int n = 0;
+    for (int k = 0; k < 600; ++k) {
+      const double t = k / 30.0;
+      const Eigen::Vector2d z = Eigen::Vector2d(0.1, 0.2) + v * t + Eigen::Vector2d(core::gaussian(rng, sigma), core::gaussian(rng, sigma));
+      const auto u = f.update(t, z, R);
+      EXPECT_TRUE(u.accepted);
+      if (k > 100) { nis_sum += u.nis; ++n; }
+    }
+    const auto kin = f.at(20.0);
+    EXPECT_NEAR((kin.v - v).norm(), 0.0, 0.01) << tracking::toString(model);
+    EXPECT_NEAR((kin.p - (Eigen::Vector2d(0.1, 0.2) + v * 20.0)).norm(), 0.0, 0.02) << tracking::toString(model);
+    EXPECT_NEAR(nis_sum / n, 2.0, 0.4) << tracking::toString(model);  // chi-square, 2 dof
+  }
+  EXPECT_THROW(tracking::targetModelFromString("zigzag"), core::InvalidInput);
+}
+
+TEST(PlanarTargetFilter, JumpDetectionFindsTheCornerOfAPolylineAndNotACircle) {
+  // Constant speed 0.15 m/s, a 90° corner at t = 6 s (the rectangle of [T]'s test), σ = 4 cm.
+  const auto corner = [](double t) -> Eigen::Vector2d {
+    return t < 6.0 ? Eigen::Vector2d(0.15 * t, 0.0) : Eigen::Vector2d(0.9, 0.15 * (t - 6.0));
+  };
+  tracking::TargetFilterConfig cv;
+  cv.model = tracking::TargetModel::ConstantVelocity;
+  cv.q = 1e-5;
+  tracking::TargetFilterConfig cv_jump = cv;
+  cv_jump.jump_window = 3.0;
+  cv_jump.jump_threshold = 15.0;
+  cv_jump.jump_min_samples = 8;
+  double rms_plain = 0.0, rms_jump = 0.0;
+  for (std::uint64_t seed = 1; seed <= 4; ++seed) {
+    const TrackScore plain = scoreTrack(cv, corner, 6.0, seed);
+    const TrackScore jump = scoreTrack(cv_jump, corner, 6.0, seed);
+    EXPECT_EQ(plain.jumps, 0u);
+    EXPECT_GE(jump.jumps, 1u) << seed;
+    EXPECT_LE(jump.jumps, 2u) << seed;
+    EXPECT_GT(jump.first_jump_after_corner, 0.0) << seed;  // found after the corner happened ...
+    EXPECT_LT(jump.first_jump_after_corner, 1.0) << seed;  // ... within a second
+    rms_plain += plain.rms / 4.0;
+    rms_jump += jump.rms / 4.0;
+  }
+  // measured: 16.5 vs 37.7 mm
+  EXPECT_LT(rms_jump, 0.75 * rms_plain) << rms_jump << " vs " << rms_plain;
+  const auto line = [](double t) -> Eigen::Vector2d { return Eigen::Vector2d(0.15 * t, -0.05 * t); };
+  // A straight track at constant speed (the test's null hypothesis): the threshold (χ² = 15, scanned
+  // over every candidate time of every step) lets a few false jumps through; each re-opens the
+  // velocity prior, which costs accuracy for a while.
+  double rms_line = 0.0, rms_line_jump = 0.0;
+  std::size_t line_jumps = 0;
+  for (std::uint64_t seed = 1; seed <= 4; ++seed) {
+    const auto a = scoreTrack(cv, line, 1e9, seed), b = scoreTrack(cv_jump, line, 1e9, seed);
+    line_jumps += b.jumps;
+    rms_line += a.rms / 4.0;
+    rms_line_jump += b.rms / 4.0;
+  }
+  EXPECT_LE(line_jumps, 4u);  // (measured: 3 over the four 12 s tracks)
+  // measured: 1.28x (13.1 vs 10.2 mm)
+  EXPECT_LT(rms_line_jump, 1.3 * rms_line) << rms_line_jump << " vs " << rms_line;
+  // A circle (radius 0.3 m at 0.15 m/s) followed by the coordinated-turn model: the turn-rate prior
+  // keeps the test from taking the curvature for corners, except, rarely, while ω is still being
+  // learnt (this can happen in the first seconds of a track), at a cost.
+  const auto circle = [](double t) -> Eigen::Vector2d { return 0.3 * Eigen::Vector2d(std::cos(0.5 * t), std::sin(0.5 * t)); };
+  tracking::TargetFilterConfig ct;
+  ct.model = tracking::TargetModel::CoordinatedTurn;
+  ct.ct_q_accel = 1e-6;
+  ct.ct_q_omega = 1e-6;
+  ct.init_omega_sigma = 0.5;
+  tracking::TargetFilterConfig ct_jump = ct;
+  ct_jump.jump_window = 3.0;
+  ct_jump.jump_threshold = 15.0;
+  ct_jump.jump_min_samples = 8;
+  double rms_ct = 0.0, rms_ct_jump = 0.0;
+  std::size_t false_jumps = 0;
+  for (std::uint64_t seed = 1; seed <= 4; ++seed) {
+    const TrackScore a = scoreTrack(ct, circle, 1e9, seed), b = scoreTrack(ct_jump, circle, 1e9, seed);
+    false_jumps += b.jumps;
+    rms_ct += a.rms / 4.0;
+    rms_ct_jump += b.rms / 4.0;
+  }
+  EXPECT_LE(false_jumps, 4u);  // (measured: 4 over the four 12 s tracks, all in the first 8 s)
+  // measured: 1.24x (17.1 vs 13.8 mm)
+  EXPECT_LT(rms_ct_jump, 1.3 * rms_ct) << rms_ct_jump << " vs " << rms_ct;
+  cv_jump.jump_min_samples = 1;
+  EXPECT_THROW(tracking::PlanarTargetFilter{cv_jump}, core::InvalidInput);
+}
+
+TEST(PlanarTargetFilter, SoftJumpsAndConstantSpeedLegsOnASquare) {
+  tracking::TargetFilterConfig hard;  // CV + hard jump decisions
+  hard.model = tracking::TargetModel::ConstantVelocity;
+  hard.q = 1e-5;
+  hard.init_velocity_sigma = 0.3;
+  hard.jump_window = 3.0;
+  hard.jump_threshold = 15.0;
+  hard.jump_min_samples = 8;
+  tracking::TargetFilterConfig soft = hard;
+  soft.jump_rate = 1.0;
+  soft.jump_prior_sigma = 0.1;
+  tracking::TargetFilterConfig legs = soft;  // constant-speed legs, no turn prior
+  legs.jump_threshold = 20.0;
+  legs.constant_speed = true;
+  legs.constant_speed_sigma = 0.002;
+  legs.jump_corner_sigma = 0.005;
+  tracking::TargetFilterConfig turns = legs;  // the shipped rectangle filter: learnt turns, leg evidence
+  turns.jump_threshold = 30.0;
+  turns.jump_rate = 0.3;
+  turns.jump_evidence = "legs";
+  turns.jump_corner_sigma = 0.01;
+  turns.turn_prior_weight = 0.9;
+  turns.turn_prior_sigma_deg = 4.0;
+  tracking::TargetFilterConfig oracle = hard;
+  oracle.jump_threshold = 1e300;
+  oracle.constant_speed = true;
+  oracle.constant_speed_sigma = 0.0;
+  double r_hard = 0.0, r_soft = 0.0, r_legs = 0.0, r_turns = 0.0, r_oracle = 0.0;
+  for (std::uint64_t seed = 1; seed <= 4; ++seed) {
+    r_hard += scoreSquare(hard, seed).rms / 4.0;
+    r_soft += scoreSquare(soft, seed).rms / 4.0;
+    const LongScore l = scoreSquare(legs, seed);
+    r_legs += l.rms / 4.0;
+    EXPECT_NEAR(l.speed, 0.15, 0.005) << seed;  // learnt from the legs between the detected corners
+    EXPECT_GE(l.jumps, 8u) << seed;              // 9 corners in 30 s
+    EXPECT_LE(l.jumps, 11u) << seed;
+    r_oracle += scoreSquare(oracle, seed, true).rms / 4.0;
+    tracking::PlanarTargetFilter learnt(turns);
+    const LongScore t = scoreSquare(turns, seed, false, &learnt);
+    r_turns += t.rms / 4.0;
+    EXPECT_GE(t.jumps, 8u) << seed;
+    EXPECT_LE(t.jumps, 11u) << seed;
+    ASSERT_GE(learnt.learntTurns().size(), 5u) << seed;
+    std::size_t left_turns = 0;  // the square turns +90° at every corner
+    for (double turn : learnt.learntTurns()) left_turns += std::abs(turn - core::kPi / 2.0) < 0.15 ? 1 : 0;
+    EXPECT_GE(left_turns + 1, learnt.learntTurns().size()) << seed;
+  }
+  std::cout << "square, RMS (mm): hard " << 1e3 * r_hard << ", soft " << 1e3 * r_soft << ", legs + soft "
+            << 1e3 * r_legs << ", learnt turns + leg evidence " << 1e3 * r_turns << ", oracle corners "
+            << 1e3 * r_oracle << "\n";
+  // measured (mm): hard 20.34, soft 18.79, legs + soft 16.45, oracle 12.47
+  EXPECT_LT(r_soft, r_hard);
+  EXPECT_LT(r_legs, r_soft);
+  EXPECT_LT(r_legs, 0.85 * r_hard);
+  EXPECT_LT(r_turns, r_legs);
+  EXPECT_LT(r_oracle, r_legs);  // knowing the corners is a bound
+
+  tracking::TargetFilterConfig bad = legs;
+  bad.model = tracking::TargetModel::CoordinatedTurn;
+  EXPECT_THROW(tracking::PlanarTargetFilter{bad}, core::InvalidInput);  // constant speed is a CV leg model
+  bad = legs;
+  bad.jump_window = 0.0;
+  EXPECT_THROW(tracking::PlanarTargetFilter{bad}, core::InvalidInput);  // the speed is learnt between jumps
+  bad = soft;
+  bad.model = tracking::TargetModel::Imm;
+  EXPECT_THROW(tracking::PlanarTargetFilter{bad}, core::InvalidInput);  // the soft mixture is for linear models
+  bad = soft;
+  bad.jump_evidence = "legs";
+  EXPECT_THROW(tracking::PlanarTargetFilter{bad}, core::InvalidInput);  // leg evidence needs constant-speed legs
+  bad = soft;
+  bad.turn_prior_weight = 0.5;
+  EXPECT_THROW(tracking::PlanarTargetFilter{bad}, core::InvalidInput);  // so does the turn prior
+  bad = turns;
+  bad.jump_evidence = "kinks";
+  EXPECT_THROW(tracking::PlanarTargetFilter{bad}, core::InvalidInput);
+  bad = turns;
+  bad.turn_prior_weight = 1.0;
+  EXPECT_THROW(tracking::PlanarTargetFilter{bad}, core::InvalidInput);  // would forbid any new turn
+  bad = turns;
+  bad.turn_prior_sigma_deg = 0.0;
+  EXPECT_THROW(tracking::PlanarTargetFilter{bad}, core::InvalidInput);
+  tracking::PlanarTargetFilter f(hard);
+  EXPECT_THROW(f.startLeg(0.0), core::Error);  // not initialised
+  f.update(0.0, Eigen::Vector2d::Zero(), 1e-4 * Eigen::Matrix2d::Identity());
+  EXPECT_THROW(f.startLeg(0.1), core::Error);  // no constant speed
+  tracking::PlanarTargetFilter g(legs);
+  g.update(0.0, Eigen::Vector2d::Zero(), 1e-4 * Eigen::Matrix2d::Identity());
+  EXPECT_THROW(g.startLeg(0.1), core::Error);  // speed not known yet
+  g.setSpeed(0.15, 1e-6);
+  EXPECT_THROW(g.startLeg(-0.1), core::InvalidInput);  // before the last measurement
+  EXPECT_NO_THROW(g.startLeg(0.1));
+}
+
+TEST(PlanarTargetFilter, LegEvidenceOnARandomPolyline) {
+  // The pan-tilt app's random path: uniformly random turns every ~2 s, [T]'s 10 % noise (σ 3.6 / 2.1 cm).
+  // The kinks filter (CV, corners by the kink test, soft mixture from kinks) against the legs filter
+  // (constant-speed legs, soft mixture from leg evidence, uniform turn prior), and the oracle.
+  const tracking::TargetFilterConfig kinks = randomKinksFilter(), legs = randomLegsFilter();
+  tracking::TargetFilterConfig oracle = legs;
+  oracle.jump_threshold = 1e300;
+  oracle.jump_rate = 0.0;
+  oracle.jump_evidence = "kink";
+  oracle.constant_speed_sigma = 0.0;
+  const double r_kinks = randomPolylineRms(kinks);
+  const double r_legs = randomPolylineRms(legs, false, [](std::uint64_t seed, const tracking::PlanarTargetFilter& f) {
+    EXPECT_NEAR(f.speedEstimate(), 0.15, 0.01) << seed;
+  });
+  const double r_oracle = randomPolylineRms(oracle, true);
+  std::cout << "random polyline, RMS (mm): kinks " << 1e3 * r_kinks << ", legs + leg evidence " << 1e3 * r_legs
+            << ", oracle corners " << 1e3 * r_oracle << "\n";
+  // measured (mm): kinks 17.32, legs + leg evidence 13.99, oracle 10.17
+  EXPECT_LT(r_legs, 0.9 * r_kinks);
+  EXPECT_LT(r_oracle, r_legs);  // knowing the corners is a bound
+}
+
+TEST(PlanarTargetFilter, AutoCornerSettingsFollowTheNoiseAndTheStep) {
+  // "auto": jump_min_samples = round(2.44 ρ^(2/3)), ρ = σ / (ŝ Δt), and jump_corner_sigma = 0.34 σ, with σ
+  // the per-axis RMS of the measurement noise. On the app's random polyline at [T]'s 10 % noise and 30 Hz
+  // that is the pair the shipped config was tuned to (8, 0.01 m); at 60 Hz ρ doubles (12 or 13).
+  tracking::TargetFilterConfig autos = randomRegionFilter();
+  autos.jump_min_samples.reset();
+  autos.jump_corner_sigma.reset();
+  const Eigen::Vector2d sigma(0.036, 0.021);
+  const double sigma_rms = std::sqrt(0.5 * sigma.squaredNorm());
+  for (const double rate : {30.0, 60.0}) {
+    std::vector<double> corners;
+    const auto track = randomPolyline(1, 20.0, corners);
+    tracking::PlanarTargetFilter f(autos);
+    EXPECT_EQ(f.minSamples(), tracking::kAutoJumpSamplesMax);  // nothing known yet
+    core::Rng rng = core::makeRng(5);
+    for (int k = 0; k < static_cast<int>(20.0 * rate); ++k) {
+      const double t = k / rate;
+      f.update(t, track(t) + Eigen::Vector2d(core::gaussian(rng, sigma.x()), core::gaussian(rng, sigma.y())),
+               sigma.cwiseAbs2().asDiagonal());
+    }
+    ASSERT_GT(f.jumps(), 3u) << rate;
+    const double s = f.speedEstimate();
+    EXPECT_NEAR(s, 0.15, 0.01) << rate;
+    const double rho = sigma_rms / (s / rate);
+    EXPECT_EQ(f.minSamples(), static_cast<int>(std::lround(2.44 * std::pow(rho, 2.0 / 3.0)))) << rate;
+    EXPECT_NEAR(f.minSamples(), rate == 30.0 ? 8 : 12.7, 0.51) << rate;
+    EXPECT_NEAR(f.cornerSigma(), 0.34 * sigma_rms, 1e-12) << rate;
+  }
+  // Set values are used as they are.
+  const tracking::PlanarTargetFilter fixed(randomRegionFilter());
+  EXPECT_EQ(fixed.minSamples(), 8);
+  EXPECT_EQ(fixed.cornerSigma(), 0.01);
+  // At half [T]'s noise the 10 %-tuned pair waits too long at each corner; "auto" takes 4-5 measurements.
+  const Eigen::Vector2d half = 0.5 * sigma;
+  const double r_fixed = randomPolylineRms(randomRegionFilter(), false, nullptr, half);
+  const double r_auto = randomPolylineRms(autos, false, nullptr, half);
+  std::cout << "random polyline at 5 % noise, RMS (mm): fixed (8, 0.01 m) " << 1e3 * r_fixed << ", auto "
+            << 1e3 * r_auto << "\n";
+  // measured (mm): fixed 7.91, auto 6.76
+  EXPECT_LT(r_auto, 0.9 * r_fixed);
+  tracking::TargetFilterConfig bad = randomRegionFilter();
+  bad.jump_min_samples = 1;
+  EXPECT_THROW(tracking::PlanarTargetFilter{bad}, core::InvalidInput);
+  bad = randomRegionFilter();
+  bad.jump_corner_sigma = -0.01;
+  EXPECT_THROW(tracking::PlanarTargetFilter{bad}, core::InvalidInput);
+}
+
+TEST(PlanarTargetFilter, WaypointDirectionDensityAndNewKeys) {
+  // p(θ) = R(θ)² / (2A) integrates to 1 from anywhere in the box, favours the long way, and is 0
+  // straight out of the box from a point on its boundary.
+  const Eigen::Vector2d center(0.1, -0.05), size(0.8, 0.43);
+  for (const Eigen::Vector2d& c : {Eigen::Vector2d(0.1, -0.05), Eigen::Vector2d(0.4, 0.1), Eigen::Vector2d(-0.29, -0.26)}) {
+    double sum = 0.0;
+    const int points = 3600;
+    for (int k = 0; k < points; ++k)
+      sum += tracking::waypointDirectionDensity(c, center, size, -core::kPi + 2.0 * core::kPi * k / points);
+    EXPECT_NEAR(sum * 2.0 * core::kPi / points, 1.0, 1e-3) << c.transpose();
+  }
+  EXPECT_GT(tracking::waypointDirectionDensity(center, center, size, 0.0),
+            3.0 * tracking::waypointDirectionDensity(center, center, size, 0.5 * core::kPi));
+  const Eigen::Vector2d right_edge(0.5, 0.0);
+  EXPECT_DOUBLE_EQ(tracking::waypointDirectionDensity(right_edge, center, size, 0.0), 0.0);
+  EXPECT_NEAR(tracking::waypointDirectionDensity(right_edge, center, size, core::kPi), 0.64 / (2.0 * 0.8 * 0.43), 1e-12);
+  EXPECT_THROW(tracking::waypointDirectionDensity(center, center, Eigen::Vector2d(0.8, 0.0), 0.0), core::InvalidInput);
+
+  tracking::TargetFilterConfig bad;
+  bad.model = tracking::TargetModel::ConstantVelocity;
+  bad.jump_window = 3.0;
+  bad.region_size = Eigen::Vector2d(0.8, 0.43);
+  EXPECT_THROW(tracking::PlanarTargetFilter{bad}, core::InvalidInput);  // needs constant-speed legs
+  bad.constant_speed = true;
+  EXPECT_NO_THROW(tracking::PlanarTargetFilter{bad});
+  bad.region_size = Eigen::Vector2d(0.8, 0.0);
+  EXPECT_THROW(tracking::PlanarTargetFilter{bad}, core::InvalidInput);
+  bad.region_size = Eigen::Vector2d(-0.8, -0.4);
+  EXPECT_THROW(tracking::PlanarTargetFilter{bad}, core::InvalidInput);
+  bad.region_size = Eigen::Vector2d(0.8, 0.43);
+  bad.jump_decision = "posterior";
+  EXPECT_THROW(tracking::PlanarTargetFilter{bad}, core::InvalidInput);  // needs the soft mixture
+  bad.jump_rate = 1.0;
+  EXPECT_NO_THROW(tracking::PlanarTargetFilter{bad});
+  bad.jump_posterior = 1.0;
+  EXPECT_THROW(tracking::PlanarTargetFilter{bad}, core::InvalidInput);
+  bad.jump_posterior = 0.99;
+  bad.jump_decision = "vote";
+  EXPECT_THROW(tracking::PlanarTargetFilter{bad}, core::InvalidInput);
+}
+
+TEST(PlanarTargetFilter, WaypointRegionOnARandomPolyline) {
+  // The same random polylines, whose waypoints are uniform in the 0.8 x 0.43 m box: the legs
+  // filter without and with that box as its waypoint region (direction prior and turn odds), and with
+  // its jumps then decided by the mixture's posterior instead of the chi-square test.
+  const tracking::TargetFilterConfig legs = randomLegsFilter();
+  tracking::TargetFilterConfig region = legs;
+  region.region_size = Eigen::Vector2d(0.80, 0.43);
+  tracking::TargetFilterConfig posterior = region;  // config/pan_tilt_random.yaml
+  posterior.jump_decision = "posterior";
+  posterior.jump_posterior = 0.99;
+  const double r_legs = randomPolylineRms(legs), r_region = randomPolylineRms(region);
+  const double r_posterior = randomPolylineRms(posterior);
+  std::cout << "random polyline, RMS (mm): legs " << 1e3 * r_legs << ", legs + waypoint region " << 1e3 * r_region
+            << ", + jumps decided by the posterior " << 1e3 * r_posterior << "\n";
+  EXPECT_LT(r_region, 0.97 * r_legs);
+  EXPECT_LT(r_posterior, 0.97 * r_region);
+}
+
+TEST(PlanarTargetFilter, AWrongWaypointRegionIsDropped) {
+  // A box of half the size: the measurements leave it, the filter drops it and goes on as without one.
+  // The true box is never dropped on these tracks.
+  const tracking::TargetFilterConfig region = randomRegionFilter();
+  tracking::TargetFilterConfig wrong = region;
+  wrong.region_size = Eigen::Vector2d(0.40, 0.215);
+  tracking::TargetFilterConfig none = region;
+  none.region_size = Eigen::Vector2d::Zero();
+  randomPolylineRms(region, false, [](std::uint64_t seed, const tracking::PlanarTargetFilter& f) {
+    EXPECT_FALSE(f.regionDropped()) << seed;
+  });
+  const double r_wrong = randomPolylineRms(wrong, false, [](std::uint64_t seed, const tracking::PlanarTargetFilter& f) {
+    EXPECT_TRUE(f.regionDropped()) << seed;
+  });
+  const double r_none = randomPolylineRms(none);
+  std::cout << "random polyline, RMS (mm): half-size region " << 1e3 * r_wrong << ", no region " << 1e3 * r_none << "\n";
+  EXPECT_LT(r_wrong, 1.05 * r_none);
+}
+
+TEST(PlanarTargetFilter, AnExtrapolationStopsAtTheWaypointRegionsEdge) {
+  // A straight leg at 0.15 m/s towards the right edge of the 0.8 x 0.43 m box (x = 0.4), measured up
+  // to x = 0.35. Coasting 1 s (an occlusion) must not carry the estimate out of the box: it stops on
+  // the edge, still. Without the region it runs on to x ~ 0.5.
+  const tracking::TargetFilterConfig region = randomRegionFilter();
+  tracking::TargetFilterConfig none = region;
+  none.region_size = Eigen::Vector2d::Zero();
+  tracking::PlanarTargetFilter with(region), without(none);
+  const Eigen::Matrix2d R = std::pow(0.005, 2) * Eigen::Matrix2d::Identity();
+  core::Rng rng = core::makeRng(3);
+  double t = 0.0;
+  for (int k = 0; 0.15 * t < 0.35; ++k) {
+    t = k / 30.0;
+    const Eigen::Vector2d z(0.15 * t + core::gaussian(rng, 0.005), 0.05 + core::gaussian(rng, 0.005));
+    with.update(t, z, R);
+    without.update(t, z, R);
+  }
+  EXPECT_FALSE(with.regionDropped());
+  const auto near = with.at(t + 0.1);  // inside: the plain extrapolation
+  EXPECT_NEAR(near.p.x(), 0.15 * (t + 0.1), 0.01);
+  EXPECT_NEAR(near.v.x(), 0.15, 0.01);
+  EXPECT_NEAR((near.p - without.at(t + 0.1).p).norm(), 0.0, 1e-9);
+  const auto far = with.at(t + 1.0);
+  EXPECT_NEAR(far.p.x(), 0.4, 1e-9);  // on the edge
+  EXPECT_NEAR(far.p.y(), 0.05, 0.01);
+  EXPECT_EQ(far.v.norm(), 0.0);
+  EXPECT_GT(without.at(t + 1.0).p.x(), 0.48);
+}
