@@ -47,7 +47,7 @@ int main(int argc, char** argv) {
     log.flush();
     nlohmann::json j = scenarios::summaryJson(s, cfg);
     if (!opt.sets.empty()) j["config_set"] = opt.sets;
-    if (!opt.summary_path.empty()) io::writeJsonFile(opt.summary_path, j);
+    if (!opt.summary_path.empty()) io::writeSummaryFile(opt.summary_path, j);
     std::printf("ball_catching: %d throws, seed %llu, %zu cameras, %s robot (%.2f m/s, %.1f m/s²), planner %s, %.1f s wall\n",
                 s.throws, static_cast<unsigned long long>(opt.seed), cfg.activeCameras(), robots::toString(cfg.robot.kind),
                 cfg.robot.limits.v_max.x(), cfg.robot.limits.a_max.x(), planning::toString(cfg.planner.model.kind), s.wall_s);

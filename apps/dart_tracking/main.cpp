@@ -43,7 +43,7 @@ int main(int argc, char** argv) {
     log.flush();
     nlohmann::json j = scenarios::summaryToJson(s, cfg);
     if (!opt.sets.empty()) j["config_set"] = opt.sets;
-    if (!opt.summary_path.empty()) io::writeJsonFile(opt.summary_path, j);
+    if (!opt.summary_path.empty()) io::writeSummaryFile(opt.summary_path, j);
     std::fputs(scenarios::dartSummaryText(s).c_str(), stdout);
     return 0;
   });

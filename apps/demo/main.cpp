@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <iostream>
 
+#include "viewline/core/version.h"
 #include "viewline/core/random.h"
 #include "viewline/estimation/consistency.h"
 #include "viewline/estimation/discretization.h"
@@ -21,6 +22,7 @@ using namespace viewline;
 
 int main(int argc, char** argv) {
   CLI::App app{"viewline estimation-core demo: ballistic flight, aperiodic samples, NEES/NIS"};
+  app.set_version_flag("--version", std::string("viewline ") + viewline::core::kVersion);
   std::uint64_t seed = 1;
   int runs = 200;
   app.add_option("--seed", seed, "random seed");

@@ -61,7 +61,7 @@ int main(int argc, char** argv) {
     if (!opt.summary_path.empty()) {
       nlohmann::json out = j;
       if (!opt.sets.empty()) out["config_set"] = opt.sets;
-      io::writeJsonFile(opt.summary_path, out);
+      io::writeSummaryFile(opt.summary_path, out);
     }
     std::printf("%s", scenarios::summaryText(s, cfg, runs, opt.seed).c_str());
     return 0;

@@ -50,7 +50,7 @@ int main(int argc, char** argv) {
     nlohmann::json j = scenarios::toJson(r);
     j["rig"] = cfg.rig ? nlohmann::json(cfg.rig->folder) : nlohmann::json(nullptr);
     if (!opt.sets.empty()) j["config_set"] = opt.sets;
-    if (!opt.summary_path.empty()) io::writeJsonFile(opt.summary_path, j);
+    if (!opt.summary_path.empty()) io::writeSummaryFile(opt.summary_path, j);
     scenarios::printTableBallSummary(stdout, r, cfg);
     if (view) view->waitForClose();
     return 0;

@@ -10,6 +10,7 @@
 #include <memory>
 
 #include "app_options.h"
+#include "viewline/core/version.h"
 #include "viewline/core/error.h"
 #include "viewline/tuning/command_line.h"
 #include "viewline/viz/live_plot.h"
@@ -38,6 +39,7 @@ std::function<void(const tuning::LiveSample&)> livePlot(const std::string& title
 int main(int argc, char** argv) {
   CLI::App app{"viewline_tune: parameter sweeps, NEES/NIS consistency, noise auto-tuning and HTML reports for the\n"
                "viewline scenarios (run in-process, in parallel). See tutorials/tune_tracking_loop/README.md."};
+  app.set_version_flag("--version", std::string("viewline ") + viewline::core::kVersion);
   tuning::TuneCommandLine command_line(app);
   if (const auto code = apps::parseCommandLine(app, argc, argv)) return *code;
   std::signal(SIGINT, onSigint);

@@ -20,6 +20,7 @@
 #include <utility>
 #include <vector>
 
+#include "viewline/core/version.h"
 #include "viewline/core/error.h"
 #include "viewline/io/config.h"
 #include "viewline/io/files.h"
@@ -48,6 +49,7 @@ std::string row(const std::string& label, const scenarios::CatchSummary& s) {
 
 int main(int argc, char** argv) {
   CLI::App app{"Catch-rate tables: cameras, frame rate, pixel noise, robot limits, planner model"};
+  app.set_version_flag("--version", std::string("viewline ") + viewline::core::kVersion);
   std::string config_path = "config/ball_catching.yaml", only, json_path;
   int throws = 150, jobs = 2;
   std::uint64_t seed = 1;

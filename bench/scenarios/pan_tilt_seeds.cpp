@@ -30,6 +30,7 @@
 #include <string>
 #include <vector>
 
+#include "viewline/core/version.h"
 #include "viewline/core/error.h"
 #include "viewline/io/config.h"
 #include "viewline/io/log.h"
@@ -63,6 +64,7 @@ std::string pair(double x, double y) { return num(x, 3) + " / " + num(y, 3); }
 
 int main(int argc, char** argv) {
   CLI::App app{"Pan-tilt seed tables: closed loop (ours and ViSP's law), the filter's prediction and the oracle bound."};
+  app.set_version_flag("--version", std::string("viewline ") + viewline::core::kVersion);
   std::string config_file, log_dir, json_file;
   std::vector<std::string> sets;
   int seeds = 5, jobs = 2;

@@ -4,12 +4,14 @@
 #include <iostream>
 
 #include "tool_common.h"
+#include "viewline/core/version.h"
 #include "viewline/calib/intrinsics.h"
 #include "viewline/io/files.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"Intrinsic calibration from images of a chessboard, circle grid, AprilTag grid or ChArUco board.\n"
                "Writes a ViSP camera XML (models with and without distortion) and an OpenCV YAML."};
+  app.set_version_flag("--version", std::string("viewline ") + viewline::core::kVersion);
   std::string board_file, name = "camera", xml, yaml, report;
   std::vector<std::string> images;
   int min_views = 3;

@@ -10,6 +10,7 @@
 #include <iostream>
 
 #include "tool_common.h"
+#include "viewline/core/version.h"
 #include "viewline/calib/hand_eye.h"
 #include "viewline/core/frames.h"
 #include "viewline/io/files.h"
@@ -17,6 +18,7 @@
 
 int main(int argc, char** argv) {
   CLI::App app{"Hand-eye calibration (eye-in-hand or eye-to-hand) with vpHandEyeCalibration."};
+  app.set_version_flag("--version", std::string("viewline ") + viewline::core::kVersion);
   std::string setup = "eye-in-hand", robot_file, camera_file, output;
   app.add_option("--setup", setup, "eye-in-hand (camera on the end effector) | eye-to-hand (camera fixed)")
       ->check(CLI::IsMember({"eye-in-hand", "eye-to-hand"}));

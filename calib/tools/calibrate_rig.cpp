@@ -27,11 +27,13 @@
 #include <iostream>
 
 #include "tool_common.h"
+#include "viewline/core/version.h"
 #include "viewline/calib/synthetic.h"  // boardOutline
 #include "viewline/io/rig.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"Rig extrinsics: every camera's pose in one world frame from shared board views."};
+  app.set_version_flag("--version", std::string("viewline ") + viewline::core::kVersion);
   std::string config, output;
   app.add_option("--config", config, "rig calibration config (YAML)")->required();
   app.add_option("--output", output, "rig file to write (with one <camera>.xml per camera next to it)")->required();

@@ -9,12 +9,14 @@
 #include <iostream>
 
 #include "tool_common.h"
+#include "viewline/core/version.h"
 #include "viewline/core/frames.h"
 #include "viewline/io/files.h"
 #include "viewline/io/rig.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"Camera-to-ground rotation (and height) from a board or tag lying on the floor."};
+  app.set_version_flag("--version", std::string("viewline ") + viewline::core::kVersion);
   std::string board_file, intrinsics, camera_name = "camera", projection = "with_distortion", output;
   std::vector<std::string> images;
   int tag_id = -1;

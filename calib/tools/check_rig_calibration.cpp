@@ -10,6 +10,7 @@
 #include <iostream>
 
 #include "tool_common.h"
+#include "viewline/core/version.h"
 #include "viewline/calib/synthetic.h"
 #include "viewline/core/frames.h"
 #include "viewline/io/config.h"
@@ -17,6 +18,7 @@
 
 int main(int argc, char** argv) {
   CLI::App app{"Compares a calibrated rig with the true rig of a truth file."};
+  app.set_version_flag("--version", std::string("viewline ") + viewline::core::kVersion);
   std::string truth_file, rig_file, emc_file;
   double max_ray = -1, max_pos = -1, max_rot_deg = -1;
   app.add_option("--truth", truth_file, "truth file")->required();

@@ -6,11 +6,13 @@
 #include <sstream>
 
 #include "tool_common.h"
+#include "viewline/core/version.h"
 #include "viewline/core/frames.h"
 #include "viewline/io/files.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"Pose of a calibration board (or of each AprilTag) in each image, from calibrated intrinsics."};
+  app.set_version_flag("--version", std::string("viewline ") + viewline::core::kVersion);
   std::string board_file, intrinsics, camera_name = "camera", projection = "with_distortion", output;
   std::vector<std::string> images;
   app.add_option("--board", board_file, "board description (YAML)")->required();

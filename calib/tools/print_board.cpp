@@ -16,6 +16,7 @@
 #include <sstream>
 
 #include "tool_common.h"
+#include "viewline/core/version.h"
 #include "viewline/calib/render.h"
 #include "viewline/io/files.h"
 
@@ -102,6 +103,7 @@ std::string mm(double metres) {
 
 int main(int argc, char** argv) {
   CLI::App app{"Writes a calibration board as a printable PNG (and PDF) at true scale."};
+  app.set_version_flag("--version", std::string("viewline ") + viewline::core::kVersion);
   std::string board_file, output, pdf;
   double dpi = 300.0, margin_mm = 15.0;
   app.add_option("--board", board_file, "board description (calib/boards/*.yaml)")->required();

@@ -28,6 +28,7 @@
 #include <sstream>
 
 #include "tool_common.h"
+#include "viewline/core/version.h"
 #include "viewline/calib/synthetic.h"
 #include "viewline/core/frames.h"
 #include "viewline/io/files.h"
@@ -37,6 +38,7 @@ namespace fs = std::filesystem;
 int main(int argc, char** argv) {
   CLI::App app{"Renders calibration-board images through the true rig of a truth file (simulator renderer,\n"
                "ViSP kud distortion, blur, sensor noise)."};
+  app.set_version_flag("--version", std::string("viewline ") + viewline::core::kVersion);
   std::string truth_file, board_file, mode = "intrinsics", camera, out_dir, intrinsics_dir, reference;
   int views = 15, surveyed = 1;
   std::uint64_t seed = 1;

@@ -79,7 +79,7 @@ TEST(PanTiltScenario, EachShippedPathTracksForAFewSeconds) {
       EXPECT_FALSE(cfg.control.filter.jump_min_samples.has_value());
       EXPECT_NEAR(m.filter_corner_sigma, 0.34 * std::sqrt(0.5 * m.noise_sigma_cm.squaredNorm()) / 100.0, 1e-9);
       EXPECT_GE(m.filter_min_samples, 2);
-      EXPECT_LE(m.filter_min_samples, control::kAutoJumpSamplesMax);
+      EXPECT_LE(m.filter_min_samples, tracking::kAutoJumpSamplesMax);
     } else {
       EXPECT_EQ(m.filter_min_samples, *cfg.control.filter.jump_min_samples) << name;
       EXPECT_EQ(m.filter_corner_sigma, *cfg.control.filter.jump_corner_sigma) << name;
@@ -396,7 +396,7 @@ TEST(PanTiltScenario, TheParticleFilterRunsInTheLoopAndItsReplayReproducesIt) {
   auto cfg = scenarios::loadPanTiltScenarioConfig(io::loadConfigWithValues(
       "config/pan_tilt_random.yaml", {"filter.model=waypoint_particles", "filter.particles=3000",
                                       "filter.particle_speed=[0.15, 0.15]", "filter.particle_min_leg=0.043"}));
-  EXPECT_EQ(cfg.control.filter.model, control::TargetModel::WaypointParticles);
+  EXPECT_EQ(cfg.control.filter.model, tracking::TargetModel::WaypointParticles);
   EXPECT_EQ(cfg.control.filter.particles, 3000u);
   cfg.duration = 6.0;
   cfg.metrics_start = 2.0;

@@ -6,6 +6,7 @@
 #include <iostream>
 #include <string>
 
+#include "viewline/core/version.h"
 #include "viewline/calib/synthetic.h"
 #include "viewline/core/frames.h"
 
@@ -22,6 +23,10 @@ const char* const kUsage =
 int main(int argc, char** argv) {
   if (argc == 2 && (std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h")) {
     std::cout << kUsage;
+    return 0;
+  }
+  if (argc == 2 && std::string(argv[1]) == "--version") {
+    std::cout << "viewline " << viewline::core::kVersion << "\n";
     return 0;
   }
   if ((argc != 2 && argc != 3) || argv[1][0] == '-') {

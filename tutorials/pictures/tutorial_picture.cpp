@@ -11,6 +11,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "viewline/core/version.h"
 #include "viewline/calib/board.h"
 #include "viewline/core/error.h"
 
@@ -45,6 +46,7 @@ cv::Mat picture(const std::string& input, const viewline::calib::BoardSpec* boar
 
 int main(int argc, char** argv) {
   CLI::App app{"Writes a small PNG of images side by side, with the detected board drawn on them."};
+  app.set_version_flag("--version", std::string("viewline ") + viewline::core::kVersion);
   std::vector<std::string> inputs;
   std::string board_file, output;
   int width = 320;

@@ -34,7 +34,7 @@ int runReplay(const CommandOptions& o, const PanTiltScenarioConfig& cfg, std::FI
   log.flush();
   nlohmann::json rj = r.toJson();
   if (!o.sets.empty()) rj["config_set"] = o.sets;
-  if (!o.summary_path.empty()) io::writeJsonFile(o.summary_path, rj);
+  if (!o.summary_path.empty()) io::writeSummaryFile(o.summary_path, rj);
   const auto seed = static_cast<unsigned long long>(o.seed);
   if (o.estimator == PanTiltReplayEstimator::OracleCorners)
     std::fprintf(out, "replay of %s (seed %llu, oracle: constant-speed legs at the %zu true corners): %zu measurements\n",
@@ -44,7 +44,7 @@ int runReplay(const CommandOptions& o, const PanTiltScenarioConfig& cfg, std::FI
                  o.replay.c_str(), seed, o.particles, r.measurements);
   else
     std::fprintf(out, "replay of %s (seed %llu, filter %s): %zu measurements, %zu velocity jumps detected\n",
-                 o.replay.c_str(), seed, control::toString(cfg.control.filter.model), r.measurements, r.jumps);
+                 o.replay.c_str(), seed, tracking::toString(cfg.control.filter.model), r.measurements, r.jumps);
   std::fprintf(out, "  rmse measured (cm)          x %.4f  y %.4f\n", r.rmse_measured_cm.x(), r.rmse_measured_cm.y());
   std::fprintf(out, "  rmse filtered (cm)          x %.4f  y %.4f\n", r.rmse_filtered_cm.x(), r.rmse_filtered_cm.y());
   std::fprintf(out, "  rmse predicted %.4f s ahead (cm)  x %.4f  y %.4f  (%.2f px)\n", r.horizon_s,
@@ -63,7 +63,7 @@ void printSummary(const PanTiltScenarioConfig& cfg, const PanTiltComparison& res
   const auto& o = result.ours;
   std::fprintf(out, "pan-tilt %s, seed %llu, %.0f s at %.0f fps (%ux%u, fx %.0f fy %.0f), filter %s, gain %.2f (ours %.2f)\n",
                result.path.c_str(), static_cast<unsigned long long>(seed), cfg.duration, cfg.fps, cfg.image_width,
-               cfg.image_height, cfg.fx, cfg.fy, control::toString(cfg.control.filter.model), cfg.control.servo.gain,
+               cfg.image_height, cfg.fx, cfg.fy, tracking::toString(cfg.control.filter.model), cfg.control.servo.gain,
                cfg.control.gain > 0.0 ? cfg.control.gain : cfg.control.servo.gain);
   if (o.stopped) std::fprintf(out, "  (ended early by the viewer: the figures cover the frames run)\n");
   if (!cfg.rig_folder.empty())
@@ -136,7 +136,7 @@ int runCommand(const CommandOptions& o, FrameSink* view, std::FILE* out) {
   log.flush();
   nlohmann::json j = result.toJson(cfg);
   if (!o.sets.empty()) j["config_set"] = o.sets;
-  if (!o.summary_path.empty()) io::writeJsonFile(o.summary_path, j);
+  if (!o.summary_path.empty()) io::writeSummaryFile(o.summary_path, j);
   printSummary(cfg, result, o.seed, out);
   return 0;
 }

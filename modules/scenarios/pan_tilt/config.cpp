@@ -163,7 +163,7 @@ PanTiltScenarioConfig loadPanTiltScenarioConfig(const io::ConfigNode& root) {
   }
   {
     const auto f = root.child("filter");
-    c.control.filter.model = control::targetModelFromString(
+    c.control.filter.model = tracking::targetModelFromString(
         f.getChoice("model", {"constant_velocity", "cv", "constant_acceleration", "ca", "singer", "coordinated_turn",
                               "ct", "imm", "waypoint_particles"}));
     c.control.filter.q = f.getOr<double>("q", c.control.filter.q);

@@ -50,7 +50,7 @@ private:
 /// The gate's decision for ours' last observe(), from the controller's own report: a measurement
 /// that (re)initialised a filter without a live track starts one; one that re-initialised it
 /// after rejections in a row restarts it.
-tracking::GateDecision decisionOf(const control::PlanarTargetFilter::Update& u, bool started) {
+tracking::GateDecision decisionOf(const tracking::PlanarTargetFilter::Update& u, bool started) {
   if (started) return tracking::GateDecision::Start;
   if (!u.accepted) return tracking::GateDecision::Reject;
   return u.reinitialized ? tracking::GateDecision::Restart : tracking::GateDecision::Accept;
@@ -100,14 +100,14 @@ PanTiltRunMetrics runPanTilt(const PanTiltScenarioConfig& cfg, std::uint64_t see
     const double tc = p.frame.capture_time;
     const bool had_track = ours != nullptr && ours->filter().initialized();
     const std::size_t reacquisitions = ours != nullptr ? ours->reacquisitions() : 0;
-    std::optional<control::PlanarTargetFilter::Kinematics> prior;  // x(k|k−1), for the innovation record
+    std::optional<tracking::PlanarTargetFilter::Kinematics> prior;  // x(k|k−1), for the innovation record
     if (tel != nullptr && had_track && obs.detected) prior = ours->filter().at(obs.stamp);
     ctrl->observe(obs);
 
     bool used = obs.detected;  // the baseline uses every detection
     Vector2d filt = Vector2d::Constant(std::nan(""));
     if (ours != nullptr && obs.detected) {
-      const control::PlanarTargetFilter::Update& u = ours->lastUpdate();
+      const tracking::PlanarTargetFilter::Update& u = ours->lastUpdate();
       const bool started = !had_track || ours->reacquisitions() != reacquisitions;
       const tracking::GateDecision d = decisionOf(u, started);
       score.decision(d);
@@ -129,7 +129,7 @@ PanTiltRunMetrics runPanTilt(const PanTiltScenarioConfig& cfg, std::uint64_t see
           r.nis = u.nis;
         }
         tel->innovation(r);
-        const control::PlanarTargetFilter::Kinematics k = ours->filter().at(obs.stamp);
+        const tracking::PlanarTargetFilter::Kinematics k = ours->filter().at(obs.stamp);
         Eigen::VectorXd x(4);
         x << k.p, k.v;
         tel->estimate({name, obs.stamp, x, k.P_pos});

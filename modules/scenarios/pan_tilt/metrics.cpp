@@ -75,7 +75,7 @@ nlohmann::json PanTiltComparison::toJson(const PanTiltScenarioConfig& cfg) const
   j["metrics_start_s"] = cfg.metrics_start;
   j["camera"] = {{"width", cfg.image_width}, {"height", cfg.image_height}, {"fx", cfg.fx}, {"fy", cfg.fy}, {"fps", cfg.fps}};
   j["path_speed_m_s"] = cfg.path.speed;
-  j["filter_model"] = control::toString(cfg.control.filter.model);
+  j["filter_model"] = tracking::toString(cfg.control.filter.model);
   j["servo_gain"] = cfg.control.servo.gain;  // the baseline's (and ours unless predictive_gain is set)
   j["predictive_gain"] = cfg.control.gain > 0.0 ? cfg.control.gain : cfg.control.servo.gain;
   j["rig"] = cfg.rig_folder;
@@ -109,8 +109,8 @@ nlohmann::json PanTiltComparison::toJson(const PanTiltScenarioConfig& cfg) const
 
 namespace pan_tilt {
 
-std::pair<int, double> cornerSettings(const control::PlanarTargetFilter& f) {
-  if (f.config().model == control::TargetModel::WaypointParticles || !(f.config().jump_window > 0.0)) return {0, 0.0};
+std::pair<int, double> cornerSettings(const tracking::PlanarTargetFilter& f) {
+  if (f.config().model == tracking::TargetModel::WaypointParticles || !(f.config().jump_window > 0.0)) return {0, 0.0};
   return {f.minSamples(), f.cornerSigma()};
 }
 

@@ -9,7 +9,7 @@
 #include <tuple>
 #include <vector>
 
-#include "viewline/control/waypoint_particle_filter.h"
+#include "viewline/tracking/planar_target/waypoint_particles.h"
 #include "viewline/core/error.h"
 #include "viewline/core/random.h"
 #include "viewline/scenarios/pan_tilt/metrics.h"
@@ -70,7 +70,7 @@ PanTiltReplayMetrics replayPanTiltFilter(const PanTiltScenarioConfig& cfg, std::
   // Oracle (a bound, not a controller): constant-speed legs started at the path's true corner times with
   // the true speed; jump detection off. Only the leg directions, the corners' positions and the speed's
   // leg-to-leg variation (none) remain to be estimated from the measurements.
-  std::optional<control::PlanarTargetFilter> oracle;
+  std::optional<tracking::PlanarTargetFilter> oracle;
   std::vector<double> corners;
   std::size_t next_corner = 0;
   if (oracle_corners) {
@@ -78,8 +78,8 @@ PanTiltReplayMetrics replayPanTiltFilter(const PanTiltScenarioConfig& cfg, std::
     if (pp.corner_radius > 0.0)
       throw core::InvalidInput("--oracle-corners: the path's corners are rounded (path.corner_radius > 0); the oracle's "
                                "legs are straight");
-    control::TargetFilterConfig fc;
-    fc.model = control::TargetModel::ConstantVelocity;
+    tracking::TargetFilterConfig fc;
+    fc.model = tracking::TargetModel::ConstantVelocity;
     fc.q = 1e-5;  // the first leg (before the first corner), a plain CV filter
     fc.init_velocity_sigma = cfg.control.filter.init_velocity_sigma;
     fc.gate_probability = cfg.control.filter.gate_probability;
@@ -97,7 +97,7 @@ PanTiltReplayMetrics replayPanTiltFilter(const PanTiltScenarioConfig& cfg, std::
   }
   // Reference (not a controller): the waypoint particle filter, the posterior mean under the random
   // path's generator. It knows the generator's box (filter.region) and minimum leg, not the path.
-  std::optional<control::WaypointParticleFilter> pf;
+  std::optional<tracking::WaypointParticleFilter> pf;
   if (estimator == PanTiltReplayEstimator::WaypointParticles) {
     if (pp.shape != sim::PathShape::Random || pp.corner_radius > 0.0)
       throw core::InvalidInput("--particles: the model is the random path's (sharp corners, "
@@ -105,7 +105,7 @@ PanTiltReplayMetrics replayPanTiltFilter(const PanTiltScenarioConfig& cfg, std::
     const auto& fcfg = cfg.control.filter;
     if (!(fcfg.region_size.x() > 0.0 && fcfg.region_size.y() > 0.0))
       throw core::InvalidInput("--particles: needs the waypoint region (filter.region: {center, size})");
-    control::WaypointParticleConfig wc;
+    tracking::WaypointParticleConfig wc;
     wc.particles = particles;
     wc.region_center = fcfg.region_center;
     wc.region_size = fcfg.region_size;
@@ -137,7 +137,20 @@ PanTiltReplayMetrics replayPanTiltFilter(const PanTiltScenarioConfig& cfg, std::
     std::vector<double> v;
     std::stringstream ss(line);
     std::string f;
-    while (std::getline(ss, f, ',')) v.push_back(f.empty() || f == "nan" ? std::nan("") : std::strtod(f.c_str(), nullptr));
+    while (std::getline(ss, f, ',')) {
+      if (f.empty() || f == "nan") {
+        v.push_back(std::nan(""));
+        continue;
+      }
+      // A field that is not a whole number is refused with its row and column (strtod alone would
+      // read "abc" as 0 and replay a different run without a word).
+      char* end = nullptr;
+      const double x = std::strtod(f.c_str(), &end);
+      if (end == f.c_str() || *end != '\0')
+        throw core::InvalidInput(frames_csv + ":" + std::to_string(row) + ": column " + std::to_string(v.size() + 1) +
+                                 " is '" + f + "' (expected a number or nan)");
+      v.push_back(x);
+    }
     if (v.size() != header.size()) throw core::InvalidInput(frames_csv + ":" + std::to_string(row) + ": wrong number of columns");
     const double t = v[ct];
     if (t >= cfg.duration) break;

@@ -8,7 +8,7 @@
 // estimate after the update; the truth and the image error of every frame. NIS samples once a track
 // has `burn_in` accepted measurements; NEES (2 dof, screen position) against the truth, one sample
 // every `nees_spacing_s` seconds (spaced so that they are nearly independent). Replays with other
-// noise parameters (auto-tuning) re-run the same filter (control::PlanarTargetFilter, same
+// noise parameters (auto-tuning) re-run the same filter (tracking::PlanarTargetFilter, same
 // measurements, time stamps and R, the controller's reacquisition rule: re-initialise after
 // control.coast_time without an accepted measurement) on the recorded frames.
 //
@@ -199,16 +199,16 @@ public:
     // The IMM / CT filters have several process-noise densities (per mode); filter.q alone barely
     // changes their likelihood (measured: the search drifts to q -> 0), so they are not auto-tuned.
     // The waypoint particle filter has no process noise at all (its model is the path's generator).
-    if (cfg_.control.filter.model == control::TargetModel::WaypointParticles)
+    if (cfg_.control.filter.model == tracking::TargetModel::WaypointParticles)
       throw core::InvalidInput("pan-tilt auto-tuning: filter.model waypoint_particles has no process noise to tune (its "
                                "model is the random path's generator); sweeps work with every model");
-    if (cfg_.control.filter.model == control::TargetModel::Imm ||
-        cfg_.control.filter.model == control::TargetModel::CoordinatedTurn)
-      throw core::InvalidInput(std::string("pan-tilt auto-tuning: filter.model ") + control::toString(cfg_.control.filter.model) +
+    if (cfg_.control.filter.model == tracking::TargetModel::Imm ||
+        cfg_.control.filter.model == tracking::TargetModel::CoordinatedTurn)
+      throw core::InvalidInput(std::string("pan-tilt auto-tuning: filter.model ") + tracking::toString(cfg_.control.filter.model) +
                                " has one process noise per mode; auto-tuning supports constant_velocity, "
                                "constant_acceleration and singer (e.g. config/sweeps/scenarios/pan_tilt_circle_ca.yaml); "
                                "sweeps work with every model");
-    return {{"process", "q", cfg_.control.filter.model == control::TargetModel::ConstantVelocity ? "m^2/s^3" : "m^2/s^5",
+    return {{"process", "q", cfg_.control.filter.model == tracking::TargetModel::ConstantVelocity ? "m^2/s^3" : "m^2/s^5",
              "filter.q", "process noise density of the target filter", cfg_.control.filter.q},
             {"measurement", "R_scale", "x", "",
              "filter R = R_scale^2 x the scenario's R (estimated; no config key: see the adapter's note)", r_scale_}};
@@ -345,9 +345,9 @@ private:
 
   void replayRun(const Recorded& rec, double q, double r_scale, double eps, Accum& a, RunSeries* series,
                  io::CsvWriter* inn, const RunOptions& ro) const {
-    control::TargetFilterConfig fc = cfg_.control.filter;
+    tracking::TargetFilterConfig fc = cfg_.control.filter;
     fc.q = q;
-    control::PlanarTargetFilter filter(fc);
+    tracking::PlanarTargetFilter filter(fc);
     const Eigen::Matrix2d R = r_scale * r_scale * rec.R;
     const double u = 1.0 / (cfg_.screen_width * cfg_.screen_height);
     const double horizon = 0.2;  // s, the prediction drawn in the trajectory plot
@@ -376,7 +376,7 @@ private:
       Eigen::Vector2d d = Eigen::Vector2d::Zero();
       Eigen::Matrix2d S = Eigen::Matrix2d::Identity();
       if (filter.initialized() && accepted_in_track >= opt_.burn_in) {
-        const control::PlanarTargetFilter::Kinematics k = filter.at(f.t);
+        const tracking::PlanarTargetFilter::Kinematics k = filter.at(f.t);
         d = f.z - k.p;
         S = k.P_pos + R;
         const Eigen::LLT<Eigen::Matrix2d> llt(S);
@@ -385,7 +385,7 @@ private:
           have = std::isfinite(nis);
         }
       }
-      const control::PlanarTargetFilter::Update up = filter.update(f.t, f.z, R);
+      const tracking::PlanarTargetFilter::Update up = filter.update(f.t, f.z, R);
       if (up.reinitialized) accepted_in_track = 0;
       if (up.accepted) {
         ++accepted_in_track;
@@ -408,7 +408,7 @@ private:
                   up.accepted ? 1.0 : 0.0, have && up.accepted ? 1.0 : 0.0});
       if (ro.live) ro.live({f.t, f.error_px, have && up.accepted ? nis : -1.0});
       if (filter.initialized() && rec.has_truth && up.accepted && f.t >= next_nees && accepted_in_track >= opt_.burn_in) {
-        const control::PlanarTargetFilter::Kinematics k = filter.at(f.t);
+        const tracking::PlanarTargetFilter::Kinematics k = filter.at(f.t);
         const Eigen::Vector2d e = k.p - f.truth;
         a.nees.add(e.dot(k.P_pos.ldlt().solve(e)), 2.0);
         next_nees = f.t + opt_.nees_spacing;

@@ -568,7 +568,7 @@ nlohmann::json runSweepSession(const AdapterRegistry& registry, const std::strin
   for (const auto& r : out.settings) all.push_back(r.toJson(spec));
   j["all_settings"] = all;
   rep.write(report_path);
-  io::writeJsonFile((fs::path(opt.out_dir) / "summary.json").string(), j);
+  io::writeSummaryFile((fs::path(opt.out_dir) / "summary.json").string(), j);
   return j;
 }
 
@@ -617,7 +617,7 @@ nlohmann::json runSingleSession(const AdapterRegistry& registry, const SingleRun
   j["report"] = report_path;
   j["report_plots"] = rep.plotCount();
   rep.write(report_path);
-  io::writeJsonFile((fs::path(o.out_dir) / "summary.json").string(), j);
+  io::writeSummaryFile((fs::path(o.out_dir) / "summary.json").string(), j);
   return j;
 }
 
@@ -661,7 +661,7 @@ nlohmann::json runAutotuneSession(const AdapterRegistry& registry, const Autotun
   j["report"] = report_path;
   j["report_plots"] = rep.plotCount();
   rep.write(report_path);
-  io::writeJsonFile((fs::path(o.out_dir) / "summary.json").string(), j);
+  io::writeSummaryFile((fs::path(o.out_dir) / "summary.json").string(), j);
   return j;
 }
 

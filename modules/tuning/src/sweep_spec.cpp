@@ -12,6 +12,12 @@
 namespace viewline::tuning {
 
 namespace {
+// Bounds that keep a sweep file from asking for unbounded memory or time (each setting is a run).
+constexpr int kMaxGridPoints = 10000;
+constexpr int kMaxSettings = 1000000;
+}  // namespace
+
+namespace {
 
 std::string numberText(double v, bool integer) {
   if (integer) return std::to_string(static_cast<long long>(std::llround(v)));
@@ -67,7 +73,8 @@ SweepParameter readParameter(const io::ConfigNode& p, SweepMode mode) {
     if (sp.log_scale && !(sp.lo > 0.0)) p.fail("range", "lo > 0 with scale: log");
     if (mode == SweepMode::Grid) {
       sp.count = p.get<int>("count");
-      if (sp.count < 1) p.fail("count", "at least 1 grid point");
+      if (sp.count < 1 || sp.count > kMaxGridPoints)
+        p.fail("count", "from 1 to " + std::to_string(kMaxGridPoints) + " grid points");
       if (sp.count > 1 && sp.hi == sp.lo) p.fail("range", "lo < hi for more than one grid point (empty range)");
       for (int i = 0; i < sp.count; ++i) {
         const double f = sp.count == 1 ? 0.0 : static_cast<double>(i) / (sp.count - 1);
@@ -116,7 +123,7 @@ SweepSpec fromNode(const io::ConfigNode& root, const AdapterRegistry& registry, 
   s.mode = root.getChoiceOr("mode", {"grid", "random"}, "grid") == "grid" ? SweepMode::Grid : SweepMode::Random;
   if (s.mode == SweepMode::Random) {
     s.samples = root.get<int>("samples");
-    if (s.samples < 1) root.fail("samples", "at least 1");
+    if (s.samples < 1 || s.samples > kMaxSettings) root.fail("samples", "from 1 to " + std::to_string(kMaxSettings));
     s.sample_seed = root.getOr<std::uint64_t>("sample_seed", s.sample_seed);
   } else if (root.has("samples")) {
     root.fail("samples", "no 'samples' in grid mode");
@@ -130,6 +137,14 @@ SweepSpec fromNode(const io::ConfigNode& root, const AdapterRegistry& registry, 
     SweepParameter sp = readParameter(p, s.mode);
     if (!keys.insert(sp.key).second) p.fail("key", "a key not already swept ('" + sp.key + "' is listed twice)");
     s.parameters.push_back(std::move(sp));
+  }
+  if (s.mode == SweepMode::Grid) {
+    // Every setting of a grid is run: refuse a product no session could finish before generating it.
+    double settings = 1.0;
+    for (const SweepParameter& sp : s.parameters) settings *= static_cast<double>(sp.values.size());
+    if (settings > kMaxSettings)
+      root.fail("parameters", "a grid of at most " + std::to_string(kMaxSettings) + " settings (this one has " +
+                                  std::to_string(settings) + ")");
   }
   if (root.has("adapter")) {
     const io::ConfigNode a = root.child("adapter");

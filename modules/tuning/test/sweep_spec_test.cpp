@@ -85,6 +85,20 @@ TEST(SweepSpec, ErrorsNameLineAndKey) {
             std::string::npos);
 }
 
+TEST(SweepSpec, SizesNoSessionCouldRunAreRefusedBeforeAnythingIsGenerated) {
+  // A huge count or sample number used to be generated in full (memory and time without bound).
+  const std::string count = errorOf("scenario: toy\nparameters:\n  - key: filter.q\n    range: [1, 2]\n    count: 1000000000\n");
+  EXPECT_NE(count.find("parameters[0].count"), std::string::npos) << count;
+  const std::string samples =
+      errorOf("scenario: toy\nmode: random\nsamples: 2000000000\nparameters:\n  - key: filter.q\n    range: [1, 2]\n");
+  EXPECT_NE(samples.find("s.yaml:3:"), std::string::npos) << samples;
+  // Two parameters of 1001 and 1000 points: just over 10^6 settings.
+  const std::string product = errorOf(
+      "scenario: toy\nparameters:\n  - key: filter.q\n    range: [1, 2]\n    count: 1001\n"
+      "  - key: filter.r\n    range: [1, 2]\n    count: 1000\n");
+  EXPECT_NE(product.find("at most 1000000 settings"), std::string::npos) << product;
+}
+
 TEST(YamlEdit, RelativePathsAreRelocatedForACopyWrittenElsewhere) {
   namespace fs = std::filesystem;
   const fs::path root = fs::temp_directory_path() / "viewline_relocated_paths_test";

@@ -92,18 +92,6 @@ private:
 
 // ---------------------------------------------------------------------------------------------
 // The target filter is tracking::PlanarTargetFilter (viewline/tracking/planar_target/filter.h).
-// transitional: remove once scenarios use tracking::
-using tracking::kAutoCornerSigmaPerNoise;
-using tracking::kAutoJumpSamplesMax;
-using tracking::kAutoJumpSamplesScale;
-using tracking::PlanarTargetFilter;
-using tracking::TargetFilterConfig;
-using tracking::TargetModel;
-using tracking::targetModelFromString;
-using tracking::toString;
-using tracking::waypointDirectionDensity;
-using tracking::WaypointParticleConfig;
-using tracking::WaypointParticleFilter;
 
 // ---------------------------------------------------------------------------------------------
 // Controllers (one interface for the scenario loop).

@@ -78,7 +78,7 @@ namespace pan_tilt {
 
 /// The filter's corner settings in force (its configured values or what "auto" made of them);
 /// (0, 0) for the particle filter and without jump detection, where they do not apply.
-std::pair<int, double> cornerSettings(const control::PlanarTargetFilter& filter);
+std::pair<int, double> cornerSettings(const tracking::PlanarTargetFilter& filter);
 
 /// A sum of squares and its count: the RMS of a metric accumulated frame by frame.
 struct SquareSum {

@@ -38,10 +38,10 @@ enum class PanTiltReplayEstimator {
   /// The config's filter (the predictive controller's, same reacquisition rule).
   Filter,
   /// Rectangle and random paths: a bound, a constant-speed leg filter told the path's true corner times
-  /// and speed (control::PlanarTargetFilter::startLeg); `jumps` is then the number of corners. No causal
+  /// and speed (tracking::PlanarTargetFilter::startLeg); `jumps` is then the number of corners. No causal
   /// filter that must detect the corners can expect to beat it.
   OracleCorners,
-  /// Random path: control::WaypointParticleFilter, the posterior mean under the path's generator
+  /// Random path: tracking::WaypointParticleFilter, the posterior mean under the path's generator
   /// (waypoints uniform in filter.region, one constant speed), the causal reference; `jumps` is 0.
   WaypointParticles,
 };
