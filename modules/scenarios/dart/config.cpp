@@ -2,6 +2,7 @@
 
 #include "viewline/core/checks.h"
 #include "viewline/core/frames.h"
+#include "viewline/io/config_check.h"
 #include "viewline/io/config_edit.h"
 
 namespace viewline::scenarios {
@@ -151,12 +152,7 @@ DartScenarioConfig dartScenarioFromNode(const io::ConfigNode& root) {
   cfg.outlier_rate = root.getOr<double>("outlier_rate", cfg.outlier_rate);
   if (root.has("tracker")) readTracker(root.child("tracker"), cfg);
   if (root.has("experiments")) readExperiments(root.child("experiments"), cfg);
-  root.finish();
-  try {
-    cfg.validate();
-  } catch (const core::InvalidInput& ex) {
-    throw core::InvalidInput(root.fileName() + ": " + ex.what());
-  }
+  io::finishAndValidate(root, cfg);
   return cfg;
 }
 

@@ -8,6 +8,7 @@
 #include "viewline/core/checks.h"
 #include "viewline/core/error.h"
 #include "viewline/core/frames.h"
+#include "viewline/io/config_check.h"
 #include "viewline/io/camera_fields.h"
 #include "viewline/scenarios/simulated_rig.h"
 
@@ -258,12 +259,7 @@ MobileCaptureConfig loadMobileCaptureConfig(const io::ConfigNode& root) {
     c.hfov = 2.0 * std::atan(0.5 * c.width / c.rig->calibrated.intrinsics.get_px());
     c.vfov = 2.0 * std::atan(0.5 * c.height / c.rig->calibrated.intrinsics.get_py());
   }
-  root.finish();
-  try {
-    c.validate();
-  } catch (const core::InvalidInput& e) {
-    throw core::InvalidInput(root.fileName() + ": " + e.what());
-  }
+  io::finishAndValidate(root, c);
   return c;
 }
 

@@ -6,6 +6,7 @@
 #include "viewline/core/checks.h"
 #include "viewline/core/error.h"
 #include "viewline/core/frames.h"
+#include "viewline/io/config_check.h"
 #include "viewline/io/camera_fields.h"
 #include "viewline/io/rig.h"
 #include "viewline/scenarios/simulated_rig.h"
@@ -215,12 +216,7 @@ PanTiltScenarioConfig loadPanTiltScenarioConfig(const io::ConfigNode& root) {
     c.occlusion_duration = r.getOr<double>("occlusion_duration", 1.0);
     c.run_baseline = r.getOr<bool>("baseline", true);
   }
-  root.finish();
-  try {
-    c.validate();
-  } catch (const core::InvalidInput& e) {
-    throw core::InvalidInput(root.fileName() + ": " + e.what());
-  }
+  io::finishAndValidate(root, c);
   return c;
 }
 

@@ -5,6 +5,7 @@
 #include "viewline/core/checks.h"
 #include "viewline/core/error.h"
 #include "viewline/core/frames.h"
+#include "viewline/io/config_check.h"
 #include "viewline/io/camera_fields.h"
 #include "viewline/scenarios/simulated_rig.h"
 
@@ -216,12 +217,7 @@ TableBallConfig tableBallConfigFromYaml(const io::ConfigNode& root) {
     c.compare_tunings = n.getOr<bool>("compare_tunings", c.compare_tunings);
     c.time_reference = n.getOr<bool>("time_reference", c.time_reference);
   }
-  root.finish();
-  try {
-    c.validate();
-  } catch (const core::InvalidInput& e) {
-    throw core::InvalidInput(root.fileName() + ": " + e.what());
-  }
+  io::finishAndValidate(root, c);
   return c;
 }
 
