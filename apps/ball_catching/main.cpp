@@ -48,18 +48,7 @@ int main(int argc, char** argv) {
     nlohmann::json j = scenarios::summaryJson(s, cfg);
     if (!opt.sets.empty()) j["config_set"] = opt.sets;
     if (!opt.summary_path.empty()) io::writeSummaryFile(opt.summary_path, j);
-    std::printf("ball_catching: %d throws, seed %llu, %zu cameras, %s robot (%.2f m/s, %.1f m/s²), planner %s, %.1f s wall\n",
-                s.throws, static_cast<unsigned long long>(opt.seed), cfg.activeCameras(), robots::toString(cfg.robot.kind),
-                cfg.robot.limits.v_max.x(), cfg.robot.limits.a_max.x(), planning::toString(cfg.planner.model.kind), s.wall_s);
-    std::printf("  caught %d: catch rate %.3f of all, %.3f of the %d reachable throws\n", s.caught, s.catch_rate_all,
-                s.catch_rate_reachable, s.reachable_throws);
-    std::printf("  misses: late %d, off target %d, lost track %d, not reachable %d\n", s.miss_reasons.at("late"),
-                s.miss_reasons.at("off_target"), s.miss_reasons.at("lost_track"), s.miss_reasons.at("not_reachable"));
-    std::printf("  prediction error at the crossing: median %.1f mm, p95 %.1f mm; decision time median %.3f s, p95 %.3f s\n",
-                s.prediction_error_mm_median, s.prediction_error_mm_p95, s.decision_time_s_median, s.decision_time_s_p95);
-    std::printf("  %d frames, detection rate %.3f, %.2f ms per frame (render + detect + track + plan); "
-                "robot limit violations %zu\n",
-                s.frames, s.detection_rate, s.ms_per_frame, s.limit_violations);
+    std::fputs(scenarios::summaryText(s, cfg).c_str(), stdout);
     if (view) view->waitForClose();
     return 0;
   });

@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <limits>
+#include <string>
 
 #include "viewline/core/error.h"
 #include "viewline/core/statistics.h"
@@ -90,7 +93,9 @@ CatchSummary summarise(std::vector<ThrowResult> results, std::uint64_t seed,
   }
   using core::percentile;
   s.catch_rate_all = static_cast<double>(s.caught) / s.throws;
-  s.catch_rate_reachable = s.reachable_throws > 0 ? static_cast<double>(s.caught_reachable) / s.reachable_throws : 0.0;
+  // Over no reachable throw the rate is not scored (NaN: null in the summary, "not scored" in the text).
+  s.catch_rate_reachable = s.reachable_throws > 0 ? static_cast<double>(s.caught_reachable) / s.reachable_throws
+                                                  : std::numeric_limits<double>::quiet_NaN();
   s.prediction_error_mm_median = percentile(pred_err, 0.5);
   s.prediction_error_mm_p95 = percentile(pred_err, 0.95);
   s.prediction_error_lead_mm_median = percentile(pred_lead, 0.5);
@@ -124,7 +129,7 @@ nlohmann::json summaryJson(const CatchSummary& s, const BallCatchingConfig& cfg)
   j["reachable_throws"] = s.reachable_throws;
   j["caught"] = s.caught;
   j["catch_rate_all"] = s.catch_rate_all;
-  j["catch_rate_reachable"] = s.catch_rate_reachable;
+  j["catch_rate_reachable"] = num(s.catch_rate_reachable);
   j["miss_reasons"] = s.miss_reasons;
   j["prediction_error_mm_at_catch"] = {{"median", num(s.prediction_error_mm_median)},
                                        {"p95", num(s.prediction_error_mm_p95)}};
@@ -192,6 +197,45 @@ void writeThrowsCsv(io::LogDirectory& log, const std::vector<ThrowResult>& resul
                r.caught ? "1" : "0", r.reachable ? "1" : "0", std::to_string(r.decision_time),
                std::to_string(r.t_first_visible), std::to_string(r.t_first_detection), std::to_string(r.t_first_move),
                std::to_string(r.oracle_time), r.gave_up ? "1" : "0", r.miss_reason});
+}
+
+std::string summaryText(const CatchSummary& s, const BallCatchingConfig& cfg) {
+  std::string out;
+  char line[512];
+  std::snprintf(line, sizeof line, "ball_catching: %d throws, seed %llu, %zu cameras, %s robot (%.2f m/s, %.1f m/s²), planner %s, %.1f s wall\n",
+                s.throws, static_cast<unsigned long long>(s.seed), cfg.activeCameras(), robots::toString(cfg.robot.kind),
+                cfg.robot.limits.v_max.x(), cfg.robot.limits.a_max.x(), planning::toString(cfg.planner.model.kind), s.wall_s);
+  out += line;
+  if (s.reachable_throws > 0) {
+    std::snprintf(line, sizeof line, "  caught %d: catch rate %.3f of all, %.3f of the %d reachable throws\n", s.caught,
+                  s.catch_rate_all, s.catch_rate_reachable, s.reachable_throws);
+  } else {
+    std::snprintf(line, sizeof line, "  caught %d: catch rate %.3f of all; of the reachable throws not scored (none was reachable)\n",
+                  s.caught, s.catch_rate_all);
+  }
+  out += line;
+  std::snprintf(line, sizeof line, "  misses: late %d, off target %d, lost track %d, not reachable %d\n", s.miss_reasons.at("late"),
+                s.miss_reasons.at("off_target"), s.miss_reasons.at("lost_track"), s.miss_reasons.at("not_reachable"));
+  out += line;
+  if (std::isfinite(s.prediction_error_mm_median)) {
+    std::snprintf(line, sizeof line, "  prediction error at the crossing: median %.1f mm, p95 %.1f mm; ", s.prediction_error_mm_median,
+                  s.prediction_error_mm_p95);
+  } else {
+    std::snprintf(line, sizeof line, "  prediction error at the crossing: not scored (no throw was predicted); ");
+  }
+  out += line;
+  if (s.decisions > 0) {
+    std::snprintf(line, sizeof line, "decision time median %.3f s, p95 %.3f s\n", s.decision_time_s_median, s.decision_time_s_p95);
+  } else {
+    std::snprintf(line, sizeof line, "decision time not scored (no decision)\n");
+  }
+  out += line;
+  std::snprintf(line, sizeof line,
+                "  %d frames, detection rate %.3f, %.2f ms per frame (render + detect + track + plan); "
+                "robot limit violations %zu\n",
+                s.frames, s.detection_rate, s.ms_per_frame, s.limit_violations);
+  out += line;
+  return out;
 }
 
 }  // namespace viewline::scenarios

@@ -219,9 +219,16 @@ std::string summaryJson(const MobileCaptureSummary& s, const MobileCaptureConfig
   nlohmann::json j;
   j["runs"] = s.runs.size();
   j["capture_success_rate"] = s.success_rate;
-  j["capture_time_ratio_to_oracle"] = {{"median", s.ratio_median}, {"p95", s.ratio_p95}, {"runs", s.ratio_runs}};
-  j["capture_time_s"] = {{"median", s.time_median}, {"p95", s.time_p95}};
-  j["oracle_capture_time_s"] = {{"median", s.oracle_time_median}};
+  // A figure over no run is not scored: null, not 0.
+  const bool any_capture = std::any_of(s.runs.begin(), s.runs.end(), [](const MobileCaptureRun& r) { return r.captured; });
+  const bool any_oracle =
+      std::any_of(s.runs.begin(), s.runs.end(), [](const MobileCaptureRun& r) { return r.oracle_captured; });
+  auto scored = [](bool ok, double v) { return ok ? nlohmann::json(v) : nlohmann::json(nullptr); };
+  j["capture_time_ratio_to_oracle"] = {{"median", scored(s.ratio_runs > 0, s.ratio_median)},
+                                       {"p95", scored(s.ratio_runs > 0, s.ratio_p95)},
+                                       {"runs", s.ratio_runs}};
+  j["capture_time_s"] = {{"median", scored(any_capture, s.time_median)}, {"p95", scored(any_capture, s.time_p95)}};
+  j["oracle_capture_time_s"] = {{"median", scored(any_oracle, s.oracle_time_median)}};
   j["oracle_success_rate"] = s.oracle_success_rate;
   int attempts = 0, frames = 0, detections = 0;
   double longest = 0.0;
@@ -265,12 +272,29 @@ std::string summaryText(const MobileCaptureSummary& s, const MobileCaptureConfig
   } else {
     out += "  camera: inline config keys (one perfect camera)\n";
   }
-  std::snprintf(line, sizeof line,
-                "  capture success %.3f (oracle %.3f); time median %.1f s, p95 %.1f s; oracle median %.1f s\n",
-                s.success_rate, s.oracle_success_rate, s.time_median, s.time_p95, s.oracle_time_median);
+  const bool any_capture = std::any_of(s.runs.begin(), s.runs.end(), [](const MobileCaptureRun& r) { return r.captured; });
+  const bool any_oracle =
+      std::any_of(s.runs.begin(), s.runs.end(), [](const MobileCaptureRun& r) { return r.oracle_captured; });
+  std::snprintf(line, sizeof line, "  capture success %.3f (oracle %.3f); ", s.success_rate, s.oracle_success_rate);
   out += line;
-  std::snprintf(line, sizeof line, "  capture time / oracle: median %.3f, p95 %.3f (%d runs)\n", s.ratio_median,
-                s.ratio_p95, s.ratio_runs);
+  if (any_capture) {
+    std::snprintf(line, sizeof line, "time median %.1f s, p95 %.1f s; ", s.time_median, s.time_p95);
+    out += line;
+  } else {
+    out += "time not scored (no capture); ";
+  }
+  if (any_oracle) {
+    std::snprintf(line, sizeof line, "oracle median %.1f s\n", s.oracle_time_median);
+    out += line;
+  } else {
+    out += "oracle time not scored (the oracle captured in no run)\n";
+  }
+  if (s.ratio_runs > 0) {
+    std::snprintf(line, sizeof line, "  capture time / oracle: median %.3f, p95 %.3f (%d runs)\n", s.ratio_median,
+                  s.ratio_p95, s.ratio_runs);
+  } else {
+    std::snprintf(line, sizeof line, "  capture time / oracle: not scored (no run where both captured)\n");
+  }
   out += line;
   const LocalizationErrors& l = s.localization;
   std::snprintf(line, sizeof line,

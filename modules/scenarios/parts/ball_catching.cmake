@@ -7,3 +7,4 @@ list(APPEND scenarios_sources
   ball_catching/metrics.cpp
   ball_catching/registration.cpp
   ball_catching/world.cpp)
+list(APPEND scenarios_tests test/summary_text_test.cpp)

@@ -60,47 +60,44 @@ void RollingBallTracker::step(double t, const Eigen::Vector2d& a_xy, const std::
   if (!(t > t_)) throw core::InvalidInput("RollingBallTracker::step: time must increase");
   const double dt = t - t_;
   const estimation::LinearTransition tr = model.transition(dt, a_xy);  // rediscretised every frame
-  bool fused = false;
-  if (stationary_) {
-    if (y) {
-      const estimation::UpdateReport rep = stationaryInnovation(tr, *y);
-      const GateDecision d = gate_.decide(t, rep.nis);
-      if (d == GateDecision::Restart) {
-        start(t, a_xy, *y, d);
-        return;
-      }
-      last_update_ = BallUpdate{d, rep};
-      if (d == GateDecision::Accept) {
-        nis_ = rep.nis;
-        x_ = model.stationaryStep(*stationary_, tr, x_, *y);
-        fused = true;
-      }
-    }
-    if (!fused) {
-      x_ = tr.Phi * x_ + tr.Gamma * tr.u;
-      model.clamp(x_);
-    }
-  } else {
+  if (!stationary_) {
     estimation::predict(state_, tr);
     model.clampEstimate(state_);
-    if (y) {
-      // The update is tried on a copy: the gate decides on its own NIS before it is kept.
-      estimation::StateEstimate trial = state_;
-      const estimation::UpdateReport rep = estimation::update(trial, model.measurement(*y));
-      const GateDecision d = gate_.decide(t, rep.nis);
-      if (d == GateDecision::Restart) {
-        start(t, a_xy, *y, d);
-        return;
-      }
-      last_update_ = BallUpdate{d, rep};
-      if (d == GateDecision::Accept) {
+  }
+  bool fused = false;
+  if (y) {
+    // The gate decides on the update's own NIS before the update is kept: the time-varying
+    // filter tries it on a copy; the stationary one reads its innovation.
+    estimation::StateEstimate trial;
+    estimation::UpdateReport rep;
+    if (stationary_) {
+      rep = stationaryInnovation(tr, *y);
+    } else {
+      trial = state_;
+      rep = estimation::update(trial, model.measurement(*y));
+    }
+    const GateDecision d = gate_.decide(t, rep.nis);
+    if (d == GateDecision::Restart) {
+      start(t, a_xy, *y, d);
+      return;
+    }
+    last_update_ = BallUpdate{d, rep};
+    if (d == GateDecision::Accept) {
+      nis_ = rep.nis;
+      fused = true;
+      if (stationary_) {
+        x_ = model.stationaryStep(*stationary_, tr, x_, *y);
+      } else {
         state_ = std::move(trial);
-        nis_ = rep.nis;
         model.clampEstimate(state_);
-        fused = true;
       }
     }
+  }
+  if (!stationary_) {
     x_ = state_.x();
+  } else if (!fused) {
+    x_ = tr.Phi * x_ + tr.Gamma * tr.u;
+    model.clamp(x_);
   }
   missed_ = fused ? 0 : missed_ + 1;
   t_ = t;

@@ -103,6 +103,9 @@ CatchSummary summarise(std::vector<ThrowResult> results, std::uint64_t seed,
 
 nlohmann::json summaryJson(const CatchSummary& s, const BallCatchingConfig& cfg);
 
+/// The console summary: a figure over no throw says "not scored" instead of printing nan.
+std::string summaryText(const CatchSummary& s, const BallCatchingConfig& cfg);
+
 /// One row per throw (throws.csv in a --log folder).
 void writeThrowsCsv(io::LogDirectory& log, const std::vector<ThrowResult>& results);
 
