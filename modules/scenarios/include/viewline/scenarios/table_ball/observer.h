@@ -52,45 +52,59 @@ Eigen::Isometry3d borderAwareTablePose(const core::Camera& camera, const std::ar
 /// (robots::TableTilt convention): θx = atan2(R21, R11), θy = atan2(R02, R00).
 Eigen::Vector2d tiltFromTableRotation(const Eigen::Matrix3d& w_R_t);
 
-enum class TablePoseSource { Corners, AprilTag };
-enum class BallGeometry { KnownRadius, UnknownRadius };
+/// Where the table pose comes from.
+enum class TablePoseSource {
+  Corners,   ///< [M]'s red-surface corners + solvePnP (vision::TableDetector)
+  AprilTag,  ///< AprilTags fixed around the borders (vision::AprilTagTableDetector)
+};
+/// How the ball's position on the table is found from its image circle.
+enum class BallGeometry {
+  KnownRadius,    ///< d = r / sin α with the configured radius ([M] eq 4.12, corrected)
+  UnknownRadius,  ///< r solved from the contact condition z = r first
+};
 
+/// Settings of TableBallObserver.
 struct TableBallObserverConfig {
-  TablePoseSource table_pose = TablePoseSource::Corners;
-  BallGeometry ball_geometry = BallGeometry::KnownRadius;
+  TablePoseSource table_pose = TablePoseSource::Corners;  ///< corners ([M]) or AprilTags
+  BallGeometry ball_geometry = BallGeometry::KnownRadius;  ///< known or unknown ball radius
   vision::TableDetectorConfig detector;               ///< colours, kernels, refine, L, r
   double border_height = 0.02;                        ///< m, raised border above the surface (0: plain [M] PnP)
   std::vector<vision::TagOnTable> tag_layout;         ///< AprilTag alternative: tags in the table frame
-  vision::AprilTagDetectorConfig tag_detector;
+  vision::AprilTagDetectorConfig tag_detector;        ///< AprilTag alternative: detector settings
   tracking::RollingBallTrackerConfig tracker;  ///< the rolling-ball filter (steps 4-5)
   bool edge_tracking = true;                          ///< fast path between full detections (corners mode)
   vision::TableEdgeTrackerConfig edge_tracker;  ///< the fast path's settings
-  Eigen::Vector3d gravity_w = Eigen::Vector3d(0.0, 0.0, -9.81);
+  Eigen::Vector3d gravity_w = Eigen::Vector3d(0.0, 0.0, -9.81);  ///< gravity in the world frame, m/s²
 };
 
 /// What the observer made of one frame.
 struct ObserverFrame {
-  double t = 0.0;
+  double t = 0.0;                        ///< capture time stamp, s
   bool image = false;                    ///< false: no image this step (dropped frame)
-  bool table_found = false;
+  bool table_found = false;              ///< a table pose was measured in this frame
   bool tracked = false;                  ///< table and ball came from the fast path
-  bool ball_found = false;
+  bool ball_found = false;               ///< a ball position on the table was measured
   std::string failure;                   ///< why the table or the ball was not measured
   Eigen::Isometry3d c_M_t = Eigen::Isometry3d::Identity();  ///< last valid table pose
   std::array<Eigen::Vector2d, 4> corners{};  ///< detected corners (corner pipeline)
-  std::optional<vision::Circle> ball_circle;
+  std::optional<vision::Circle> ball_circle;        ///< the ball's image circle (pixels), when detected
   std::optional<vision::Circle> ball_circle_prev;  ///< circle of a found ball (seeds the fast path)
+  /// Measured ball position on the table (m, table frame); NaN when not measured.
   Eigen::Vector2d measured = Eigen::Vector2d::Constant(std::numeric_limits<double>::quiet_NaN());
   Eigen::Vector2d measured_tilt = Eigen::Vector2d::Zero();  ///< (θx, θy) from the table pose
-  Eigen::Vector2d a_xy = Eigen::Vector2d::Zero();
-  bool estimate_valid = false;
-  Eigen::VectorXd x = Eigen::VectorXd::Zero(6);
-  std::vector<Eigen::Vector2d> predictions;
+  Eigen::Vector2d a_xy = Eigen::Vector2d::Zero();  ///< in-plane acceleration fed to the filter, m/s² (table frame)
+  bool estimate_valid = false;           ///< the filter has started (x and predictions are valid)
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(6);  ///< filter state (p_x, v_x, p_y, v_y, w2_x, w2_y), table frame
+  std::vector<Eigen::Vector2d> predictions;  ///< the next N predicted positions (m, table frame)
   double seconds = 0.0;                  ///< wall-clock cost of detection + filter
 };
 
+/// [M]'s observer: one camera image in, table pose, ball on the table and the filtered and
+/// predicted ball out (the steps at the top of this file).
 class TableBallObserver {
 public:
+  /// `camera`: the calibrated head camera (intrinsics; its pose is given per frame through c_R_w
+  /// and the table pose). Throws core::InvalidInput for an invalid config.
   TableBallObserver(const core::Camera& camera, const TableBallObserverConfig& config);
   ~TableBallObserver();
   TableBallObserver(const TableBallObserver&) = delete;
@@ -104,8 +118,11 @@ public:
   /// A step without an image (dropped frame): prediction only.
   const ObserverFrame& predictOnly(double t);
 
+  /// The last frame's result.
   const ObserverFrame& last() const { return frame_; }
+  /// The rolling-ball filter (state, covariance, gate counts).
   const tracking::RollingBallTracker& tracker() const { return tracker_; }
+  /// The config the observer was built with.
   const TableBallObserverConfig& config() const { return config_; }
 
 private:
