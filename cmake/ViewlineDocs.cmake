@@ -1,7 +1,8 @@
 # The API reference: Doxygen over the public headers of every module (modules/<m>/include).
 #   cmake --build build --target api_docs    -> build/docs/api/index.html
 #   ctest -R docs.api_reference              -> fails on any Doxygen warning (an undocumented
-#                                               public declaration, a broken reference)
+#                                               public declaration, a broken reference); the
+#                                               target prints the same warnings but still builds
 # The HTML installs with the package (component api_docs) once it has been built.
 find_package(Doxygen QUIET)
 
@@ -17,11 +18,19 @@ foreach(m IN LISTS _viewline_doc_modules)
 endforeach()
 set(VIEWLINE_DOXYFILE ${VIEWLINE_DOCS_OUTPUT_DIR}/Doxyfile)
 configure_file(${PROJECT_SOURCE_DIR}/docs/Doxyfile.in ${VIEWLINE_DOXYFILE} @ONLY)
+# The target writes the HTML even while warnings remain (they are printed); the test is the gate,
+# and it writes its HTML to a folder of its own, so the installed reference is only ever what
+# api_docs built.
+set(VIEWLINE_DOXYFILE_HTML ${VIEWLINE_DOCS_OUTPUT_DIR}/Doxyfile.html)
+file(WRITE ${VIEWLINE_DOXYFILE_HTML} "@INCLUDE = \"${VIEWLINE_DOXYFILE}\"\nWARN_AS_ERROR = NO\n")
+set(VIEWLINE_DOXYFILE_CHECK ${VIEWLINE_DOCS_OUTPUT_DIR}/Doxyfile.check)
+file(WRITE ${VIEWLINE_DOXYFILE_CHECK}
+  "@INCLUDE = \"${VIEWLINE_DOXYFILE}\"\nOUTPUT_DIRECTORY = \"${VIEWLINE_DOCS_OUTPUT_DIR}/check\"\n")
 
 if(DOXYGEN_FOUND)
   add_custom_target(api_docs
     COMMAND ${CMAKE_COMMAND} -E make_directory ${VIEWLINE_DOCS_OUTPUT_DIR}
-    COMMAND Doxygen::doxygen ${VIEWLINE_DOXYFILE}
+    COMMAND Doxygen::doxygen ${VIEWLINE_DOXYFILE_HTML}
     WORKING_DIRECTORY ${VIEWLINE_DOCS_OUTPUT_DIR}
     COMMENT "API reference (Doxygen) -> ${VIEWLINE_DOCS_OUTPUT_DIR}/api/index.html"
     VERBATIM)
@@ -35,7 +44,7 @@ endif()
 if(VIEWLINE_BUILD_TESTS)
   if(DOXYGEN_FOUND)
     # WARN_AS_ERROR = FAIL_ON_WARNINGS: every warning is printed, then the exit status is non-zero.
-    add_test(NAME docs.api_reference COMMAND Doxygen::doxygen ${VIEWLINE_DOXYFILE}
+    add_test(NAME docs.api_reference COMMAND Doxygen::doxygen ${VIEWLINE_DOXYFILE_CHECK}
       WORKING_DIRECTORY ${VIEWLINE_DOCS_OUTPUT_DIR})
     set_tests_properties(docs.api_reference PROPERTIES LABELS docs TIMEOUT 600)
   else()
