@@ -39,7 +39,8 @@ namespace viewline::calib {
 /// Kind of calibration target (the `type:` key of a board file).
 enum class BoardType { Chessboard, CirclesGrid, AsymmetricCirclesGrid, AprilTagGrid, AprilTag, ChArUco };
 
-/// A calibration target as a board file describes it (metres; board frame x along a row, y down the columns, z into the board).
+/// A calibration target as a board file describes it (metres; board frame x along a row, y down the columns,
+/// z into the board).
 struct BoardSpec {
   BoardType type = BoardType::Chessboard;  ///< target kind
   int cols = 9;  ///< inner corners (chessboard), circles per row, or squares per row (charuco)

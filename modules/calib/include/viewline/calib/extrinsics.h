@@ -52,7 +52,8 @@ std::map<int, BoardPose> estimateTagPoses(const PoseCamera& cam, const cv::Mat& 
 /// camera i saw at instant k (nullopt when it did not see the board).
 struct RigObservations {
   std::vector<PoseCamera> cameras;  ///< intrinsics of camera i
-  std::vector<std::vector<std::optional<BoardObservation>>> views;  ///< views[k][i]: what camera i saw at instant k (nullopt: not seen)
+  /// Views[k][i]: what camera i saw at instant k (nullopt: not seen)
+  std::vector<std::vector<std::optional<BoardObservation>>> views;
 };
 
 /// Result of calibrateRig(): camera poses relative to the reference camera, board poses and errors.
@@ -91,7 +92,8 @@ struct GroundResult {
   /// Gravity direction (unit, pointing down) in camera coordinates.
   Eigen::Vector3d down_c() const { return c_M_g.linear() * Eigen::Vector3d(0, 0, -1); }
 };
-/// Ground frame, height, pitch and roll of the camera from poses c_M_o of a board lying flat on the floor (throws InvalidInput for no pose).
+/// Ground frame, height, pitch and roll of the camera from poses c_M_o of a board lying flat on the floor
+/// (throws InvalidInput for no pose).
 GroundResult cameraToGround(const std::vector<Eigen::Isometry3d>& c_M_o, BoardType type);
 
 }  // namespace viewline::calib

@@ -13,7 +13,8 @@
 
 namespace viewline::calib {
 
-/// Where the camera is: on the end effector (eye-in-hand) or fixed, looking at a board on the end effector (eye-to-hand).
+/// Where the camera is: on the end effector (eye-in-hand) or fixed, looking at a board on the end effector
+/// (eye-to-hand).
 enum class HandEyeSetup { EyeInHand, EyeToHand };
 
 /// Result of calibrateHandEye(): the hand-eye pose X, the fixed pose and per-pose residuals.

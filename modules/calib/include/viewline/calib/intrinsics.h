@@ -40,7 +40,8 @@ struct IntrinsicsOptions {
   bool fit_visp = true;              ///< also fit ViSP's models with vpCalibration
 };
 
-/// Result of calibrateIntrinsics(): OpenCV's model with standard deviations and ViSP's two models, with per-view errors.
+/// Result of calibrateIntrinsics(): OpenCV's model with standard deviations and ViSP's two models, with per-
+/// view errors.
 struct IntrinsicsResult {
   cv::Size image_size;  ///< image size, px
   // OpenCV model

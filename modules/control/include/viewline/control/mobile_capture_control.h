@@ -45,7 +45,8 @@ struct BaseCommand {
          omega = 0.0;  ///< turn rate, rad/s (counter-clockwise seen from above)
 };
 
-/// Base command that drives towards `goal` (floor frame, m): turn first when it is behind, slow down near stop_distance.
+/// Base command that drives towards `goal` (floor frame, m): turn first when it is behind, slow down near
+/// stop_distance.
 BaseCommand goToPoint(const robots::BasePose& pose, const Eigen::Vector2d& goal, const GoToPointParams& params);
 
 /// Joint set points that point the head camera at a world point (z up) from a base pose;

@@ -112,11 +112,13 @@ struct SimulatedCartesianConfig {
   double latency = 0.008;          ///< s between a set point's issue and its effect
   Eigen::Vector3d home = Eigen::Vector3d(0.0, 0.0, 1.2);      ///< tool point at rest, world
   Eigen::Vector3d workspace_min = Eigen::Vector3d(-0.1, -0.6, 0.7);  ///< stage box (and arm bounds)
-  Eigen::Vector3d workspace_max = Eigen::Vector3d(0.1, 0.6, 1.7);  ///< upper corner of the stage box (and arm bounds), world, m
+  /// Upper corner of the stage box (and arm bounds), world, m
+  Eigen::Vector3d workspace_max = Eigen::Vector3d(0.1, 0.6, 1.7);
   // Arm only.
   Eigen::Isometry3d w_M_base = Eigen::Isometry3d::Identity();  ///< arm only: pose of the robot base in the world
   Eigen::Matrix3d w_R_box = Eigen::Matrix3d::Identity();  ///< arm only: fixed box orientation in the world
-  Eigen::Vector3d tool_offset = Eigen::Vector3d(0.0, 0.0, 0.2);  ///< arm only: flange to hole centre, in the flange frame, m
+  /// Arm only: flange to hole centre, in the flange frame, m
+  Eigen::Vector3d tool_offset = Eigen::Vector3d(0.0, 0.0, 0.2);
   double joint_margin = 0.02;      ///< rad kept from each joint limit
   /// Tolerance of the limit check of the streamed set points (relative).
   double limit_tolerance = 1e-6;

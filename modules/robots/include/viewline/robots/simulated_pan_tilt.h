@@ -24,7 +24,8 @@ namespace viewline::robots {
 
 /// Parameters of the simulated pan-tilt unit: limits, latency, integration sub-step, history and initial joints.
 struct SimulatedPanTiltParams {
-  PanTiltLimits limits = PanTiltLimits::flirPtuD46();  ///< joint, rate and acceleration limits (default: FLIR PTU-D46-17.5)
+  /// Joint, rate and acceleration limits (default: FLIR PTU-D46-17.5)
+  PanTiltLimits limits = PanTiltLimits::flirPtuD46();
   double latency = 0.03;          ///< s, command issue -> effect
   double substep = 1e-3;          ///< s
   double history_seconds = 2.0;   ///< s of state kept for read(t) in the past

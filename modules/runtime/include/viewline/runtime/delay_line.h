@@ -16,7 +16,8 @@
 namespace viewline::runtime {
 
 template <typename T>
-/// A FIFO latency: values of type T sent with an availability time (s) and received once the consumer's time reaches it.
+/// A FIFO latency: values of type T sent with an availability time (s) and received once the consumer's time
+/// reaches it.
 class DelayLine {
 public:
   /// Queues `value`, available from `t_available` on. Deliveries keep the order of sending, so

@@ -48,7 +48,8 @@ struct InnovationRecord {
   Eigen::VectorXd innovation;    ///< d = z − h(x̂(k|k−1)) (empty when the decision is Start)
   Eigen::MatrixXd S;             ///< innovation covariance
   double nis = 0.0;              ///< dᵀ S⁻¹ d
-  tracking::GateDecision decision = tracking::GateDecision::Accept;  ///< the gate's decision (accept, reject, start a new track...)
+  /// The gate's decision (accept, reject, start a new track...)
+  tracking::GateDecision decision = tracking::GateDecision::Accept;
 };
 
 /// A state estimate after an update (or a prediction published to a consumer).

@@ -89,7 +89,8 @@ void applyIllumination(cv::Mat& bgr8, const Illumination& illumination, double t
 class NoisePool {
 public:
   static constexpr double kMaxPoolSigma = 40.0;  ///< above: per-frame cv::randn (no clipping)
-  /// Draws pool_size rounded N(0, sigma²) values from rng (none for sigma 0 or above kMaxPoolSigma); throws core::InvalidInput for bad settings.
+  /// Draws pool_size rounded N(0, sigma²) values from rng (none for sigma 0 or above kMaxPoolSigma); throws
+  /// core::InvalidInput for bad settings.
   NoisePool(const SensorNoise& noise, core::Rng& rng);
   /// Adds noise to an 8-bit image in place; the offset is drawn from rng.
   void apply(cv::Mat& image8, core::Rng& rng) const;

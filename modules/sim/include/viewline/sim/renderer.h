@@ -82,7 +82,8 @@ struct ExposureSpec {
   int blur_samples = 1;     ///< instants averaged over the exposure (>= 1)
 };
 
-/// Ray-cast renderer of simulated cameras: exact ViSP kud projection, anti-aliased edges, cached static layers, motion blur.
+/// Ray-cast renderer of simulated cameras: exact ViSP kud projection, anti-aliased edges, cached static
+/// layers, motion blur.
 class Renderer {
 public:
   /// Renderer with these settings.

@@ -156,13 +156,15 @@ struct ObjectTruth {
   std::string name;  ///< name of the primitive
   Shape shape = Shape::Sphere;  ///< shape kind
   Eigen::Isometry3d w_M_o = Eigen::Isometry3d::Identity();  ///< at the frame's capture time
-  Eigen::Isometry3d c_M_o = Eigen::Isometry3d::Identity();  ///< object frame in the camera frame at the capture time (p_c = c_M_o * p_o)
+  /// Object frame in the camera frame at the capture time (p_c = c_M_o * p_o)
+  Eigen::Isometry3d c_M_o = Eigen::Isometry3d::Identity();
   bool in_front = false;               ///< origin in front of the camera (Z > 0)
   bool in_image = false;               ///< projected origin inside the image
   Eigen::Vector2d center_px = Eigen::Vector2d::Zero();  ///< projection of the origin (distortion applied)
   // Spheres: the exact silhouette (72 projected points of the tangent circle, distortion applied)
   // and what ideal blob detectors would measure on it.
-  std::vector<Eigen::Vector2d> outline_px;  ///< exact silhouette of a sphere: 72 projected points of the tangent circle (distortion applied), px
+  /// Exact silhouette of a sphere: 72 projected points of the tangent circle (distortion applied), px
+  std::vector<Eigen::Vector2d> outline_px;
   Eigen::Vector2d outline_centroid_px = Eigen::Vector2d::Zero();  ///< area centroid of the silhouette
   Eigen::Vector2d enclosing_center_px = Eigen::Vector2d::Zero();  ///< cv::minEnclosingCircle centre
   double enclosing_radius_px = 0.0;                               ///< cv::minEnclosingCircle radius

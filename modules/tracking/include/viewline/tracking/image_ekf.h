@@ -18,7 +18,8 @@
 
 namespace viewline::tracking {
 
-/// Image-space EKF baseline: the ballistic state updated with pixel measurements (linearised projection), for comparison with the viewline tracker.
+/// Image-space EKF baseline: the ballistic state updated with pixel measurements (linearised projection), for
+/// comparison with the viewline tracker.
 class ImageSpaceEkf {
 public:
   /// EKF over `cameras` (intrinsics, distortion, c_M_w) with the tracker's model, prior, gate and restart settings.

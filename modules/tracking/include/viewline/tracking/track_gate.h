@@ -60,7 +60,8 @@ struct GateCounts {
   std::uint64_t total() const { return starts + accepted + rejected + restarts; }
 };
 
-/// The chi-square gate + restart + coasting life cycle every track shares: decides Start, Accept, Reject or Restart per measurement.
+/// The chi-square gate + restart + coasting life cycle every track shares: decides Start, Accept, Reject or
+/// Restart per measurement.
 class TrackGate {
 public:
   /// `dof`: rows of the update (the NIS's degrees of freedom); `sources`: how many independent

@@ -120,7 +120,8 @@ struct ImageUpdate {
   int fused_before = 0;  ///< fused images of the track the image was tested against (0 for Start)
 };
 
-/// Configuration of the viewline tracker: model, prior, gate, time handling, late-data horizon, restarts and noise model.
+/// Configuration of the viewline tracker: model, prior, gate, time handling, late-data horizon, restarts and
+/// noise model.
 struct TrackerConfig {
   BallisticModel model;  ///< ballistic motion model (gravity, acceleration noise)
   Vector6 prior_mean = (Vector6() << 0.0, 0.0, 3.0, 0.0, 0.0, -8.0).finished();  ///< SPEC §2 ([L])
@@ -169,7 +170,8 @@ MeasurementOutcome fuseImage(estimation::StateEstimate& s, const core::Camera& c
                              const GateConfig& gate, double dt_offset, double min_depth, bool force,
                              bool depth_variance_in_noise = true);
 
-/// The multi-view asynchronous viewline tracker ([L]): images of any calibrated camera fused as plane constraints, late images re-processed.
+/// The multi-view asynchronous viewline tracker ([L]): images of any calibrated camera fused as plane
+/// constraints, late images re-processed.
 class ViewlineTracker {
 public:
   /// Tracker over `cameras` (intrinsics, distortion, c_M_w; validated config, throws core::InvalidInput).

@@ -58,7 +58,8 @@ struct UnicycleUpdate {
   estimation::UpdateReport report;
 };
 
-/// Unicycle ground tracker on the floor: EKF with two-point starts, TrackGate life cycle and a least-squares trajectory predictor.
+/// Unicycle ground tracker on the floor: EKF with two-point starts, TrackGate life cycle and a least-squares
+/// trajectory predictor.
 class UnicycleTracker {
 public:
   /// Throws core::InvalidInput for an invalid config.

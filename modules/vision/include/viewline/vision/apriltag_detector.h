@@ -22,8 +22,10 @@ namespace viewline::vision {
 
 /// Configuration of the AprilTag detector (family, pose method, tag sizes in m, corner noise).
 struct AprilTagDetectorConfig {
-  vpDetectorAprilTag::vpAprilTagFamily family = vpDetectorAprilTag::TAG_36h11;  ///< tag family (vpDetectorAprilTag; default 36h11)
-  vpDetectorAprilTag::vpPoseEstimationMethod pose_method = vpDetectorAprilTag::HOMOGRAPHY_VIRTUAL_VS;  ///< ViSP's tag pose method
+  /// Tag family (vpDetectorAprilTag; default 36h11)
+  vpDetectorAprilTag::vpAprilTagFamily family = vpDetectorAprilTag::TAG_36h11;
+  /// ViSP's tag pose method
+  vpDetectorAprilTag::vpPoseEstimationMethod pose_method = vpDetectorAprilTag::HOMOGRAPHY_VIRTUAL_VS;
   double tag_size_m = 0.053;              ///< side of the black square, for ids not listed below
   std::map<int, double> tag_sizes_m;      ///< per-id sizes
   float quad_decimate = 1.0F;             ///< >= 1; 2 halves the resolution of the quad search
@@ -88,7 +90,8 @@ private:
 struct TagOnTable {
   int id = 0;  ///< tag id
   double size_m = 0.05;  ///< side of the black square, m
-  Eigen::Isometry3d t_M_tag = Eigen::Isometry3d::Identity();  ///< pose of the tag frame (vpDetectorAprilTag's) in the table frame
+  /// Pose of the tag frame (vpDetectorAprilTag's) in the table frame
+  Eigen::Isometry3d t_M_tag = Eigen::Isometry3d::Identity();
 };
 
 /// Table pose from all visible tags of a known layout: each tag's corners expressed in the table

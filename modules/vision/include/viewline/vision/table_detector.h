@@ -107,7 +107,8 @@ struct BallOnTableMeasurement : Measurement {  ///< pixel = ball circle centre
 
 /// What one image gave: the table pose, the ball on the table and the ball's circle.
 struct TableScene {
-  Result<TableMeasurement> table = Result<TableMeasurement>::fail(FailureReason::NotFound, "");  ///< the table pose, or why there is none
+  /// The table pose, or why there is none
+  Result<TableMeasurement> table = Result<TableMeasurement>::fail(FailureReason::NotFound, "");
   Result<BallOnTableMeasurement> ball =  ///< the ball on the table (needs the table pose), or why there is none
       Result<BallOnTableMeasurement>::fail(FailureReason::NotFound, "");
   std::optional<Circle> ball_circle;  ///< the ball in the image, even without a table pose

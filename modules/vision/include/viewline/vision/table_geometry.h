@@ -75,7 +75,8 @@ struct TablePose {
   std::array<Eigen::Vector2d, 4> corners;  ///< ordered like P0..P3 after the prior shift
   double reprojection_rms_px = 0.0;  ///< RMS reprojection error of the four corners, px
 };
-/// Table pose c_M_t from four ordered corners (PnP AP3P, optional Gauss-Newton refinement, prior's quarter turn); PoseFailed when behind or seen from below.
+/// Table pose c_M_t from four ordered corners (PnP AP3P, optional Gauss-Newton refinement, prior's quarter
+/// turn); PoseFailed when behind or seen from below.
 Result<TablePose> solveTablePose(const std::array<Eigen::Vector2d, 4>& ordered_corners,
                                  const core::Camera& camera, double side_m, bool refine,
                                  const std::optional<Eigen::Isometry3d>& prior);

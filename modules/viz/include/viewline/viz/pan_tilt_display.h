@@ -12,7 +12,8 @@
 
 namespace viewline::viz {
 
-/// Live view of the pan-tilt scenario: camera image with centre, measured, predicted and true target and the error vector.
+/// Live view of the pan-tilt scenario: camera image with centre, measured, predicted and true target and the
+/// error vector.
 class PanTiltDisplay : public scenarios::pan_tilt::FrameSink {
 public:
   /// Throws core::InvalidInput when ViSP has no X11 support or no X display is available.

@@ -48,7 +48,8 @@ Eigen::Vector2d rollingBallAcceleration(const Eigen::Matrix3d& table_R_world, co
 /// e.g. solvePnP) and the known camera-to-ground rotation (c_R_world). Both must be rotations.
 Eigen::Matrix3d tableRotationInWorld(const Eigen::Matrix3d& c_R_table, const Eigen::Matrix3d& c_R_world);
 
-/// Ball rolling on a tilting table with disturbance states, in table coordinates ([M] §4.2): state (p_x, v_x, p_y, v_y, w2_x, w2_y).
+/// Ball rolling on a tilting table with disturbance states, in table coordinates ([M] §4.2): state (p_x, v_x,
+/// p_y, v_y, w2_x, w2_y).
 struct RollingBallModel {
   double sigma_w = 1.0;         ///< disturbance intensity σw (w1 density σw², w2 std σw), >= 0
   double beta = 1.0;            ///< inverse correlation time β of w2 [1/s], > 0

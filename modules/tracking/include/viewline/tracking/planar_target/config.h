@@ -20,7 +20,8 @@ TargetModel targetModelFromString(const std::string& name);
 /// The config spelling of a model ("constant_velocity", "constant_acceleration", "singer", ...).
 const char* toString(TargetModel model);
 
-/// Configuration of the planar target filter: model, noise densities, jump detection, constant-speed legs, region, particles and gate.
+/// Configuration of the planar target filter: model, noise densities, jump detection, constant-speed legs,
+/// region, particles and gate.
 struct TargetFilterConfig {
   TargetModel model = TargetModel::ConstantVelocity;  ///< motion model
   double q = 0.05;                 ///< CV: acceleration density (m²/s³); CA: jerk density (m²/s⁵)
@@ -59,7 +60,8 @@ struct TargetFilterConfig {
   /// prior of the target's one speed (m/s; equal ends: the speed is known), the generator's shortest leg
   /// (m) and the particles' random stream.
   std::size_t particles = 20000;
-  Eigen::Vector2d particle_speed{0.02, 0.5};  ///< waypoint_particles: uniform prior range (min, max) of the target's speed, m/s
+  /// Waypoint_particles: uniform prior range (min, max) of the target's speed, m/s
+  Eigen::Vector2d particle_speed{0.02, 0.5};
   double particle_min_leg = 0.0;  ///< waypoint_particles: shortest leg of the waypoint generator, m
   std::uint64_t particle_seed = 1;  ///< waypoint_particles: seed of the particles' random stream
   double gate_probability = 0.9999;      ///< chi-square (2 dof) gate on the NIS (TrackGate probability)

@@ -50,7 +50,8 @@
 
 namespace viewline::tracking {
 
-/// Kalman (or IMM / particle) filter of a target moving on a known plane, plane coordinates in m, with a chi-square gate and jump handling.
+/// Kalman (or IMM / particle) filter of a target moving on a known plane, plane coordinates in m, with a chi-
+/// square gate and jump handling.
 class PlanarTargetFilter {
 public:
   /// Filter with this configuration (validated; throws core::InvalidInput).

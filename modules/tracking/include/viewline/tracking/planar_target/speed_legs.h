@@ -47,7 +47,8 @@ namespace viewline::tracking {
 /// One leg's prior and the sufficient statistics of its measurements (the model above).
 struct ConstantSpeedLeg {
   double t_c = 0.0;  ///< corner time t_c, s
-  Eigen::Vector3d beta0 = Eigen::Vector3d::Zero();  ///< prior mean β₀ = (ĉ_x, ĉ_y, ŝ) of the corner position (m) and speed (m/s)
+  /// Prior mean β₀ = (ĉ_x, ĉ_y, ŝ) of the corner position (m) and speed (m/s)
+  Eigen::Vector3d beta0 = Eigen::Vector3d::Zero();
   Eigen::Matrix3d P0_inv = Eigen::Matrix3d::Identity();  ///< prior information P₀⁻¹ of β
   std::vector<double> prior_mu;  ///< μ_k (rad); empty: θ uniform
   double prior_sigma = 0.1,   ///< σ of each learnt-turn component, rad

@@ -44,7 +44,8 @@ struct WaypointParticleConfig {
   double jitter_position = 0.0005;  ///< m, std of the position jitter after a resampling
   double jitter_waypoint = 0.005;   ///< m, std of the waypoint jitter after a resampling (kept in B)
   double jitter_speed = 0.0005;     ///< m/s, std of the speed jitter after a resampling
-  double outlier_probability = 0.01;  ///< probability that a measurement is an outlier (uniform over the grown box), in [0, 1)
+  /// Probability that a measurement is an outlier (uniform over the grown box), in [0, 1)
+  double outlier_probability = 0.01;
   /// Measurements in a row that no particle explains better than an outlier (the cloud lost the target,
   /// e.g. it turned during an occlusion) before the filter starts again from the measurement.
   int reinit_after = 3;
@@ -52,7 +53,8 @@ struct WaypointParticleConfig {
   void validate() const;  ///< throws core::InvalidInput
 };
 
-/// Particle filter of a target that runs at one speed between waypoints drawn uniformly in a box (plane coordinates, m).
+/// Particle filter of a target that runs at one speed between waypoints drawn uniformly in a box (plane
+/// coordinates, m).
 class WaypointParticleFilter {
  public:
   /// Filter with this configuration (validated; throws core::InvalidInput).
