@@ -28,13 +28,23 @@ MobileCaptureConfig MobileCaptureConfig::defaults() {
   c.detector.min_roundness = 0.2;
   c.detector.good_roundness = 0.45;
   c.detector.roi_half_size_px = 40.0;
-  c.planner.period = c.vision_period;
-  c.planner.robot_speed = c.base.max_speed;
   c.planner.reach = 0.2;
   c.planner.turn_rate = 1.5;
-  c.go.max_speed = c.base.max_speed;
-  c.go.max_turn_rate = c.base.max_turn_rate;
   return c;
+}
+
+planning::CapturePlannerParams MobileCaptureConfig::plannerParams() const {
+  planning::CapturePlannerParams p = planner;
+  p.period = vision_period;
+  p.robot_speed = base.max_speed;
+  return p;
+}
+
+control::GoToPointParams MobileCaptureConfig::goParams() const {
+  control::GoToPointParams g = go;
+  g.max_speed = base.max_speed;
+  g.max_turn_rate = base.max_turn_rate;
+  return g;
 }
 
 void MobileCaptureConfig::validate() const {
@@ -45,16 +55,10 @@ void MobileCaptureConfig::validate() const {
   core::requirePositive(max_time, "max_time");
   core::requirePositive(floor_size, "floor_size");
   core::requirePositive(vision_period, "vision_period");
-  core::requirePositive(control_period, "control_period");
-  const double ratio = vision_period / control_period;
+  core::requirePositive(base.control_period, "timing.control_period");
+  const double ratio = vision_period / controlPeriod();
   if (std::abs(ratio - std::round(ratio)) > 1e-9 || ratio < 1.0) {
     throw core::InvalidInput("vision_period: expected an integer multiple of control_period");
-  }
-  if (std::abs(base.control_period - control_period) > 1e-12) {
-    throw core::InvalidInput("base.control_period: expected equal to control_period");
-  }
-  if (std::abs(planner.period - vision_period) > 1e-12) {
-    throw core::InvalidInput("planner.period: expected equal to vision_period");
   }
   if (width < 16 || height < 16) throw core::InvalidInput("camera width/height: expected >= 16 px");
   core::requirePositive(hfov, "camera hfov");
@@ -71,8 +75,8 @@ void MobileCaptureConfig::validate() const {
   core::requireNonNegative(max_accel_v, "max_accel_v");
   core::requireNonNegative(max_accel_omega, "max_accel_omega");
   if (horizon_steps < 1) throw core::InvalidInput("horizon_steps: expected >= 1");
-  planner.validate();
-  go.validate();
+  plannerParams().validate();
+  goParams().validate();
   search.validate();
   core::requirePositive(filter_test_duration, "filter_test.duration");
   core::requirePositive(filter_test_measurement_var, "filter_test.measurement_var_cm2");
@@ -120,11 +124,9 @@ MobileCaptureConfig loadMobileCaptureConfig(const io::ConfigNode& root) {
     const auto t = root.child("timing");
     readOpt(t, "vision_period", c.vision_period);
     positive(t, "vision_period", c.vision_period);
-    readOpt(t, "control_period", c.control_period);
-    positive(t, "control_period", c.control_period);
+    readOpt(t, "control_period", c.base.control_period);
+    positive(t, "control_period", c.base.control_period);
   }
-  c.base.control_period = c.control_period;
-  c.planner.period = c.vision_period;
   if (root.has("camera")) {
     const auto cam = root.child("camera");
     if (root.has("rig")) io::refuseGeometryWithRig(cam, root.getPath("rig"), {"width", "height", "hfov_deg", "vfov_deg"});
@@ -169,9 +171,6 @@ MobileCaptureConfig loadMobileCaptureConfig(const io::ConfigNode& root) {
     readOpt(b, "kd", c.base.kd);
     readOpt(b, "encoder_noise", c.base.encoder_noise);
   }
-  c.go.max_speed = c.base.max_speed;
-  c.go.max_turn_rate = c.base.max_turn_rate;
-  c.planner.robot_speed = c.base.max_speed;
   if (root.has("gripper")) {
     const auto g = root.child("gripper");
     const auto jaws = g.getOr<std::vector<double>>("jaws", {c.jaws.x_min, c.jaws.x_max, c.jaws.half_width});

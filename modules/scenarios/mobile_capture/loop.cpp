@@ -78,10 +78,10 @@ OracleResult runOracle(const MobileCaptureConfig& cfg, std::uint64_t seed) {
   Ticks planner(sched, clock, TickClock::visionEvery(cfg), kVision, [&](long, double t) {
     const auto& p = robot.base.pose();
     plan = planning::planCapture(truePath(target, t, cfg.vision_period, cfg.horizon_steps), {{p.x, p.y}, p.theta},
-                                 cfg.planner);
+                                 cfg.plannerParams());
   });
   Ticks drive(sched, clock, 1, kDrive, [&](long, double) {
-    const control::BaseCommand c = control::goToPoint(robot.base.pose(), plan.point, cfg.go);
+    const control::BaseCommand c = control::goToPoint(robot.base.pose(), plan.point, cfg.goParams());
     robot.base.setCommand(c.v, c.omega);
     robot.base.step(rng.drive);
   });
@@ -201,7 +201,7 @@ MobileCaptureRun runMobileCapture(const MobileCaptureConfig& cfg, std::uint64_t 
     track.predictTo(t);
     if (track.valid()) {
       prediction = predictPath(track, cfg);
-      plan = planning::planCapture(prediction, {{pose.x, pose.y}, pose.theta}, cfg.planner);
+      plan = planning::planCapture(prediction, {{pose.x, pose.y}, pose.theta}, cfg.plannerParams());
       const Vector2d rel = toRobot(pose, track.state().x().head<2>());
       centre_bearing = std::atan2(rel.y(), rel.x());
       have_bearing = true;
@@ -254,8 +254,8 @@ MobileCaptureRun runMobileCapture(const MobileCaptureConfig& cfg, std::uint64_t 
     control::BaseCommand cmd;
     robots::PanTiltJoints head_target = robot.q;
     if (mode != control::SearchMode::Sweeping) {
-      cmd = control::goToPoint(pose, plan.point, cfg.go);
-      const Vector2d p = track.positionAt(t + cfg.control_period);
+      cmd = control::goToPoint(pose, plan.point, cfg.goParams());
+      const Vector2d p = track.positionAt(t + cfg.controlPeriod());
       head_target = control::headSetPoint(robot.head, pose, Vector3d(p.x(), p.y(), plane_z));
     } else {
       head_target = search.sweep(robot.head, t, sweep_start, have_bearing ? centre_bearing : 0.0);
@@ -263,7 +263,7 @@ MobileCaptureRun runMobileCapture(const MobileCaptureConfig& cfg, std::uint64_t 
       if (have_bearing) {
         // The base turns towards the bearing; it is expressed in the robot frame at the last
         // estimate, so update it with the base's own rotation.
-        centre_bearing = std::remainder(centre_bearing - robot.base.turnRate() * cfg.control_period, 2.0 * M_PI);
+        centre_bearing = std::remainder(centre_bearing - robot.base.turnRate() * cfg.controlPeriod(), 2.0 * M_PI);
       }
     }
     robot.stepHead(head_target);

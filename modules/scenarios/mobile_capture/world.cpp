@@ -52,7 +52,7 @@ sim::GroundTargetParams targetParams(const MobileCaptureConfig& cfg, sim::Ground
   p.start = cfg.object_start;
   p.heading = cfg.object_heading;
   p.duration = duration;
-  p.substep = cfg.control_period;
+  p.substep = cfg.controlPeriod();
   p.noise = cfg.object_noise;
   return p;
 }
@@ -68,10 +68,10 @@ Vector2d toRobot(const robots::BasePose& pose, const Vector2d& p_w) {
 }
 
 TickClock TickClock::of(const MobileCaptureConfig& cfg) {
-  return {cfg.control_period, std::lround(cfg.max_time / cfg.control_period)};
+  return {cfg.controlPeriod(), std::lround(cfg.max_time / cfg.controlPeriod())};
 }
 
-long TickClock::visionEvery(const MobileCaptureConfig& cfg) { return std::lround(cfg.vision_period / cfg.control_period); }
+long TickClock::visionEvery(const MobileCaptureConfig& cfg) { return std::lround(cfg.vision_period / cfg.controlPeriod()); }
 
 RobotSim::RobotSim(const MobileCaptureConfig& c)
     : cfg(c), head(c.head), base(c.base, {c.robot_start.x(), c.robot_start.y(), c.robot_heading}) {
@@ -80,8 +80,8 @@ RobotSim::RobotSim(const MobileCaptureConfig& c)
 
 void RobotSim::stepHead(const robots::PanTiltJoints& target) {
   const auto t = head.clampToLimits(target);
-  q.tilt = robots::JointRateLimiter::step(q.tilt, t.tilt, cfg.head.tilt_rate_max, cfg.control_period);
-  q.pan = robots::JointRateLimiter::step(q.pan, t.pan, cfg.head.pan_rate_max, cfg.control_period);
+  q.tilt = robots::JointRateLimiter::step(q.tilt, t.tilt, cfg.head.tilt_rate_max, cfg.controlPeriod());
+  q.pan = robots::JointRateLimiter::step(q.pan, t.pan, cfg.head.pan_rate_max, cfg.controlPeriod());
 }
 
 // ------------------------------------------------------------------------------------------------

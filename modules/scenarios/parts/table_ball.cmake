@@ -1,5 +1,5 @@
 # Table-ball balancing ([M]): the observer and edge tracker, and the scenario in its folder
 # (config, world, loop on the runtime scheduler, metrics). The live view is in modules/viz.
-list(APPEND scenarios_sources src/table_ball_observer.cpp src/table_edge_tracker.cpp
+list(APPEND scenarios_sources table_ball/observer.cpp
   table_ball/config.cpp table_ball/world.cpp table_ball/loop.cpp table_ball/metrics.cpp)
 list(APPEND scenarios_tests test/table_ball_observer_test.cpp)

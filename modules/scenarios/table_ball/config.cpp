@@ -23,6 +23,11 @@ void TableBallConfig::validate() const {
   core::requirePositive(tag_size, "table.tag_size");
   core::requirePositive(border_height, "table.border_height");
   wrist.validate();
+  const tracking::TrackGateConfig& gate = observer.tracker.gate;
+  if (!(gate.probability > 0.0 && gate.probability <= 1.0)) {
+    throw core::InvalidInput("observer.gate_probability: expected in (0, 1] (1: no gate)");
+  }
+  if (gate.restart_after < 1) throw core::InvalidInput("observer.restart_after: expected >= 1");
   if (width < 16 || height < 16) throw core::InvalidInput("camera.width/height: expected >= 16 pixels");
   core::requirePositive(hfov, "camera.hfov_deg");
   if (hfov >= core::kPi) throw core::InvalidInput("camera.hfov_deg: expected < 180");
@@ -81,8 +86,8 @@ Eigen::Vector2d TableBallConfig::setpointAt(double t) const {
   return r;
 }
 
-RollingBallTrackerConfig TableBallConfig::trackerConfig() const {
-  RollingBallTrackerConfig c = observer.tracker;
+tracking::RollingBallTrackerConfig TableBallConfig::trackerConfig() const {
+  tracking::RollingBallTrackerConfig c = observer.tracker;
   c.model.table_side = table_side;
   c.model.ball_radius = ball_radius;
   c.nominal_period = framePeriod();
@@ -152,6 +157,9 @@ void readObserver(const io::ConfigNode& n, TableBallConfig& c) {
   m.prediction_steps = n.getOr<int>("prediction_steps", m.prediction_steps);
   c.observer.tracker.stationary_gain = n.getOr<bool>("stationary_gain", c.observer.tracker.stationary_gain);
   c.observer.tracker.initial_velocity_std = n.getOr<double>("initial_velocity_std", c.observer.tracker.initial_velocity_std);
+  auto& gate = c.observer.tracker.gate;
+  gate.probability = n.getOr<double>("gate_probability", gate.probability);
+  gate.restart_after = n.getOr<int>("restart_after", gate.restart_after);
   c.observer.detector.refine = n.getOr<bool>("refine", c.observer.detector.refine);
   c.observer.edge_tracking = n.getOr<bool>("edge_tracking", c.observer.edge_tracking);
   c.border_aware_pnp = n.getOr<bool>("border_aware_pnp", c.border_aware_pnp);

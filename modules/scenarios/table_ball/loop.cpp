@@ -65,13 +65,13 @@ private:
   core::Camera camera_;
   Eigen::Vector3d gravity_w_;
   vision::TableDetectorConfig detector_;
-  RollingBallTracker tracker_;
+  tracking::RollingBallTracker tracker_;
 };
 
-SideFilters makeSideFilters(const TableBallConfig& cfg, const RollingBallTrackerConfig& tracker) {
+SideFilters makeSideFilters(const TableBallConfig& cfg, const tracking::RollingBallTrackerConfig& tracker) {
   SideFilters side;
   if (!cfg.compare_tunings) return side;
-  RollingBallTrackerConfig a = tracker, b = tracker, st = tracker;
+  tracking::RollingBallTrackerConfig a = tracker, b = tracker, st = tracker;
   a.model.sigma_w = 1.0;
   a.model.sigma_v = 0.005;
   a.stationary_gain = false;
@@ -79,9 +79,9 @@ SideFilters makeSideFilters(const TableBallConfig& cfg, const RollingBallTracker
   b.model.sigma_v = 1.0;
   b.stationary_gain = false;
   st.stationary_gain = true;
-  side.emplace_back("M_best", RollingBallTracker(a));
-  side.emplace_back("M_lag", RollingBallTracker(b));
-  side.emplace_back("stationary", RollingBallTracker(st));
+  side.emplace_back("M_best", tracking::RollingBallTracker(a));
+  side.emplace_back("M_lag", tracking::RollingBallTracker(b));
+  side.emplace_back("stationary", tracking::RollingBallTracker(st));
   return side;
 }
 
@@ -94,7 +94,7 @@ Eigen::VectorXd vec(std::initializer_list<double> v) {
 
 /// The records of one frame (see TableBallHooks::telemetry).
 void reportFrame(runtime::TelemetrySink& sink, double t, double capture_time, const sim::TiltTableState& truth,
-                 const Eigen::Vector2d& ref, const ObserverFrame& of, const RollingBallTracker& tracker,
+                 const Eigen::Vector2d& ref, const ObserverFrame& of, const tracking::RollingBallTracker& tracker,
                  const SideFilters& side, double sigma_v) {
   if (of.table_found) sink.measurement({"table_tilt", t, 0, of.measured_tilt, {}});
   if (of.ball_found) sink.measurement({"ball", t, 0, of.measured, Eigen::Vector2d::Constant(sigma_v)});

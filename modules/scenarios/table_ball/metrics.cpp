@@ -47,7 +47,7 @@ void TableBallMetrics::tick(double t, const Eigen::Vector2d& p) {
 }
 
 void TableBallMetrics::frame(double t, const sim::TiltTableState& truth, const ObserverFrame& of,
-                             const RollingBallTracker& tracker, const SideFilters& side) {
+                             const tracking::RollingBallTracker& tracker, const SideFilters& side) {
   TableBallResult& r = counts_;
   ++r.frames;
   if (!of.image) ++r.frames_dropped;

@@ -1,4 +1,4 @@
-#include "viewline/scenarios/table_ball_observer.h"
+#include "viewline/scenarios/table_ball/observer.h"
 
 #include <gtest/gtest.h>
 
@@ -66,49 +66,6 @@ TEST(TableBallObserver, BorderAwarePnpRemovesTheOcclusionBias) {
   EXPECT_GT(core::rad2deg(plain_err), 0.3);
   EXPECT_LT(core::rad2deg(fixed_err), 0.01);
   EXPECT_LT((fixed.translation() - c_M_t.translation()).norm(), 1e-4);
-}
-
-TEST(TableBallObserver, TrackerPredictsThroughMissedDetectionsAndClampsAtTheBorder) {
-  scenarios::RollingBallTrackerConfig cfg;
-  scenarios::RollingBallTracker trk(cfg);
-  const double dt = 0.02;
-  const Eigen::Vector2d a(0.5, 0.0);  // rolling towards +x
-  // Nothing before the first detection.
-  trk.step(0.0, a, std::nullopt);
-  EXPECT_FALSE(trk.initialized());
-  // Measurements of a ball accelerating at a along x from rest at x = 0.
-  double t = 0.0;
-  for (int k = 0; k < 25; ++k) {
-    t = k * dt;
-    trk.step(t, a, Eigen::Vector2d(0.5 * a.x() * t * t, 0.0));
-  }
-  ASSERT_TRUE(trk.initialized());
-  EXPECT_EQ(static_cast<int>(trk.predictions().size()), 10);
-  EXPECT_GT(trk.predictions().back().x(), trk.position().x());
-  // Missed detections: keeps predicting, moving along x.
-  const double x_before = trk.position().x();
-  for (int k = 25; k < 30; ++k) trk.step(k * dt, a, std::nullopt);
-  EXPECT_EQ(trk.missedStreak(), 5);
-  EXPECT_GT(trk.position().x(), x_before + 0.005);
-  // Long enough without measurements: stops at the border L/2 - r with zero velocity along x.
-  for (int k = 30; k < 200; ++k) trk.step(k * dt, a, std::nullopt);
-  EXPECT_NEAR(trk.position().x(), 0.125, 1e-12);
-  EXPECT_EQ(trk.velocity().x(), 0.0);
-  for (const auto& p : trk.predictions()) EXPECT_LE(p.x(), 0.125 + 1e-12);
-}
-
-TEST(TableBallObserver, StationaryGainMatchesTheTimeVaryingFilterInSteadyState) {
-  scenarios::RollingBallTrackerConfig tv, st;
-  st.stationary_gain = true;
-  scenarios::RollingBallTracker a(tv), b(st);
-  core::Rng rng = core::makeRng(3);
-  for (int k = 0; k < 400; ++k) {
-    const Eigen::Vector2d y(0.05 * std::sin(0.02 * k) + core::gaussian(rng, 0.002), core::gaussian(rng, 0.002));
-    a.step(k * 0.02, Eigen::Vector2d::Zero(), y);
-    b.step(k * 0.02, Eigen::Vector2d::Zero(), y);
-  }
-  EXPECT_LT((a.position() - b.position()).norm(), 1e-5);
-  EXPECT_LT((a.P() - b.P()).cwiseAbs().maxCoeff(), 1e-6);
 }
 
 // The AprilTag table pose. A tagged table rendered at a known tilt must come back at

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <string>
 
@@ -22,8 +23,8 @@ const char* toString(GateDecision d) {
 
 void TrackGateConfig::validate(const char* what) const {
   const std::string w = what;
-  if (!(probability > 0.0 && probability < 1.0))
-    throw core::InvalidInput(w + ".probability: expected in (0, 1), got " + std::to_string(probability));
+  if (!(probability > 0.0 && probability <= 1.0))
+    throw core::InvalidInput(w + ".probability: expected in (0, 1] (1: no test), got " + std::to_string(probability));
   if (restart_after < 1) throw core::InvalidInput(w + ".restart_after: expected >= 1, got " + std::to_string(restart_after));
   if (!(max_coast_s > 0.0)) throw core::InvalidInput(w + ".max_coast_s: expected > 0 (inf: no limit)");
 }
@@ -32,7 +33,8 @@ TrackGate::TrackGate(Eigen::Index dof, TrackGateConfig config, std::size_t sourc
   config_.validate();
   if (dof < 1) throw core::InvalidInput("TrackGate: dof must be >= 1");
   if (sources < 1) throw core::InvalidInput("TrackGate: sources must be >= 1");
-  threshold_ = core::chiSquareQuantile(static_cast<double>(dof), config_.probability);
+  threshold_ = config_.probability < 1.0 ? core::chiSquareQuantile(static_cast<double>(dof), config_.probability)
+                                         : std::numeric_limits<double>::infinity();
   rejected_.assign(sources, 0);
 }
 

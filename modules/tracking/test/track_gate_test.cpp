@@ -92,3 +92,12 @@ TEST(TrackGate, BadConfigIsRefusedWithItsName) {
   EXPECT_THROW(TrackGate(2, {0.99, 3, 0.0}), core::InvalidInput);
   EXPECT_THROW(TrackGate(0, {0.99, 3}), core::InvalidInput);
 }
+
+TEST(TrackGate, ProbabilityOneTurnsTheTestOffButStillRejectsNaN) {
+  TrackGate g(2, {1.0, 2});
+  EXPECT_TRUE(std::isinf(g.threshold()));
+  EXPECT_EQ(g.decide(0.0, 0.0), GateDecision::Start);
+  EXPECT_EQ(g.decide(0.1, 1e12), GateDecision::Accept);
+  EXPECT_EQ(g.decide(0.2, std::numeric_limits<double>::quiet_NaN()), GateDecision::Reject);
+  EXPECT_THROW(TrackGate(2, {1.0 + 1e-9, 2}), core::InvalidInput);
+}

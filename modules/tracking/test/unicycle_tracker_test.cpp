@@ -174,7 +174,7 @@ TEST(UnicycleTracker, RefusesAnInvalidConfig) {
   c.predictor_window = 1;
   EXPECT_THROW(UnicycleTracker{c}, core::InvalidInput);
   c = config();
-  c.gate.probability = 1.0;
+  c.gate.probability = 0.0;
   EXPECT_THROW(UnicycleTracker{c}, core::InvalidInput);
   c = config();
   c.model.q_v = -1.0;

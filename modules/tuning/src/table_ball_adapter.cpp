@@ -12,7 +12,7 @@
 //
 // Noise auto-tuning: the filter's measurements (y, a_xy, t) do not depend on σw, σv within a
 // replay (the closed loop changes the ball's path only in live runs), so the maximum-likelihood
-// search replays the logged measurements through scenarios::RollingBallTracker built as the loop
+// search replays the logged measurements through tracking::RollingBallTracker built as the loop
 // builds it (TableBallConfig::trackerConfig) with other σw (observer.sigma_w) and σv
 // (observer.sigma_v), each replayed update reporting its own innovation, S and NIS (with the
 // stationary gain, S uses the DARE's a-priori covariance). Gross outliers: uniform over the
@@ -32,7 +32,8 @@
 #include "viewline/core/random.h"
 #include "viewline/runtime/telemetry.h"
 #include "viewline/scenarios/table_ball.h"
-#include "viewline/scenarios/table_ball_observer.h"
+#include "viewline/scenarios/table_ball/observer.h"
+#include "viewline/tracking/rolling_ball_tracker.h"
 #include "viewline/tuning/scenario.h"
 #include "viewline/viz/table_ball_display.h"
 
@@ -194,8 +195,8 @@ public:
 
 private:
   /// The observer's filter as the loop builds it, with other noise intensities.
-  scenarios::RollingBallTrackerConfig trackerConfig(double sigma_w, double sigma_v) const {
-    scenarios::RollingBallTrackerConfig tc = cfg_.trackerConfig();
+  tracking::RollingBallTrackerConfig trackerConfig(double sigma_w, double sigma_v) const {
+    tracking::RollingBallTrackerConfig tc = cfg_.trackerConfig();
     tc.model.sigma_w = sigma_w;
     tc.model.sigma_v = sigma_v;
     return tc;
@@ -320,8 +321,8 @@ private:
   /// Replays logged measurements through the observer's filter with (σw, σv).
   void replayRun(const std::vector<BallFrame>& frames, double sigma_w, double sigma_v, double eps, Accum& a,
                  RunSeries* series) const {
-    const scenarios::RollingBallTrackerConfig tc = trackerConfig(sigma_w, sigma_v);
-    scenarios::RollingBallTracker trk(tc);
+    const tracking::RollingBallTrackerConfig tc = trackerConfig(sigma_w, sigma_v);
+    tracking::RollingBallTracker trk(tc);
     const double side = tc.model.table_side - 2.0 * tc.model.ball_radius;
     const double log_u = -std::log(side * side);
     Curve err{"error", {}, {}}, tru{"truth", {}, {}}, est{"estimate", {}, {}}, pre{"prediction", {}, {}};

@@ -44,7 +44,9 @@ inline bool uses(GateDecision d) { return d != GateDecision::Reject; }
 
 /// Configuration of a track's chi-square gate, restart and coasting life cycle.
 struct TrackGateConfig {
-  double probability = 0.999;  ///< chi-square acceptance probability, in (0, 1)
+  /// Chi-square acceptance probability, in (0, 1]; 1 turns the test off (every measurement with a
+  /// finite NIS is accepted, so the track never restarts) for filters shipped without a gate.
+  double probability = 0.999;
   int restart_after = 3;       ///< rejections in a row (of one source) that restart the track, >= 1
   double max_coast_s = std::numeric_limits<double>::infinity();  ///< > 0; inf: a track never goes stale
   void validate(const char* what = "gate") const;  ///< throws core::InvalidInput naming `what`

@@ -42,7 +42,8 @@ struct MobileCaptureConfig {
 
   // Timing.
   double vision_period = 0.1;           ///< s ([K]); also the profile step and the planner's T
-  double control_period = 0.01;         ///< s ([K]: wheel PID every 10 ms)
+  // The control period (key timing.control_period) is the base's wheel-PID period,
+  // base.control_period ([K]: 10 ms): controlPeriod() asks it.
 
   // Camera (320x240, 50° x 40°).
   unsigned width = 320, height = 240;
@@ -85,7 +86,10 @@ struct MobileCaptureConfig {
   int horizon_steps = 200;              ///< M of [K] eq 30
 
   // Planning and control.
+  /// The planner's own settings (reach, turn_rate); its T and v_max belong to vision_period and
+  /// base.max_speed and are filled in by plannerParams(), so they are not read from here.
   planning::CapturePlannerParams planner;
+  /// The go-to-point law's gains; its speed and turn-rate limits are the base's (goParams()).
   control::GoToPointParams go;
   control::SearchParams search;
 
@@ -103,6 +107,13 @@ struct MobileCaptureConfig {
   double fov_sweep_pixel_sigma = 0.5;   ///< px noise added to the projected pixels
 
   int threads = 2;                      ///< parallel runs in runMobileCaptureBatch
+
+  /// The control tick (s): the base's wheel-PID period, which every other control-rate step follows.
+  double controlPeriod() const { return base.control_period; }
+  /// The planner's parameters as it runs: T = vision_period, v_max = base.max_speed.
+  planning::CapturePlannerParams plannerParams() const;
+  /// The go-to-point law as it runs: speed and turn-rate limits from the base.
+  control::GoToPointParams goParams() const;
 
   /// The defaults above plus [K]'s red-object detector settings.
   static MobileCaptureConfig defaults();

@@ -12,7 +12,7 @@
 #include "viewline/core/camera.h"
 #include "viewline/io/config.h"
 #include "viewline/robots/table_tilt.h"
-#include "viewline/scenarios/table_ball_observer.h"
+#include "viewline/scenarios/table_ball/observer.h"
 
 namespace viewline::scenarios {
 
@@ -87,7 +87,7 @@ struct TableBallConfig {
   Eigen::Vector2d setpointAt(double t) const;
   /// The rolling-ball filter as the observer runs it: the configured tuning on this table
   /// (L, r) with the camera's frame period as its nominal period.
-  RollingBallTrackerConfig trackerConfig() const;
+  tracking::RollingBallTrackerConfig trackerConfig() const;
   /// The controller: the configured weights, the camera's period, and what it asks the wrist
   /// it commands: its limits, and its delay, which with the processing latency is the model delay.
   control::TableBalancerConfig controllerConfig(const robots::TableTilt& wrist) const;

@@ -18,7 +18,7 @@
 #include "viewline/runtime/telemetry.h"
 #include "viewline/scenarios/table_ball/config.h"
 #include "viewline/scenarios/table_ball/metrics.h"
-#include "viewline/scenarios/table_ball_observer.h"
+#include "viewline/scenarios/table_ball/observer.h"
 
 namespace viewline::scenarios {
 

@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "viewline/scenarios/table_ball/config.h"
-#include "viewline/scenarios/table_ball_observer.h"
+#include "viewline/scenarios/table_ball/observer.h"
 #include "viewline/sim/physics.h"
 
 namespace viewline::scenarios {
@@ -64,7 +64,7 @@ void printTableBallSummary(std::FILE* out, const TableBallResult& r, const Table
 
 /// The side filters run beside the loop on the same measurements ([M]'s two tunings and the
 /// stationary gain), in the order of the result's fields.
-using SideFilters = std::vector<std::pair<std::string, RollingBallTracker>>;
+using SideFilters = std::vector<std::pair<std::string, tracking::RollingBallTracker>>;
 
 class TableBallMetrics {
 public:
@@ -76,7 +76,7 @@ public:
   void tick(double t, const Eigen::Vector2d& p);
   /// One frame (stamp t), with the truth at its capture instant, what the observer made of it
   /// (dropped frames: its prediction), its filter, and the side filters after their step.
-  void frame(double t, const sim::TiltTableState& truth, const ObserverFrame& of, const RollingBallTracker& tracker,
+  void frame(double t, const sim::TiltTableState& truth, const ObserverFrame& of, const tracking::RollingBallTracker& tracker,
              const SideFilters& side);
   /// Wall-clock and thread-CPU seconds of the observer and of the plain reference on one frame.
   void timing(double observer_s, double reference_s, double observer_cpu_s, double reference_cpu_s);

@@ -15,7 +15,7 @@
 #include "viewline/robots/table_tilt.h"
 #include "viewline/runtime/frame_source.h"
 #include "viewline/scenarios/table_ball/config.h"
-#include "viewline/scenarios/table_ball_observer.h"
+#include "viewline/scenarios/table_ball/observer.h"
 #include "viewline/sim/physics.h"
 #include "viewline/sim/rig.h"
 #include "viewline/sim/worlds.h"

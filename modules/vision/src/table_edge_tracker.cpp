@@ -1,4 +1,4 @@
-#include "viewline/scenarios/table_edge_tracker.h"
+#include "viewline/vision/table_edge_tracker.h"
 
 #include <algorithm>
 #include <cmath>
@@ -6,7 +6,7 @@
 
 #include "viewline/vision/color.h"
 
-namespace viewline::scenarios {
+namespace viewline::vision {
 
 namespace {
 
@@ -47,7 +47,7 @@ bool fitLine(std::vector<Eigen::Vector2d>& pts, Eigen::Vector2d& c, Eigen::Vecto
 
 }  // namespace
 
-TableEdgeTracker::TableEdgeTracker(const vision::TableDetectorConfig& detector, const TableEdgeTrackerConfig& config)
+TableEdgeTracker::TableEdgeTracker(const TableDetectorConfig& detector, const TableEdgeTrackerConfig& config)
     : detector_(detector), config_(config) {
   if (detector_.ball_open_kernel_px > 1) {
     kernel_ = cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(detector_.ball_open_kernel_px, detector_.ball_open_kernel_px));
@@ -108,7 +108,7 @@ std::optional<std::array<Eigen::Vector2d, 4>> TableEdgeTracker::trackCorners(
   return out;
 }
 
-std::optional<vision::Circle> TableEdgeTracker::trackBall(const cv::Mat& bgr, const vision::Circle& previous) {
+std::optional<Circle> TableEdgeTracker::trackBall(const cv::Mat& bgr, const Circle& previous) {
   const double half = config_.ball_window_factor * previous.radius + config_.ball_margin_px;
   const cv::Rect roi = vision::squareRoi(previous.center.x(), previous.center.y(), half, bgr.size());
   if (roi.width < 8 || roi.height < 8) return std::nullopt;
@@ -140,7 +140,7 @@ std::optional<vision::Circle> TableEdgeTracker::trackBall(const cv::Mat& bgr, co
   cv::Point2f centre;
   float r = 0.0F;
   cv::minEnclosingCircle(*ball, centre, r);
-  vision::Circle c{Eigen::Vector2d(static_cast<double>(centre.x), static_cast<double>(centre.y)), static_cast<double>(r)};
+  Circle c{Eigen::Vector2d(static_cast<double>(centre.x), static_cast<double>(centre.y)), static_cast<double>(r)};
   std::vector<cv::Point2f> edge;
   constexpr double kStep = 0.25;
   const double reach = 3.0;
@@ -201,4 +201,4 @@ std::optional<vision::Circle> TableEdgeTracker::trackBall(const cv::Mat& bgr, co
   return c;
 }
 
-}  // namespace viewline::scenarios
+}  // namespace viewline::vision

@@ -23,7 +23,7 @@
 
 #include "viewline/vision/table_detector.h"
 
-namespace viewline::scenarios {
+namespace viewline::vision {
 
 struct TableEdgeTrackerConfig {
   int samples_per_side = 14;
@@ -36,19 +36,19 @@ struct TableEdgeTrackerConfig {
 
 class TableEdgeTracker {
 public:
-  TableEdgeTracker(const vision::TableDetectorConfig& detector, const TableEdgeTrackerConfig& config = {});
+  TableEdgeTracker(const TableDetectorConfig& detector, const TableEdgeTrackerConfig& config = {});
 
   /// New corners (order P0..P3 kept) from the previous ones, or nullopt.
   std::optional<std::array<Eigen::Vector2d, 4>> trackCorners(const cv::Mat& bgr,
                                                              const std::array<Eigen::Vector2d, 4>& previous) const;
   /// The ball circle in a window around the previous one, or nullopt.
-  std::optional<vision::Circle> trackBall(const cv::Mat& bgr, const vision::Circle& previous);
+  std::optional<Circle> trackBall(const cv::Mat& bgr, const Circle& previous);
 
 private:
-  vision::TableDetectorConfig detector_;
+  TableDetectorConfig detector_;
   TableEdgeTrackerConfig config_;
   cv::Mat kernel_, blurred_, hls_, mask_;
   std::vector<std::vector<cv::Point>> contours_;
 };
 
-}  // namespace viewline::scenarios
+}  // namespace viewline::vision

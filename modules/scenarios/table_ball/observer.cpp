@@ -1,6 +1,5 @@
-#include "viewline/scenarios/table_ball_observer.h"
+#include "viewline/scenarios/table_ball/observer.h"
 
-#include <Eigen/Cholesky>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -43,90 +42,6 @@ Eigen::Isometry3d borderAwareTablePose(const core::Camera& camera, const std::ar
     pose = next;
   }
   return pose;
-}
-
-// -------------------------------------------------------------------------------------------
-
-RollingBallTracker::RollingBallTracker(const RollingBallTrackerConfig& config) : config_(config) {
-  config_.model.validate();
-  core::requirePositive(config_.nominal_period, "RollingBallTrackerConfig.nominal_period");
-  core::requirePositive(config_.initial_velocity_std, "RollingBallTrackerConfig.initial_velocity_std");
-  if (config_.stationary_gain) stationary_ = config_.model.stationaryFilter(config_.nominal_period);
-}
-
-Eigen::MatrixXd RollingBallTracker::P() const {
-  if (stationary_) return stationary_->Pf;
-  return initialized_ ? state_.P() : Eigen::MatrixXd::Zero(6, 6);
-}
-
-void RollingBallTracker::step(double t, const Eigen::Vector2d& a_xy, const std::optional<Eigen::Vector2d>& y) {
-  core::requireFinite(t, "RollingBallTracker::step: t");
-  core::requireFinite(a_xy, "RollingBallTracker::step: a_xy");
-  const auto& model = config_.model;
-  last_update_.reset();
-  if (!initialized_) {
-    if (!y) return;
-    core::requireFinite(*y, "RollingBallTracker::step: measurement");
-    x_ = Eigen::VectorXd::Zero(6);
-    x_[0] = (*y)[0];
-    x_[2] = (*y)[1];
-    model.clamp(x_);
-    const double sv = model.sigma_v, sp = config_.initial_velocity_std;
-    const double sw = std::max(model.sigma_w, 1e-3);
-    Eigen::VectorXd d(6);
-    d << sv * sv, sp * sp, sv * sv, sp * sp, sw * sw, sw * sw;
-    state_ = estimation::StateEstimate(x_, d.asDiagonal(), t);
-    t_ = t;
-    initialized_ = true;
-    missed_ = 0;
-    predictions_ = model.predictPositions(x_, last_dt_, a_xy);
-    last_update_ = BallUpdate{tracking::GateDecision::Start, {}};
-    last_update_->report.rows = 2;
-    return;
-  }
-  if (!(t > t_)) throw core::InvalidInput("RollingBallTracker::step: time must increase");
-  const double dt = t - t_;
-  const estimation::LinearTransition tr = model.transition(dt, a_xy);  // rediscretised every frame
-  if (stationary_) {
-    if (y) {
-      last_update_ = BallUpdate{tracking::GateDecision::Accept, stationaryInnovation(tr, *y)};
-      nis_ = last_update_->report.nis;
-      x_ = model.stationaryStep(*stationary_, tr, x_, *y);
-    } else {
-      x_ = tr.Phi * x_ + tr.Gamma * tr.u;
-      model.clamp(x_);
-    }
-  } else {
-    estimation::predict(state_, tr);
-    model.clampEstimate(state_);
-    if (y) {
-      last_update_ = BallUpdate{tracking::GateDecision::Accept, estimation::update(state_, model.measurement(*y))};
-      nis_ = last_update_->report.nis;
-      model.clampEstimate(state_);
-    }
-    x_ = state_.x();
-  }
-  missed_ = y ? 0 : missed_ + 1;
-  t_ = t;
-  last_dt_ = dt;
-  predictions_ = model.predictPositions(x_, dt, a_xy);
-}
-
-estimation::UpdateReport RollingBallTracker::stationaryInnovation(const estimation::LinearTransition& tr,
-                                                                 const Eigen::Vector2d& y) const {
-  // The innovation RollingBallModel::stationaryStep fuses, with the stationary a-priori
-  // covariance (read only: the step itself stays the model's).
-  Eigen::VectorXd xp = tr.Phi * x_;
-  if (tr.u.size() > 0) xp += tr.Gamma * tr.u;
-  const estimation::LinearMeasurement m = config_.model.measurement(y);
-  estimation::UpdateReport rep;
-  rep.rows = 2;
-  rep.innovation = y - m.C * xp;
-  rep.S = m.C * stationary_->P * m.C.transpose() + m.R;
-  const Eigen::LLT<Eigen::MatrixXd> llt(rep.S);
-  rep.nis = llt.info() == Eigen::Success ? rep.innovation.dot(llt.solve(rep.innovation))
-                                         : std::numeric_limits<double>::quiet_NaN();
-  return rep;
 }
 
 // -------------------------------------------------------------------------------------------

@@ -19,19 +19,14 @@
 //     the unknown-radius variant solves r from z = r first;
 //  3. measured tilt: table_R_world = c_R_tᵀ c_R_w, input a_xy = (5/7)[table_R_world g_w]_xy
 //     (estimation::rollingBallAcceleration). Without a table pose the last one is kept;
-//  4. rolling-ball filter (estimation::RollingBallModel): Φ, Γ, Q rediscretised every frame for
-//     the actual interval and the measured a_xy (Van Loan), time update with the border clamp,
-//     measurement update with y = p_t.xy when the ball was found, else prediction only; or the
-//     stationary gain of the DARE (option);
-//  5. the next N (= 10) positions predicted from the filtered state (clamped at the borders).
+//  4-5. tracking::RollingBallTracker: the rolling-ball filter (estimation::RollingBallModel)
+//     fed y = p_t.xy when the ball was found, else prediction only, and the next N (= 10)
+//     predicted positions.
 //
 // Fast path (ours; option edge_tracking, corners mode): after a frame where table and ball
 // were found, the next frame tracks the four sides and the ball locally (TableEdgeTracker) and
 // re-solves the same PnP from the previous pose; [M]'s full pipeline runs on the first frame and
-// whenever tracking fails.
-//
-// RollingBallTracker is step 3-5 alone (no images), so other tunings can run on the same
-// measurements side by side.
+// whenever tracking fails (vision::TableEdgeTracker).
 
 #include <Eigen/Geometry>
 #include <memory>
@@ -40,13 +35,10 @@
 #include <vector>
 
 #include "viewline/core/camera.h"
-#include "viewline/estimation/kalman_filter.h"
-#include "viewline/estimation/models/rolling_ball.h"
-#include "viewline/estimation/state.h"
-#include "viewline/tracking/track_gate.h"
+#include "viewline/tracking/rolling_ball_tracker.h"
 #include "viewline/vision/apriltag_detector.h"
-#include "viewline/scenarios/table_edge_tracker.h"
 #include "viewline/vision/table_detector.h"
+#include "viewline/vision/table_edge_tracker.h"
 
 namespace viewline::scenarios {
 
@@ -60,62 +52,6 @@ Eigen::Isometry3d borderAwareTablePose(const core::Camera& camera, const std::ar
 /// (robots::TableTilt convention): θx = atan2(R21, R11), θy = atan2(R02, R00).
 Eigen::Vector2d tiltFromTableRotation(const Eigen::Matrix3d& w_R_t);
 
-struct RollingBallTrackerConfig {
-  estimation::RollingBallModel model;      ///< σw, β, σv, L, r, N
-  bool stationary_gain = false;            ///< use the DARE gain for the nominal frame period
-  double nominal_period = 0.02;            ///< s, for the stationary gain
-  double initial_velocity_std = 0.5;       ///< m/s, prior on the velocity at the first detection
-};
-
-/// What one step did with its measurement. The filter has no gate: the first measurement starts
-/// the track (Start, no innovation), every later one is fused (Accept). The report is the
-/// update's own: d = y − C x̂(t|t−), S = C P(t|t−) Cᵀ + σv² I (with the stationary gain, P(t|t−)
-/// is the DARE's a-priori covariance), NIS = dᵀ S⁻¹ d with 2 degrees of freedom.
-struct BallUpdate {
-  tracking::GateDecision decision = tracking::GateDecision::Accept;
-  estimation::UpdateReport report;
-};
-
-/// The filter part of the observer (steps 3-5).
-class RollingBallTracker {
-public:
-  explicit RollingBallTracker(const RollingBallTrackerConfig& config);
-
-  /// Advances to time t with the measured in-plane acceleration a_xy, fusing the ball position
-  /// y (table frame, m) when present. Before the first measurement nothing is estimated.
-  void step(double t, const Eigen::Vector2d& a_xy, const std::optional<Eigen::Vector2d>& y);
-
-  bool initialized() const { return initialized_; }
-  /// State (p_x, v_x, p_y, v_y, w2_x, w2_y) at the last step.
-  const Eigen::VectorXd& x() const { return x_; }
-  Eigen::Vector2d position() const { return {x_[0], x_[2]}; }
-  Eigen::Vector2d velocity() const { return {x_[1], x_[3]}; }
-  /// Covariance (time-varying filter) or the stationary filtered covariance.
-  Eigen::MatrixXd P() const;
-  /// The N predicted positions after the last step (one frame interval apart).
-  const std::vector<Eigen::Vector2d>& predictions() const { return predictions_; }
-  /// NIS of the last fused measurement (0 before any).
-  double lastNis() const { return nis_; }
-  /// The last step's measurement update; empty when that step had no measurement.
-  const std::optional<BallUpdate>& lastUpdate() const { return last_update_; }
-  int missedStreak() const { return missed_; }
-  const RollingBallTrackerConfig& config() const { return config_; }
-
-private:
-  estimation::UpdateReport stationaryInnovation(const estimation::LinearTransition& tr, const Eigen::Vector2d& y) const;
-  RollingBallTrackerConfig config_;
-  bool initialized_ = false;
-  double t_ = 0.0;
-  double last_dt_ = 0.02;
-  Eigen::VectorXd x_ = Eigen::VectorXd::Zero(6);
-  estimation::StateEstimate state_;
-  std::optional<estimation::StationaryFilter> stationary_;
-  std::vector<Eigen::Vector2d> predictions_;
-  double nis_ = 0.0;
-  int missed_ = 0;
-  std::optional<BallUpdate> last_update_;
-};
-
 enum class TablePoseSource { Corners, AprilTag };
 enum class BallGeometry { KnownRadius, UnknownRadius };
 
@@ -126,9 +62,9 @@ struct TableBallObserverConfig {
   double border_height = 0.02;                        ///< m, raised border above the surface (0: plain [M] PnP)
   std::vector<vision::TagOnTable> tag_layout;         ///< AprilTag alternative: tags in the table frame
   vision::AprilTagDetectorConfig tag_detector;
-  RollingBallTrackerConfig tracker;
+  tracking::RollingBallTrackerConfig tracker;  ///< the rolling-ball filter (steps 4-5)
   bool edge_tracking = true;                          ///< fast path between full detections (corners mode)
-  TableEdgeTrackerConfig edge_tracker;
+  vision::TableEdgeTrackerConfig edge_tracker;  ///< the fast path's settings
   Eigen::Vector3d gravity_w = Eigen::Vector3d(0.0, 0.0, -9.81);
 };
 
@@ -169,7 +105,7 @@ public:
   const ObserverFrame& predictOnly(double t);
 
   const ObserverFrame& last() const { return frame_; }
-  const RollingBallTracker& tracker() const { return tracker_; }
+  const tracking::RollingBallTracker& tracker() const { return tracker_; }
   const TableBallObserverConfig& config() const { return config_; }
 
 private:
@@ -178,8 +114,8 @@ private:
   TableBallObserverConfig config_;
   vision::TableDetector detector_;
   std::unique_ptr<vision::AprilTagTableDetector> tags_;
-  RollingBallTracker tracker_;
-  TableEdgeTracker edges_;
+  tracking::RollingBallTracker tracker_;
+  vision::TableEdgeTracker edges_;
   ObserverFrame frame_;
   bool have_table_ = false;
   bool need_prior_ = true;

@@ -1,0 +1,99 @@
+#pragma once
+// The rolling-ball track of [M] (Andersen, "Ball on a tilting table", the table-ball observer's
+// filter): a ball rolling on a tilting table, seen as its position on the table (table frame,
+// metres), driven by the in-plane acceleration measured from the table's tilt.
+//
+// Per step (time t, measured a_xy = (5/7)[table_R_world g_w]_xy, optional position y):
+//  - the model (estimation::RollingBallModel) is rediscretised for the actual interval and a_xy
+//    (Φ, Γ, Q by Van Loan), the time update clamps the ball at the borders;
+//  - the measurement y goes through the shared track life cycle (tracking::TrackGate): the first
+//    one starts the track, later ones are tested on the update's own NIS
+//    d = y − C x̂(t|t−), S = C P(t|t−) Cᵀ + σv² I, NIS = dᵀ S⁻¹ d (2 degrees of freedom) and
+//    fused when accepted; a restart re-initialises the track from y. The shipped config turns the
+//    test off (probability 1: every finite NIS is accepted), as [M]'s filter has no gate;
+//  - or, with `stationary_gain`, the DARE's constant gain for the nominal period ([M]'s option;
+//    P(t|t−) is then the DARE's a-priori covariance);
+//  - the next N positions are predicted from the filtered state (clamped at the borders).
+
+#include <Eigen/Core>
+#include <optional>
+#include <vector>
+
+#include "viewline/estimation/kalman_filter.h"
+#include "viewline/estimation/models/rolling_ball.h"
+#include "viewline/estimation/state.h"
+#include "viewline/tracking/track_gate.h"
+
+namespace viewline::tracking {
+
+/// Settings of RollingBallTracker.
+struct RollingBallTrackerConfig {
+  estimation::RollingBallModel model;  ///< σw, β, σv, table side L, ball radius r, predicted steps N
+  bool stationary_gain = false;        ///< use the DARE gain for the nominal frame period
+  double nominal_period = 0.02;        ///< s, for the stationary gain
+  double initial_velocity_std = 0.5;   ///< m/s, prior on the velocity at the first detection
+  /// The measurement gate and restart rule; probability 1 (the default) accepts every finite NIS.
+  TrackGateConfig gate{1.0, 3};
+  /// Throws core::InvalidInput naming the first bad value.
+  void validate() const;
+};
+
+/// What one step did with its measurement: the gate's decision and the update's own innovation
+/// report (for Start, no innovation: rows = 2, empty innovation).
+struct BallUpdate {
+  GateDecision decision = GateDecision::Accept;  ///< Start, Accept, Reject or Restart
+  estimation::UpdateReport report;               ///< d, S and NIS of the update (2 rows)
+};
+
+/// The filter part of the table-ball observer: ball position and velocity on the table.
+class RollingBallTracker {
+public:
+  /// Throws core::InvalidInput when the config is invalid.
+  explicit RollingBallTracker(const RollingBallTrackerConfig& config);
+
+  /// Advances to time t (s, increasing) with the measured in-plane acceleration a_xy (m/s², table
+  /// frame), fusing the ball position y (table frame, m) when present and accepted by the gate.
+  /// Before the first measurement nothing is estimated.
+  void step(double t, const Eigen::Vector2d& a_xy, const std::optional<Eigen::Vector2d>& y);
+
+  /// True once a measurement has started the track.
+  bool initialized() const { return initialized_; }
+  /// State (p_x, v_x, p_y, v_y, w2_x, w2_y) at the last step (m, m/s, m/s²; table frame).
+  const Eigen::VectorXd& x() const { return x_; }
+  /// Ball position on the table (m, table frame) at the last step.
+  Eigen::Vector2d position() const { return {x_[0], x_[2]}; }
+  /// Ball velocity on the table (m/s, table frame) at the last step.
+  Eigen::Vector2d velocity() const { return {x_[1], x_[3]}; }
+  /// Covariance (time-varying filter) or the stationary filtered covariance.
+  Eigen::MatrixXd P() const;
+  /// The N predicted positions after the last step (one frame interval apart; m, table frame).
+  const std::vector<Eigen::Vector2d>& predictions() const { return predictions_; }
+  /// NIS of the last fused measurement (0 before any).
+  double lastNis() const { return nis_; }
+  /// The last step's gate decision and update; empty when that step had no measurement.
+  const std::optional<BallUpdate>& lastUpdate() const { return last_update_; }
+  /// Steps in a row without a fused measurement.
+  int missedStreak() const { return missed_; }
+  /// The gate's decision counts (starts, accepted, rejected, restarts).
+  const GateCounts& gateCounts() const { return gate_.counts(); }
+  /// The config the tracker was built with.
+  const RollingBallTrackerConfig& config() const { return config_; }
+
+private:
+  void start(double t, const Eigen::Vector2d& a_xy, const Eigen::Vector2d& y, GateDecision why);
+  estimation::UpdateReport stationaryInnovation(const estimation::LinearTransition& tr, const Eigen::Vector2d& y) const;
+  RollingBallTrackerConfig config_;
+  TrackGate gate_;
+  bool initialized_ = false;
+  double t_ = 0.0;
+  double last_dt_ = 0.02;
+  Eigen::VectorXd x_ = Eigen::VectorXd::Zero(6);
+  estimation::StateEstimate state_;
+  std::optional<estimation::StationaryFilter> stationary_;
+  std::vector<Eigen::Vector2d> predictions_;
+  double nis_ = 0.0;
+  int missed_ = 0;
+  std::optional<BallUpdate> last_update_;
+};
+
+}  // namespace viewline::tracking
