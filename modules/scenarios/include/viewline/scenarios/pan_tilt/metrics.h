@@ -27,7 +27,7 @@ namespace viewline::scenarios {
 /// One controller's run: image error, target-position errors, limits, occlusion and filter
 /// figures. Errors are taken from metrics_start on, leaving out the occlusion and the 2 s after it.
 struct PanTiltRunMetrics {
-  std::string controller;  ///< "predictive" or "baseline"
+  std::string controller;  ///< "predictive" or "visp_baseline"
   std::size_t frames = 0,         ///< frames captured
               detections = 0,     ///< frames in which the target was detected
               metric_frames = 0;  ///< frames inside the metric window
