@@ -58,10 +58,11 @@ struct DartSummary {
   double update_time_us = 0.0;  ///< mean ViewlineTracker::submit time in C (exact)
   // D
   GateFigures scenario_gate;    ///< full scenario with the configured gate (rmse_position = scenario RMSE)
-  double late_vs_inorder_max_diff = 0.0;  ///< max difference of final x, P and time, arrival vs capture order
+  /// Largest difference of the final x, P and time between arrival and capture order.
+  double late_vs_inorder_max_diff = 0.0;
   std::size_t late_inserted = 0;            ///< late measurements inserted into the past (replayed)
   std::size_t late_outcome_mismatches = 0;  ///< detections whose fate differs between the two orders
-  std::size_t late_refused = 0;             ///< arrivals the tracker refused (e.g. older than late_horizon)
+  std::size_t late_refused = 0;             ///< arrivals refused (e.g. older than late_horizon)
   // E
   /// 95th percentile (nearest rank) of the measurements needed to stay within single_tolerance of
   /// the filter started at the truth (a count).

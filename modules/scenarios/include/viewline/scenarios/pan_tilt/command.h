@@ -29,7 +29,7 @@ struct CommandOptions {
   std::string log_dir,                  ///< --log folder for the CSV logs ("" : none)
               summary_path;             ///< --summary JSON file ("" : none)
   bool quiet = false;                   ///< no progress lines
-  runtime::Pacing pacing;               ///< wall-clock pacing of the loop (--realtime); as fast as possible by default
+  runtime::Pacing pacing;               ///< wall-clock pacing of the loop (default: as fast as possible)
   std::string replay;                   ///< frames CSV of a logged run: filter-only replay instead of the loop
   PanTiltReplayEstimator estimator = PanTiltReplayEstimator::Filter;  ///< the replay's estimator
   std::size_t particles = 20000;        ///< of PanTiltReplayEstimator::WaypointParticles

@@ -44,7 +44,7 @@ struct TableBallConfig {
   unsigned width = 320,   ///< image width, px
            height = 240;  ///< image height, px
   double hfov = 1.5707963267948966;                            ///< rad (90°)
-  std::optional<double> cx,                                    ///< principal point u, px (absent: image centre)
+  std::optional<double> cx,                                    ///< principal point u, px (absent: centre)
                         cy;                                    ///< principal point, px (absent: image centre)
   double rate_hz = 50.0;                                       ///< camera frame rate, Hz
   /// Rest position of the head camera's optical centre, m (world).
