@@ -45,7 +45,7 @@ namespace viewline::scenarios {
 
 /// What a live view gets for every image.
 struct CatchFrame {
-  int throw_index = 0;     ///< index of the throw in the session
+  int throw_index = 0;     ///< index of the throw in runBallCatching()
   std::size_t camera = 0;  ///< index of the camera that took the image (config order)
   const core::Camera* camera_model = nullptr;   ///< what the estimator believes (calibrated with rig:)
   double t = 0.0;                               ///< s, capture stamp on the throw's clock (from 0)
@@ -56,7 +56,7 @@ struct CatchFrame {
   std::optional<Eigen::Vector3d> estimate;      ///< tracker position
 };
 
-/// Optional observers of a session: telemetry per throw, live view, progress, pacing.
+/// Optional observers of runBallCatching(): telemetry per throw, live view, progress, pacing.
 struct CatchHooks {
   /// The telemetry sink of throw i, or null. Called once per throw, from the thread running it:
   /// with threads > 1 return a distinct sink per throw. The throw flushes it and drops its

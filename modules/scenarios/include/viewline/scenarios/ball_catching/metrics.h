@@ -39,8 +39,8 @@ namespace viewline::scenarios {
 /// Everything one throw measured: the draw, the truth, what the tracker and planner did, the
 /// outcome (world frame, s and m unless the name says otherwise).
 struct ThrowResult {
-  int index = 0;           ///< throw index in the session
-  std::uint64_t seed = 0;  ///< the throw's own seed (deriveSeed(session seed, index))
+  int index = 0;           ///< throw index (0-based)
+  std::uint64_t seed = 0;  ///< the throw's own seed (deriveSeed(runBallCatching's seed, index))
   // Throw
   Eigen::Vector3d release = Eigen::Vector3d::Zero(),          ///< release point, m (world)
                   launch_velocity = Eigen::Vector3d::Zero();  ///< velocity at release, m/s (world)
@@ -77,9 +77,9 @@ struct ThrowResult {
   double wall_s = 0.0;  ///< wall-clock time the throw took to simulate, s
 };
 
-/// A session's figures (the summary JSON): catch rates, prediction errors, decisions, limits.
+/// The figures of runBallCatching() (the summary JSON): catch rates, prediction errors, decisions, limits.
 struct CatchSummary {
-  std::uint64_t seed = 0;  ///< session seed
+  std::uint64_t seed = 0;  ///< the seed runBallCatching() was given
   int throws = 0,            ///< throws run
       reachable_throws = 0,  ///< throws the oracle could catch
       caught = 0,            ///< throws caught
@@ -112,7 +112,7 @@ struct CatchSummary {
          elevation_deg_max = 0.0;  ///< degrees
   double flight_time_min = 0.0,  ///< release to crossing over the throws, s
          flight_time_max = 0.0;  ///< s
-  double wall_s = 0.0,        ///< wall-clock time of the session, s (set by the caller)
+  double wall_s = 0.0,        ///< wall-clock time of all throws, s (set by the caller)
          ms_per_frame = 0.0;  ///< wall-clock per image, ms
   std::vector<ThrowResult> results;  ///< every throw, in throw order
 };

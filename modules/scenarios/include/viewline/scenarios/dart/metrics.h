@@ -29,7 +29,7 @@ struct GateFigures {
 
 /// The figures of experiments A-E over all runs (see loop.h for what each experiment does).
 struct DartSummary {
-  std::uint64_t seed = 0;  ///< session seed
+  std::uint64_t seed = 0;  ///< the seed runDartExperiments() was given
   int runs = 0;            ///< seeded runs (one flight per experiment each)
   // A
   double nees_mean = 0.0;             ///< 6-dof state NEES, one sample per run

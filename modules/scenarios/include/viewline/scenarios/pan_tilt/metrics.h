@@ -40,7 +40,7 @@ struct PanTiltRunMetrics {
   Eigen::Vector2d noise_sigma_cm = Eigen::Vector2d::Zero();  ///< [T]'s measurement noise std (x, y), cm
   double detection_pixel_rmse_px = 0.0;  ///< detector error (before [T] noise) vs the true centre projection
   // limits
-  std::size_t commands = 0,         ///< joint velocity commands issued
+  std::size_t commands = 0,         ///< joint velocity commands sent
               unsafe_commands = 0,  ///< commands the law could not keep within the limits (predicted state)
               rate_violations = 0,  ///< commands above q̇max (the unit clipped them)
               limit_hits = 0;       ///< times a joint reached a hard stop while moving towards it
@@ -53,7 +53,7 @@ struct PanTiltRunMetrics {
        reacquired = false;  ///< a measurement was used again after the occlusion ended
   double reacquisition_delay_s = std::nan("");  ///< s from the occlusion's end to that measurement (NaN: never)
   std::size_t reacquisitions = 0;    ///< times ours' filter restarted after losing the target
-  std::size_t frames_searching = 0;  ///< commands issued while searching for the target
+  std::size_t frames_searching = 0;  ///< commands sent while searching for the target
   std::size_t filter_jumps = 0;              ///< velocity jumps (corners) the filter detected (ours)
   /// Ours, Kalman models with jump detection: the corner settings in force at the end of the run (the
   /// configured filter.jump_min_samples / jump_corner_sigma, or what "auto" made of them); 0 otherwise.
