@@ -36,7 +36,7 @@ struct CatchCameraConfig {
   double kud = 0.0;                      ///< ViSP forward radial distortion
   /// Optical centre in the world frame, m (the pose c_M_w is built from it and look_at).
   Eigen::Vector3d position = Eigen::Vector3d(1.0, -3.2, 1.9);
-  /// World point on the optical axis, m (image up is world +z).
+  /// World point on the optical axis, m.
   Eigen::Vector3d look_at = Eigen::Vector3d(2.2, 0.0, 1.3);
   double rate_hz = 50.0;  ///< frames per second (nominal, before drift)
   double drift = 0.0;                 ///< relative clock period error

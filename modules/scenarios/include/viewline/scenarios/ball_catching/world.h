@@ -98,8 +98,8 @@ std::vector<sim::SimCamera> throwCameras(const BallCatchingConfig& cfg, core::Rn
 /// The true objects of the last frame (a simulator's privilege) are kept for the metrics.
 class RigFrameSource : public runtime::FrameSource {
 public:
-  /// Builds the rig from `cameras` (rng: their noise and drops; kept by reference, as is world);
-  /// t_end in s on the throw's clock.
+  /// Builds the sim::CameraRig from `cameras` and rng (and throws as it does); world is kept by
+  /// reference; t_end in s on the throw's clock.
   RigFrameSource(std::vector<sim::SimCamera> cameras, core::Rng& rng, const sim::RenderSettings& render,
                  const sim::World& world, double t_end);
   std::size_t cameraCount() const override { return rig_.cameras().size(); }

@@ -35,7 +35,7 @@ struct DartCameraConfig {
 
 /// The dart experiments' whole configuration: rig, throws, detection noise, tracker, experiments.
 struct DartScenarioConfig {
-  std::vector<DartCameraConfig> cameras;  ///< the rig (experiments A-D use the first two)
+  std::vector<DartCameraConfig> cameras;  ///< the rig, in camera-index order
   /// The one owner of gravity: the tracker's model asks trackerConfig() for it.
   Eigen::Vector3d gravity_w{0.0, 0.0, -9.81};
   // Throws.

@@ -17,7 +17,7 @@ namespace viewline::scenarios {
 
 /// How well one gate separated gross outliers from good detections, and the RMSE it left.
 struct GateFigures {
-  std::string gate;  ///< gate name ("directional", "mahalanobis", or the configured one)
+  std::string gate;  ///< gate name ("directional", "mahalanobis"; D: the configured kind)
   std::size_t outliers = 0,           ///< generated outliers submitted
               outliers_rejected = 0,  ///< of which the gate rejected
               inliers = 0,            ///< good detections submitted
@@ -45,7 +45,7 @@ struct DartSummary {
   // B
   GateFigures gate_directional,   ///< the directional gate on B's data
               gate_mahalanobis;   ///< the Mahalanobis gate on the same data
-  std::string better_gate;        ///< name of the gate with the lower RMSE
+  std::string better_gate;        ///< the gate with fewer errors (outliers passed + inliers rejected)
   double outlier_rejected_fraction = 0.0;  ///< better gate
   double inlier_rejected_fraction = 0.0;   ///< better gate
   double rmse_image_ekf_alternating = 0.0;  ///< image-space EKF baseline on B's data, m

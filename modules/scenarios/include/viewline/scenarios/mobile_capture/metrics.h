@@ -38,8 +38,8 @@ void logFilterTest(const FilterTestResult& f, io::LogDirectory& log);
 /// Ground-localisation errors of the field-of-view sweep, over the whole image and by region.
 struct FovSweepResult {
   LocalizationErrors all,     ///< every projected floor point
-                     centre,  ///< points in the image centre
-                     border;  ///< centre: |u - u0| < W/6 and |v - v0| < H/6
+                     centre,  ///< points with |u - W/2| < W/6 and |v - H/2| < H/6
+                     border;  ///< the other points
 };
 /// The field-of-view sweep: floor points seen from random head and base poses (fov_sweep_*),
 /// localised by the exact back-projection and by [K]'s angle-per-pixel method, against the truth.

@@ -24,7 +24,7 @@
 namespace viewline::scenarios {
 
 /// The pan-tilt scenario ([T]): screen and target path, camera, rig, noise, unit, detector,
-/// controller and run settings (SI units; screen frame f: the screen plane in front of the unit).
+/// controller and run settings (SI units; f: the unit's base frame, see pan_tilt/world.h).
 struct PanTiltScenarioConfig {
   // World
   sim::ScreenPathParams path;            ///< shape, speed, centre, width/height, radius (duration set by the run)

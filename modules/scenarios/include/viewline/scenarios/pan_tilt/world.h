@@ -66,7 +66,7 @@ public:
   const Eigen::Isometry3d& f_M_screen() const { return f_M_screen_; }
   /// [T]'s measurement noise std (x, y) on this path, m.
   const Eigen::Vector2d& sigma() const { return sigma_; }
-  /// The measurement covariance diag(σ²) the filter is given, m².
+  /// diag(σ²) of [T]'s noise (kept positive definite), m².
   const Eigen::Matrix2d& R() const { return R_; }
   /// [T]'s noise of the next frame (drawn for every frame, detected or not).
   Eigen::Vector2d drawNoise();
