@@ -36,16 +36,19 @@
 
 namespace viewline::calib {
 
+/// Kind of calibration target (the `type:` key of a board file).
 enum class BoardType { Chessboard, CirclesGrid, AsymmetricCirclesGrid, AprilTagGrid, AprilTag, ChArUco };
 
+/// A calibration target as a board file describes it (metres; board frame x along a row, y down the columns,
+/// z into the board).
 struct BoardSpec {
-  BoardType type = BoardType::Chessboard;
-  int cols = 9;
-  int rows = 6;
-  double spacing = 0.025;
-  std::string tag_family = "36h11";
-  double tag_size = 0.0;
-  int first_id = 0;
+  BoardType type = BoardType::Chessboard;  ///< target kind
+  int cols = 9;  ///< inner corners (chessboard), circles per row, or squares per row (charuco)
+  int rows = 6;  ///< inner corners, circles per column, or squares per column (charuco)
+  double spacing = 0.025;  ///< m between neighbouring corners / circle centres / tag centres (charuco: square edge)
+  std::string tag_family = "36h11";  ///< AprilTag family (apriltag*), e.g. "36h11"
+  double tag_size = 0.0;  ///< m, black border edge of a tag (apriltag*)
+  int first_id = 0;  ///< id of the top-left tag of an apriltag_grid (ids row-major)
   std::vector<int> tag_ids;  ///< apriltag: restrict to these ids (empty = all)
   double marker_size = 0.0;  ///< charuco: ArUco marker edge (m)
   std::string dictionary = "DICT_5X5_100";  ///< charuco: OpenCV ArUco dictionary name
@@ -55,9 +58,11 @@ struct BoardSpec {
   /// Corners (chessboard, charuco: inner corners by id), circle centres or tag corners, in the
   /// board frame (z = 0).
   std::vector<cv::Point3f> objectPoints() const;
+  /// One line describing the board for reports ("chessboard 9x6, 0.025 m").
   std::string describe() const;
 };
 
+/// The board-file spelling of a type ("chessboard", "circles_grid", "apriltag_grid", "charuco", ...).
 std::string toString(BoardType t);
 /// Reads a board from a config node (keys above); marks them read.
 BoardSpec readBoard(const io::ConfigNode& node);
@@ -66,16 +71,16 @@ BoardSpec loadBoard(const std::string& path);
 
 /// One detected view of a board: matching image and board points.
 struct BoardObservation {
-  std::vector<cv::Point2f> image_points;
-  std::vector<cv::Point3f> object_points;
+  std::vector<cv::Point2f> image_points;  ///< detected pixels (sub-pixel), same order as object_points
+  std::vector<cv::Point3f> object_points;  ///< matching points in the board frame (z = 0), m
   std::vector<int> tag_ids;  ///< apriltag*: id of each group of 4 points (same order)
   std::vector<int> corner_ids;  ///< charuco: inner corner id of each point (same order)
 };
 
 /// Detection outcome: observation when found, else a reason ("chessboard 9x6 not found").
 struct Detection {
-  std::optional<BoardObservation> observation;
-  std::string reason;
+  std::optional<BoardObservation> observation;  ///< the matched points when the board was found
+  std::string reason;  ///< why it was not found (empty when found)
 };
 
 /// Detects the board in an 8-bit grey image. Chessboard corners are refined to sub-pixel.

@@ -20,7 +20,9 @@ struct PoseCamera {
   cv::Mat D;  ///< distortion coefficients (OpenCV), empty = none
   std::optional<vpCameraParameters> visp;  ///< when set, poses are refined with ViSP's model (vpPose)
 
+  /// Camera from OpenCV intrinsics (K and distortion coefficients).
   static PoseCamera fromOpenCv(const io::OpenCvIntrinsics& o);
+  /// Camera from ViSP parameters: K without distortion, poses refined with ViSP's model (kud) when it has one.
   static PoseCamera fromVisp(const vpCameraParameters& cam);
   /// Normalised (undistorted) coordinates of pixels.
   std::vector<cv::Point2f> normalize(const std::vector<cv::Point2f>& px) const;
@@ -29,10 +31,11 @@ struct PoseCamera {
   std::vector<cv::Point2d> project(const std::vector<cv::Point3f>& pts, const Eigen::Isometry3d& c_M_o) const;
 };
 
+/// Pose of a board (or tag) in a camera, with its reprojection error.
 struct BoardPose {
-  Eigen::Isometry3d c_M_o = Eigen::Isometry3d::Identity();
-  double rms_px = 0.0;
-  std::size_t points = 0;
+  Eigen::Isometry3d c_M_o = Eigen::Isometry3d::Identity();  ///< board frame o in the camera: p_c = c_M_o * p_o
+  double rms_px = 0.0;  ///< RMS reprojection error after refinement, px
+  std::size_t points = 0;  ///< number of points used
 };
 
 /// Pose of the board (or of one tag) from an observation: PnP (IPPE for planar targets)
@@ -48,17 +51,19 @@ std::map<int, BoardPose> estimateTagPoses(const PoseCamera& cam, const cv::Mat& 
 /// Observations of one board by several cameras at the same instants: views[k][i] is what
 /// camera i saw at instant k (nullopt when it did not see the board).
 struct RigObservations {
-  std::vector<PoseCamera> cameras;
+  std::vector<PoseCamera> cameras;  ///< intrinsics of camera i
+  /// Views[k][i]: what camera i saw at instant k (nullopt: not seen)
   std::vector<std::vector<std::optional<BoardObservation>>> views;
 };
 
+/// Result of calibrateRig(): camera poses relative to the reference camera, board poses and errors.
 struct RigResult {
   std::vector<Eigen::Isometry3d> c_M_ref;     ///< camera i pose: maps reference-camera coords to camera i
   std::vector<Eigen::Isometry3d> ref_M_board; ///< board pose per instant in the reference camera (identity when unseen)
   std::vector<double> camera_rms_px;          ///< reprojection RMS per camera after the joint refinement
   double rms_px = 0.0;                        ///< overall
   std::vector<std::size_t> views_used;        ///< per camera
-  int iterations = 0;
+  int iterations = 0;  ///< Levenberg-Marquardt iterations of the joint refinement
 };
 
 /// Joint estimation of the camera poses (reference = camera `reference`) and of the board poses
@@ -87,6 +92,8 @@ struct GroundResult {
   /// Gravity direction (unit, pointing down) in camera coordinates.
   Eigen::Vector3d down_c() const { return c_M_g.linear() * Eigen::Vector3d(0, 0, -1); }
 };
+/// Ground frame, height, pitch and roll of the camera from poses c_M_o of a board lying flat on the floor
+/// (throws InvalidInput for no pose).
 GroundResult cameraToGround(const std::vector<Eigen::Isometry3d>& c_M_o, BoardType type);
 
 }  // namespace viewline::calib

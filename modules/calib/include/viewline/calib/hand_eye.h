@@ -13,16 +13,20 @@
 
 namespace viewline::calib {
 
+/// Where the camera is: on the end effector (eye-in-hand) or fixed, looking at a board on the end effector
+/// (eye-to-hand).
 enum class HandEyeSetup { EyeInHand, EyeToHand };
 
+/// Result of calibrateHandEye(): the hand-eye pose X, the fixed pose and per-pose residuals.
 struct HandEyeResult {
-  HandEyeSetup setup = HandEyeSetup::EyeInHand;
+  HandEyeSetup setup = HandEyeSetup::EyeInHand;  ///< which problem was solved
   Eigen::Isometry3d X = Eigen::Isometry3d::Identity();      ///< e_M_c (eye-in-hand) or r_M_c (eye-to-hand)
   Eigen::Isometry3d fixed = Eigen::Isometry3d::Identity();  ///< r_M_o (eye-in-hand) or e_M_o (eye-to-hand), averaged
   std::vector<double> residual_translation_m;  ///< per pose: |fixed(i) - mean| translation
   std::vector<double> residual_rotation_rad;   ///< per pose: angle between fixed(i) and mean
-  double rms_translation_m = 0.0;
-  double rms_rotation_rad = 0.0;
+  double rms_translation_m = 0.0;  ///< RMS of residual_translation_m, m
+  double rms_rotation_rad = 0.0;  ///< RMS of residual_rotation_rad, rad
+  /// Human-readable report of X, the fixed pose and the residuals.
   std::string report() const;
 };
 

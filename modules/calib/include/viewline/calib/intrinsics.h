@@ -20,16 +20,19 @@
 
 namespace viewline::calib {
 
+/// One view for intrinsic calibration: its name and the detected board points.
 struct ViewInput {
   std::string name;          ///< image file (for messages)
-  BoardObservation observation;
+  BoardObservation observation;  ///< matched image and board points of the view
 };
 
+/// A view left out of the calibration, with the reason.
 struct RejectedView {
-  std::string name;
-  std::string reason;
+  std::string name;  ///< image file (for messages)
+  std::string reason;  ///< why it was left out (board not found, error above max_view_rms_px, ...)
 };
 
+/// Options of calibrateIntrinsics().
 struct IntrinsicsOptions {
   int min_views = 3;                 ///< fewer usable views is an error
   bool fix_k3 = true;                ///< OpenCV: estimate k1 k2 p1 p2 only (k3 = 0)
@@ -37,21 +40,24 @@ struct IntrinsicsOptions {
   bool fit_visp = true;              ///< also fit ViSP's models with vpCalibration
 };
 
+/// Result of calibrateIntrinsics(): OpenCV's model with standard deviations and ViSP's two models, with per-
+/// view errors.
 struct IntrinsicsResult {
-  cv::Size image_size;
+  cv::Size image_size;  ///< image size, px
   // OpenCV model
-  io::OpenCvIntrinsics opencv;
+  io::OpenCvIntrinsics opencv;  ///< OpenCV model: camera matrix, distortion, size, RMS
   Eigen::VectorXd std_dev;           ///< fx fy cx cy k1 k2 p1 p2 k3 ... (cv::calibrateCamera stdDeviationsIntrinsics)
   double rms_px = 0.0;               ///< overall RMS reprojection error (OpenCV model)
-  std::vector<std::string> view_names;
+  std::vector<std::string> view_names;  ///< names of the views used (same order as view_rms_px)
   std::vector<double> view_rms_px;   ///< per used view
-  std::vector<cv::Mat> rvecs, tvecs; ///< board poses of the used views (OpenCV model)
-  std::vector<RejectedView> rejected;
+  std::vector<cv::Mat> rvecs,        ///< board rotations (Rodrigues) of the used views (OpenCV model)
+                       tvecs;        ///< board translations of the used views, m (OpenCV model)
+  std::vector<RejectedView> rejected;  ///< views left out, with reasons
   // ViSP models (vpCalibration)
-  vpCameraParameters visp_without;
-  vpCameraParameters visp_with;
-  double visp_without_rms_px = -1.0;
-  double visp_with_rms_px = -1.0;
+  vpCameraParameters visp_without;  ///< ViSP model without distortion (px, py, u0, v0)
+  vpCameraParameters visp_with;  ///< ViSP model with distortion (+ kud, kdu)
+  double visp_without_rms_px = -1.0;  ///< RMS reprojection error of visp_without, px (-1: not fitted)
+  double visp_with_rms_px = -1.0;  ///< RMS reprojection error of visp_with, px (-1: not fitted)
   std::vector<vpHomogeneousMatrix> visp_c_M_o;  ///< per used view, model with distortion
 
   /// Human-readable report (parameters, std devs, per-view errors, rejected views).

@@ -13,6 +13,7 @@
 
 namespace viewline::calib {
 
+/// Imaging effects of renderBoard(): blur, noise, background and supersampling.
 struct RenderOptions {
   double blur_sigma_px = 0.6;    ///< Gaussian blur (optics)
   double noise_sigma = 2.0;      ///< grey levels

@@ -44,16 +44,18 @@
 
 namespace viewline::calib {
 
+/// How the synthetic calibration images are made: sensor noise, blur and anti-aliasing.
 struct SyntheticImaging {
   double noise_sigma = 2.0;   ///< grey levels
   double blur_sigma_px = 0.5; ///< Gaussian optical blur
   int supersampling = 4;      ///< renderer anti-aliasing
 };
 
+/// The true rig a simulated scenario renders with (`calib/rigs/<rig>/truth.yaml`).
 struct RigTruth {
-  std::string name;
+  std::string name;  ///< rig name
   std::vector<core::Camera> cameras;        ///< true intrinsics (kud, fitted kdu), size, c_M_w
-  SyntheticImaging imaging;
+  SyntheticImaging imaging;  ///< how its calibration images are made
   std::optional<Eigen::Isometry3d> e_M_c;   ///< pan-tilt: camera on the PTU end effector
   const core::Camera& camera(const std::string& name) const;  ///< throws InvalidInput
 };
@@ -87,11 +89,13 @@ std::vector<Eigen::Vector3d> boardOutline(const BoardSpec& board);
 bool boardFullyVisible(const core::Camera& camera, const Eigen::Isometry3d& c_M_o, const BoardSpec& board,
                        double margin_px, double max_obliquity_rad);
 
+/// Sampling of board poses for intrinsic calibration (board fill, tilt, obliquity, margin).
 struct IntrinsicsViewOptions {
-  double min_fill = 0.45, max_fill = 0.85;  ///< board width / image width (at a fronto-parallel view)
+  double min_fill = 0.45,   ///< smallest board width / image width (at a fronto-parallel view)
+         max_fill = 0.85;   ///< largest board width / image width (at a fronto-parallel view)
   double max_tilt_rad = 0.75;               ///< per axis (about the board's x and y)
-  double max_obliquity_rad = 1.05;
-  double margin_px = 6.0;
+  double max_obliquity_rad = 1.05;  ///< board normal to line-of-sight angle limit, rad
+  double margin_px = 6.0;  ///< outline kept this many pixels inside the image
 };
 /// n board poses c_M_o for intrinsic calibration: the board filling a random part of the image,
 /// tilted about both axes, rotated in plane; every one fully visible. Throws NumericalError when
@@ -99,12 +103,13 @@ struct IntrinsicsViewOptions {
 std::vector<Eigen::Isometry3d> sampleIntrinsicsPoses(const core::Camera& camera, const BoardSpec& board, int n,
                                                      core::Rng& rng, const IntrinsicsViewOptions& options = {});
 
+/// Sampling of board poses seen by every camera of a rig (for rig calibration).
 struct RigViewOptions {
   Eigen::Vector3d center_w = Eigen::Vector3d::Zero();  ///< region of the shared views (world)
   double radius = 0.4;                                 ///< board centre within ±radius per axis
   double max_tilt_rad = 0.3;                           ///< normal perturbation around the best one
   double max_obliquity_rad = 1.2;                      ///< per camera
-  double margin_px = 6.0;
+  double margin_px = 6.0;  ///< outline kept this many pixels inside every image
 };
 /// The world point closest (least squares) to every camera's optical axis.
 Eigen::Vector3d commonViewPoint(const std::vector<core::Camera>& cameras);
@@ -121,17 +126,21 @@ Eigen::Isometry3d floorBoardPose(const BoardSpec& board, const Eigen::Vector2d& 
 
 /// Errors of a calibrated camera against the true one (same name, same world frame).
 struct CameraErrors {
-  std::string name;
-  vpCameraParameters truth, calibrated;
+  std::string name;  ///< camera name
+  vpCameraParameters truth,    ///< true intrinsics
+                     calibrated;  ///< calibrated intrinsics
   double position_error_m = 0.0;   ///< |centre_cal - centre_true|
   double rotation_error_rad = 0.0; ///< angle of R_cal R_trueᵀ
   /// Over a 33x25 grid of pixels of the image: angle between the true ray (exact inverse of the
   /// kud model) and the calibrated camera's ray (ViSP back-projection with kdu), expressed in pixels
   /// (angle x mean focal length): in the camera frame (intrinsics only) and in the world (with the
   /// pose's rotation error). RMS and maximum.
-  double ray_rms_px = 0.0, ray_max_px = 0.0;
-  double world_ray_rms_px = 0.0, world_ray_max_px = 0.0;
+  double ray_rms_px = 0.0,        ///< RMS ray error in the camera frame, px
+         ray_max_px = 0.0;        ///< largest ray error in the camera frame, px
+  double world_ray_rms_px = 0.0,  ///< RMS ray error in the world (with the rotation error), px
+         world_ray_max_px = 0.0;  ///< largest ray error in the world, px
 };
+/// Errors of one calibrated camera against the true one (same world frame).
 CameraErrors compareCamera(const core::Camera& truth, const core::Camera& calibrated);
 /// compareCamera for each true camera and the calibrated one of the same name (InvalidInput when
 /// missing or of another image size).

@@ -28,19 +28,25 @@
 
 namespace viewline::control {
 
+/// Gains and limits of the base's drive-to-point law (unicycle base, floor frame).
 struct GoToPointParams {
   double max_speed = 0.3;        ///< m/s
   double max_turn_rate = 2.0;    ///< rad/s
   double k_heading = 3.0;        ///< 1/s
   double stop_distance = 0.12;   ///< m from the axle centre
   double slow_distance = 0.15;   ///< m over which v ramps down to 0 at stop_distance
+  /// Throws core::InvalidInput naming the field.
   void validate() const;
 };
 
+/// Velocity command of the unicycle base.
 struct BaseCommand {
-  double v = 0.0, omega = 0.0;
+  double v = 0.0,      ///< forward speed, m/s
+         omega = 0.0;  ///< turn rate, rad/s (counter-clockwise seen from above)
 };
 
+/// Base command that drives towards `goal` (floor frame, m): turn first when it is behind, slow down near
+/// stop_distance.
 BaseCommand goToPoint(const robots::BasePose& pose, const Eigen::Vector2d& goal, const GoToPointParams& params);
 
 /// Joint set points that point the head camera at a world point (z up) from a base pose;
@@ -48,6 +54,7 @@ BaseCommand goToPoint(const robots::BasePose& pose, const Eigen::Vector2d& goal,
 robots::PanTiltJoints headSetPoint(const robots::MobilePanTilt& head, const robots::BasePose& pose,
                                    const Eigen::Vector3d& target_w, double* angle_error = nullptr);
 
+/// Timing and geometry of the search for a lost target (head sweep, base turn).
 struct SearchParams {
   double lost_after = 0.3;       ///< s without a detection before the target counts as lost
   double search_after = 1.5;     ///< s lost before the sweep starts
@@ -55,14 +62,17 @@ struct SearchParams {
   double sweep_period = 3.0;     ///< s
   double search_range = 1.5;     ///< m, floor distance the search tilt looks at
   double base_turn_rate = 0.6;   ///< rad/s of the base while searching without a bearing
+  /// Throws core::InvalidInput naming the field.
   void validate() const;
 };
 
+/// Search state: target seen recently, lost (look at the last prediction), or sweeping.
 enum class SearchMode { Tracking, Lost, Sweeping };
 
 /// State machine of the search; feed it the time of the last detection every control period.
 class SearchPattern {
 public:
+  /// Search with these parameters (validated; throws core::InvalidInput).
   explicit SearchPattern(const SearchParams& params = {});
   /// Mode at time t given the last detection time (negative: never seen).
   SearchMode mode(double t, double last_seen) const;
@@ -72,6 +82,7 @@ public:
   /// Base command while sweeping: turn towards the centre bearing (robot frame, rad); with no
   /// bearing (never seen), turn at base_turn_rate.
   BaseCommand baseWhileSearching(double centre_bearing, bool have_bearing) const;
+  /// The parameters in use.
   const SearchParams& params() const { return params_; }
 
 private:

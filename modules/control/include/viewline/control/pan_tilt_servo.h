@@ -65,14 +65,17 @@ namespace viewline::control {
 // ---------------------------------------------------------------------------------------------
 // The ViSP law (1).
 
+/// Configuration of ViSP's point-feature servo law (1).
 struct PointServoConfig {
   double gain = 0.2;                     ///< λ (1/s)
   std::string interaction = "desired";   ///< "desired" (L at s*), "current" (L at s) or "mean"
   void validate() const;                 ///< throws core::InvalidInput naming the field
 };
 
+/// ViSP's point servo (vpServo, EYEINHAND_L_cVe_eJe) on a pan-tilt unit: law (1), no prediction.
 class VispPointServo {
 public:
+  /// Builds the vpServo task (throws core::InvalidInput for a bad config).
   explicit VispPointServo(const PointServoConfig& config = {});
   ~VispPointServo();
   VispPointServo(const VispPointServo&) = delete;
@@ -82,6 +85,7 @@ public:
   Eigen::Vector2d command(const Eigen::Vector2d& s, const vpVelocityTwistMatrix& cVe, const vpMatrix& eJe);
   /// (L cVe eJe)⁺ (2 x 2) of the last command().
   Eigen::Matrix2d jacobianPinv() const;
+  /// The configuration in use.
   const PointServoConfig& config() const { return config_; }
 
 private:
@@ -98,13 +102,14 @@ private:
 
 /// What the camera saw in one image, time-stamped with the capture time.
 struct TargetObservation {
-  core::Timestamp stamp = 0.0;
-  bool detected = false;
+  core::Timestamp stamp = 0.0;  ///< capture time of the image, s
+  bool detected = false;  ///< true when the target was found in the image (other fields are meaningless otherwise)
   Eigen::Vector2d feature = Eigen::Vector2d::Zero();    ///< normalised (x, y) in the capture camera
   Eigen::Vector2d plane = Eigen::Vector2d::Zero();      ///< measured position on the target plane (m)
   Eigen::Matrix2d plane_cov = Eigen::Matrix2d::Identity();  ///< its covariance (m²)
 };
 
+/// What a pan-tilt controller gets at each control period: time, measured joints and commands in flight.
 struct ControlInput {
   core::Timestamp t = 0.0;              ///< issue time of the command
   robots::JointState joints;            ///< measured joint state at t
@@ -112,27 +117,35 @@ struct ControlInput {
   double period = 1.0 / 30.0;           ///< s until the next command (the hold time)
 };
 
+/// What the controller is doing: following measurements, following the prediction only, searching, or nothing yet.
 enum class TrackingMode { Tracking, Coasting, Searching, Idle };
+/// Lower-case name of a mode ("tracking", "coasting", "searching", "idle").
 const char* toString(TrackingMode mode);
 
+/// A pan-tilt controller's output for one period: the joint velocity command (rad/s) and what it aimed at.
 struct ControlOutput {
   Eigen::Vector2d qdot = Eigen::Vector2d::Zero();            ///< the command (limited)
   Eigen::Vector2d qdot_unlimited = Eigen::Vector2d::Zero();  ///< before the limiter
-  TrackingMode mode = TrackingMode::Idle;
-  bool has_prediction = false;
+  TrackingMode mode = TrackingMode::Idle;  ///< what the controller was doing
+  bool has_prediction = false;  ///< true when predicted_feature and predicted_plane are set
   Eigen::Vector2d predicted_feature = Eigen::Vector2d::Zero();  ///< ŝ at the effect time (normalised)
   Eigen::Vector2d predicted_plane = Eigen::Vector2d::Zero();    ///< P̂ on the plane at the effect time
 };
 
+/// Joint-limit handling of the velocity limiter.
 struct LimitConfig {
   double margin = 0.0087;   ///< rad kept from the joint limits (0.5°)
 };
 
+/// Interface of a pan-tilt controller in the scenario loop: observations in, joint velocity commands out.
 class PanTiltController {
 public:
   virtual ~PanTiltController() = default;
+  /// Short name for summaries and logs ("visp_baseline", "predictive").
   virtual std::string name() const = 0;
+  /// Takes the observation of one image (time-stamped with its capture time).
   virtual void observe(const TargetObservation& observation) = 0;
+  /// Joint velocity command (rad/s, pan and tilt) for the period starting at input.t, within the unit's limits.
   virtual ControlOutput command(const ControlInput& input) = 0;
 };
 
@@ -157,9 +170,10 @@ private:
   TargetObservation last_;
 };
 
+/// Configuration of the predictive law (2): servo, target filter, gain, lead, coasting and search.
 struct PredictiveConfig {
-  PointServoConfig servo;
-  tracking::TargetFilterConfig filter;
+  PointServoConfig servo;  ///< point servo of the law (interaction matrix; its gain when gain = 0)
+  tracking::TargetFilterConfig filter;  ///< target filter on the plane (motion model, noise, gate)
   double gain = 0.0;              ///< λ (1/s) of law (2); 0: servo.gain (the baseline's)
   double lead = 0.0;              ///< s predicted beyond the command latency (e.g. half a period)
   bool feed_forward = true;       ///< the −J⁺ ṡ_T term of (2)
@@ -168,7 +182,8 @@ struct PredictiveConfig {
   double search_growth = 0.12;    ///< rad of radius per turn
   double search_radius = 0.8;     ///< rad, largest spiral radius (then it restarts)
   double search_gain = 4.0;       ///< 1/s, pull towards the spiral point
-  LimitConfig limits;
+  LimitConfig limits;  ///< joint-limit margin of the limiter
+  /// Throws core::InvalidInput naming the field.
   void validate() const;
 };
 
@@ -184,10 +199,13 @@ public:
   void observe(const TargetObservation& observation) override;
   ControlOutput command(const ControlInput& input) override;
 
+  /// The target filter (on the target plane, plane coordinates in m).
   const tracking::PlanarTargetFilter& filter() const { return filter_; }
   /// The filter's x(k|k) position after the last fused measurement (valid when lastUpdate().accepted).
   const Eigen::Vector2d& filteredPlane() const { return filtered_; }
+  /// Report of the filter's last measurement update (NIS, accepted or rejected).
   const tracking::PlanarTargetFilter::Update& lastUpdate() const { return last_update_; }
+  /// Number of reacquisitions (filter re-initialised after a loss or repeated rejections).
   std::size_t reacquisitions() const { return reacquisitions_; }
 
 private:

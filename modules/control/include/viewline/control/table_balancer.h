@@ -33,6 +33,7 @@
 
 namespace viewline::control {
 
+/// Configuration of the LQR table balancer (periods in s, angles in rad, LQR weights).
 struct TableBalancerConfig {
   double period = 0.02;        ///< T, controller period = frame period, s (> 0)
   double delay = 0.02;         ///< D = latency + actuator delay, s (>= 0)
@@ -51,15 +52,17 @@ struct TableBalancerConfig {
 
 /// The commanded tilt ramp of one period: θ(t) = start + rate (t − t0) for t in [t0, t0 + T].
 struct TiltRamp {
-  double t0 = 0.0;
+  double t0 = 0.0;  ///< start time of the ramp, s
   Eigen::Vector2d start = Eigen::Vector2d::Zero();  ///< (θx, θy) at t0, rad
   Eigen::Vector2d rate = Eigen::Vector2d::Zero();   ///< (θ̇x, θ̇y), rad/s
-  double period = 0.02;
+  double period = 0.02;  ///< ramp duration T, s
   /// Position command at t (held at the ramp's end after t0 + T, at its start before t0).
   Eigen::Vector2d commandAt(double t) const;
+  /// Commanded tilt (θx, θy) at the ramp's end t0 + T, rad.
   Eigen::Vector2d end() const { return start + period * rate; }
 };
 
+/// LQR balancer of a ball on a tilting table with delayed, rate-limited tilt commands ([M]'s closed loop).
 class TableBalancer {
 public:
   /// Builds the augmented model and solves the LQR; throws core::InvalidInput for a bad config.
@@ -74,10 +77,13 @@ public:
 
   /// Augmented per-axis model (z as in the file comment) and the LQR gain (1 x nz).
   const Eigen::MatrixXd& A() const { return A_; }
+  /// Input matrix of the augmented per-axis model (nz x 1).
   const Eigen::MatrixXd& B() const { return B_; }
+  /// LQR gain K (1 x nz), u = −K z.
   const Eigen::RowVectorXd& gain() const { return K_; }
   /// Spectral radius of A − B K (< 1 for a stabilising gain).
   double closedLoopSpectralRadius() const;
+  /// The configuration in use.
   const TableBalancerConfig& config() const { return config_; }
   /// Commanded tilt (θx, θy) at the end of the last ramp.
   Eigen::Vector2d commandedTilt() const;

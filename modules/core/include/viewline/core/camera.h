@@ -19,8 +19,10 @@
 
 namespace viewline::core {
 
+/// A calibrated camera: ViSP intrinsics, image size and pose c_M_w (world to camera), one model for tracker,
+/// renderer and detectors.
 struct Camera {
-  std::string name = "camera";
+  std::string name = "camera";  ///< Name used in logs, rig files and error messages.
   vpCameraParameters intrinsics;                       ///< fx=px, fy=py, cx=u0, cy=v0, kud, kdu
   Eigen::Isometry3d c_M_w = Eigen::Isometry3d::Identity();  ///< world -> camera
   unsigned width = 640;                                ///< pixels

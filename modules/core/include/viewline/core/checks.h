@@ -12,6 +12,7 @@ namespace viewline::core {
 
 /// Throws InvalidInput("<what> contains NaN or Inf ...") unless all entries are finite.
 void requireFinite(const Eigen::Ref<const Eigen::MatrixXd>& m, const std::string& what);
+/// Throws InvalidInput naming `what` unless `value` is finite.
 void requireFinite(double value, const std::string& what);
 
 /// Throws unless value > 0 and finite.

@@ -9,6 +9,7 @@
 
 namespace viewline::core {
 
+/// The one random engine type: seeded once per run and passed in, so every run is reproducible.
 using Rng = std::mt19937_64;
 
 /// An engine seeded from `seed` (mixed so that nearby seeds give unrelated streams).

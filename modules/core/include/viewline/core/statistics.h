@@ -13,9 +13,11 @@ double chiSquareQuantile(double dof, double p);
 /// Upper-tail probability P(X > x) of chi-square(dof).
 double chiSquareSurvival(double dof, double x);
 
+/// Closed interval [lo, hi] (e.g. a two-sided chi-square acceptance band).
 struct Interval {
-  double lo = 0.0;
-  double hi = 0.0;
+  double lo = 0.0;  ///< Lower bound (inclusive).
+  double hi = 0.0;  ///< Upper bound (inclusive).
+  /// True when lo <= v <= hi.
   bool contains(double v) const { return v >= lo && v <= hi; }
 };
 

@@ -5,6 +5,7 @@
 
 namespace viewline::core {
 
+/// viewline's version (major.minor.patch); its one owner, read by CMake, --version and summaries.
 inline constexpr const char* kVersion = "0.2.0";
 
 }  // namespace viewline::core

@@ -27,13 +27,17 @@ double nis(const Eigen::VectorXd& innovation, const Eigen::MatrixXd& S);
 /// Running mean of NEES or NIS values with their degrees of freedom, and the band for it.
 class ConsistencyStats {
 public:
+  /// Adds one NEES or NIS value with its degrees of freedom (its chi-square dof).
   void add(double value, double dof);
+  /// Number of values added.
   std::size_t count() const { return count_; }
+  /// Mean of the values added (0 when none).
   double mean() const;
   /// Mean degrees of freedom of the samples added.
   double meanDof() const;
   /// Two-sided band for the mean at `confidence`, treating the samples as independent.
   core::Interval bounds(double confidence = 0.99) const;
+  /// True when the mean lies inside the two-sided chi-square band at `confidence`.
   bool consistent(double confidence = 0.99) const { return bounds(confidence).contains(mean()); }
 
 private:

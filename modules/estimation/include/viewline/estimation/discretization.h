@@ -19,6 +19,7 @@
 
 namespace viewline::estimation {
 
+/// Continuous-time linear model ẋ = A x + B u + G w with white noise w of spectral density Qc.
 struct ContinuousLinearModel {
   Eigen::MatrixXd A;   ///< n x n
   Eigen::MatrixXd B;   ///< n x p (may be empty)

@@ -26,21 +26,26 @@
 
 namespace viewline::estimation {
 
+/// One mode of an IMM: its transition and mean sojourn time.
 struct ImmMode {
-  std::string name;
+  std::string name;  ///< Mode name used in reports and telemetry (e.g. "cv", "ct").
   /// The mode's transition over dt > 0 (a linear model gives f(x) = Φ x, F = Φ).
   std::function<NonlinearTransition(double dt)> transition;
   double sojourn = 1.0;  ///< τ (s), mean time spent in this mode
 };
 
+/// Interacting multiple model estimator over modes sharing one state space (Blom & Bar-Shalom 1988).
 class Imm {
 public:
   /// `jump`: M x M row-stochastic with zero diagonal (where a mode goes when it is left);
   /// an empty matrix means "uniformly to the other modes".
   Imm(std::vector<ImmMode> modes, Eigen::MatrixXd jump = {});
 
+  /// Number of modes M.
   std::size_t modeCount() const { return modes_.size(); }
+  /// Mode j (throws std::out_of_range when j >= M).
   const ImmMode& mode(std::size_t j) const { return modes_.at(j); }
+  /// True after reset(): every mode holds a state.
   bool initialized() const { return !states_.empty(); }
 
   /// Every mode starts at (x, P, t) with probabilities mu0 (default: uniform).
@@ -49,6 +54,7 @@ public:
   /// Mixing + prediction to t (no-op when t is not after the current time).
   void predict(core::Timestamp t);
 
+  /// Diagnostics of one IMM update.
   struct Report {
     double nis = 0.0;             ///< NIS of the combined prediction (d ᵀ S⁻¹ d with the mixture moments)
     double log_likelihood = 0.0;  ///< log Σ_j c_j Λ_j
@@ -60,8 +66,11 @@ public:
 
   /// Combined estimate (moment-matched mixture) at the current time.
   StateEstimate combined() const;
+  /// Estimate of mode j after the last predict/update.
   const StateEstimate& modeState(std::size_t j) const { return states_.at(j); }
+  /// Mode probabilities μ (M entries, sum 1).
   const Eigen::VectorXd& probabilities() const { return mu_; }
+  /// Time of the current estimates (s, the run's clock).
   core::Timestamp time() const;
   /// Switching matrix over dt (M x M, row-stochastic).
   Eigen::MatrixXd switching(double dt) const;

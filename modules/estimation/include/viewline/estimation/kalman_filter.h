@@ -35,7 +35,7 @@ namespace viewline::estimation {
 
 /// One discrete transition x ← Φ x + Γ u + v, cov v = Q (= R1), over dt seconds.
 struct LinearTransition {
-  Eigen::MatrixXd Phi;
+  Eigen::MatrixXd Phi;  ///< n x n state transition Φ over dt
   Eigen::MatrixXd Gamma;  ///< n x p, may be empty (no input)
   Eigen::VectorXd u;      ///< p, may be empty
   Eigen::MatrixXd Q;      ///< n x n, symmetric positive semi-definite
@@ -55,7 +55,7 @@ struct UpdateReport {
   Eigen::VectorXd innovation;  ///< d = y − C x(k|k−1)
   Eigen::MatrixXd S;           ///< R2 + C P Cᵀ
   double nis = 0.0;            ///< dᵀ S⁻¹ d (chi-square with m dof for a consistent filter)
-  Eigen::Index rows = 0;
+  Eigen::Index rows = 0;  ///< m, the number of measurement rows used (0: nothing was updated)
 };
 
 /// Time update: x ← Φ x + Γ u, P ← Φ P Φᵀ + Q, t ← t + dt.
@@ -75,6 +75,7 @@ Eigen::MatrixXd innovationCovariance(const StateEstimate& s, const Eigen::Matrix
 
 /// Validation shared by the linear and nonlinear filters (throw core::InvalidInput).
 void validateTransition(const StateEstimate& s, const LinearTransition& tr);
+/// Throws core::InvalidInput unless C is m x n, y has m entries and R is m x m symmetric positive definite, all finite.
 void validateMeasurement(const StateEstimate& s, const LinearMeasurement& m);
 
 }  // namespace viewline::estimation

@@ -19,9 +19,12 @@
 
 namespace viewline::estimation {
 
+/// A vector map x ↦ f(x) (transition or measurement function).
 using VectorFn = std::function<Eigen::VectorXd(const Eigen::VectorXd&)>;
+/// A Jacobian map x ↦ ∂f/∂x.
 using JacobianFn = std::function<Eigen::MatrixXd(const Eigen::VectorXd&)>;
 
+/// One nonlinear transition x ← f(x) + v, cov v = Q, over dt seconds.
 struct NonlinearTransition {
   VectorFn f;          ///< x ↦ f(x) over the step
   JacobianFn F;        ///< ∂f/∂x (EKF only)
@@ -30,6 +33,7 @@ struct NonlinearTransition {
   VectorFn normalize;  ///< optional: wraps angle states after each step
 };
 
+/// A nonlinear measurement y = h(x) + e, cov e = R.
 struct NonlinearMeasurement {
   VectorFn h;                ///< x ↦ predicted measurement
   JacobianFn H;              ///< ∂h/∂x (EKF only)
@@ -38,16 +42,21 @@ struct NonlinearMeasurement {
   std::function<Eigen::VectorXd(const Eigen::VectorXd&, const Eigen::VectorXd&)> residual;  ///< optional y ⊖ ŷ
 };
 
+/// EKF time update: x ← f(x), P ← F P Fᵀ + Q (square-root array form), t ← t + dt.
 void ekfPredict(StateEstimate& s, const NonlinearTransition& tr);
+/// EKF measurement update with H linearised at the prediction; returns innovation, S and NIS.
 UpdateReport ekfUpdate(StateEstimate& s, const NonlinearMeasurement& m);
 
+/// Scaling of the unscented transform (Wan & van der Merwe): λ = α²(n + κ) − n.
 struct UnscentedParams {
-  double alpha = 1.0;
-  double beta = 2.0;
-  double kappa = 0.0;
+  double alpha = 1.0;  ///< Spread α of the sigma points around the mean (0 < α <= 1).
+  double beta = 2.0;  ///< Prior knowledge of the distribution (2 is optimal for a Gaussian).
+  double kappa = 0.0;  ///< Secondary scaling κ (usually 0 or 3 − n).
 };
 
+/// UKF time update with sigma points from the square-root factor; t ← t + dt.
 void ukfPredict(StateEstimate& s, const NonlinearTransition& tr, const UnscentedParams& p = {});
+/// UKF measurement update; returns innovation, S and NIS.
 UpdateReport ukfUpdate(StateEstimate& s, const NonlinearMeasurement& m, const UnscentedParams& p = {});
 
 /// Central-difference Jacobian of f at x (step scaled per entry); used to check analytic Jacobians.

@@ -15,11 +15,12 @@
 
 namespace viewline::estimation {
 
+/// Stationary Kalman filter of a DARE solution: a-priori and a-posteriori covariances and the filter gain.
 struct StationaryFilter {
   Eigen::MatrixXd P;   ///< a-priori (predicted) covariance
   Eigen::MatrixXd Pf;  ///< a-posteriori (filtered) covariance P − Kf C P
   Eigen::MatrixXd Kf;  ///< filter-form gain
-  int iterations = 0;
+  int iterations = 0;  ///< doubling iterations used until convergence
   double residual = 0.0;  ///< max |DARE(P) − P| relative to max(1, |P|)
 };
 

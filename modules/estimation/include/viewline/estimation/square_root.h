@@ -14,6 +14,7 @@ Eigen::MatrixXd psdSqrt(const Eigen::MatrixXd& M, const char* what);
 /// The diagonal of T is made non-negative.
 Eigen::MatrixXd lowerTriangularize(const Eigen::MatrixXd& A);
 
+/// Row-major dynamic matrix: the layout lowerTriangularizeInPlace works on.
 using RowMatrixXd = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
 /// In-place form of lowerTriangularize for the filter's hot path: Householder reflections applied

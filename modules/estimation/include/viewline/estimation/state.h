@@ -14,6 +14,7 @@
 
 namespace viewline::estimation {
 
+/// Filter state: mean x, covariance as a square-root factor L (P = L Lᵀ) and the time stamp t (s).
 class StateEstimate {
 public:
   StateEstimate() = default;
@@ -24,16 +25,22 @@ public:
   static StateEstimate fromSqrt(const Eigen::VectorXd& x, const Eigen::MatrixXd& sqrtP,
                                 core::Timestamp t = 0.0);
 
+  /// State dimension n.
   Eigen::Index dim() const { return x_.size(); }
+  /// Mean x (n entries).
   const Eigen::VectorXd& x() const { return x_; }
   /// The covariance P = L Lᵀ (computed on demand).
   Eigen::MatrixXd P() const { return L_ * L_.transpose(); }
   /// The square-root factor L (lower triangular).
   const Eigen::MatrixXd& sqrtP() const { return L_; }
+  /// Time stamp of the estimate (s, the run's clock).
   core::Timestamp t() const { return t_; }
 
+  /// Replaces the mean (finite, same dimension; throws core::InvalidInput otherwise).
   void setMean(const Eigen::VectorXd& x);
+  /// Replaces the covariance (symmetric positive definite, checked) and refactors L.
   void setCovariance(const Eigen::MatrixXd& P);
+  /// Sets the time stamp (s) without propagating the state.
   void setTime(core::Timestamp t) { t_ = t; }
 
   /// Used by the filter functions after they validated everything (no checks).

@@ -22,10 +22,12 @@
 
 namespace viewline::io {
 
+/// Geometry of a simulated pinhole camera as a scenario file gives it (pixels, radians, world frame in metres).
 struct PinholeFields {
-  unsigned width = 640;
-  unsigned height = 480;
+  unsigned width = 640;  ///< image width, px
+  unsigned height = 480;  ///< image height, px
   double hfov_rad = 1.0;                      ///< horizontal field of view, rad
+  /// Principal point (cx, cy), px; absent: the image centre.
   std::optional<double> cx, cy;               ///< principal point, px (absent: the image centre)
   double kud = 0.0;                           ///< radial distortion (undistorted -> distorted)
   std::optional<Eigen::Vector3d> position;    ///< camera centre in the world, m

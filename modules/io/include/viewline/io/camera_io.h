@@ -13,16 +13,18 @@
 
 namespace viewline::io {
 
+/// Which of ViSP's two camera models to read or write (vpCameraParameters projection type).
 enum class Projection { WithoutDistortion, WithDistortion };
 
 /// "without_distortion" / "with_distortion" (the rig file and config spelling).
 std::string toString(Projection p);
 Projection projectionFromString(const std::string& s);  ///< throws InvalidInput on anything else
 
+/// One camera read from a ViSP XML file: intrinsics of the requested model and the image size.
 struct CameraXml {
-  vpCameraParameters intrinsics;
-  unsigned width = 0;
-  unsigned height = 0;
+  vpCameraParameters intrinsics;  ///< px, py, u0, v0 (and kud, kdu with distortion)
+  unsigned width = 0;  ///< image width, px
+  unsigned height = 0;  ///< image height, px
 };
 
 /// Reads camera `camera_name` from a ViSP XML file. width/height 0 = any size (the file's
@@ -32,8 +34,8 @@ CameraXml loadVispCameraXml(const std::string& path, const std::string& camera_n
 
 /// Writes a ViSP XML file (replacing any existing file) with the model without distortion and,
 /// when given, the model with distortion, for one camera name and image size.
-/// `additional_info` is XML elements put into the file's <additional_information>, e.g.
-/// "<reprojection_error_px>0.21</reprojection_error_px>" (plain text is dropped by ViSP).
+/// `additional_info` is XML elements put into the file's `<additional_information>`, e.g.
+/// `<reprojection_error_px>0.21</reprojection_error_px>` (plain text is dropped by ViSP).
 void saveVispCameraXml(const std::string& path, const std::string& camera_name,
                        const vpCameraParameters& without_distortion,
                        const std::optional<vpCameraParameters>& with_distortion, unsigned width, unsigned height,
@@ -44,11 +46,12 @@ void writeVispCameraXmlTo(const std::string& path, const std::string& camera_nam
                           const std::optional<vpCameraParameters>& with_distortion, unsigned width,
                           unsigned height, const std::string& additional_info = {});
 
+/// Intrinsics as OpenCV's calibration writes them (cv::FileStorage YAML/XML).
 struct OpenCvIntrinsics {
-  Eigen::Matrix3d camera_matrix = Eigen::Matrix3d::Identity();
+  Eigen::Matrix3d camera_matrix = Eigen::Matrix3d::Identity();  ///< K = [fx 0 cx; 0 fy cy; 0 0 1], px
   Eigen::VectorXd distortion = Eigen::VectorXd::Zero(5);  ///< k1 k2 p1 p2 [k3 [k4 k5 k6 ...]]
-  unsigned width = 0;
-  unsigned height = 0;
+  unsigned width = 0;  ///< image width, px
+  unsigned height = 0;  ///< image height, px
   double rms_px = -1.0;  ///< avg_reprojection_error when present, else -1
 };
 

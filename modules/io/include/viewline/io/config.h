@@ -32,6 +32,7 @@
 
 namespace viewline::io {
 
+/// A node of a strict YAML config: typed reads with file:line:col errors, and a check that every key was read.
 class ConfigNode {
 public:
   /// Parses a YAML file; throws InvalidInput naming the file (and line for syntax errors,
@@ -74,10 +75,12 @@ public:
 
   /// An angle: the key must end in "_deg"; the file holds degrees, the result is radians.
   double getAngle(const std::string& key) const;
+  /// Optional angle: the `_deg` key in degrees converted to radians, `fallback_rad` (rad) when absent.
   double getAngleOr(const std::string& key, double fallback_rad) const;
 
   /// A string that must be one of `choices`; the error lists them.
   std::string getChoice(const std::string& key, const std::vector<std::string>& choices) const;
+  /// Optional choice among `choices`: `fallback` when absent, the error lists the choices otherwise.
   std::string getChoiceOr(const std::string& key, const std::vector<std::string>& choices,
                           const std::string& fallback) const;
 
@@ -86,7 +89,9 @@ public:
 
   /// Nested map (required / optional) and list of maps.
   ConfigNode child(const std::string& key) const;
+  /// True when the key is present (a nested map is expected there).
   bool hasChild(const std::string& key) const { return has(key); }
+  /// Required list of maps under `key` (each a node with its own key path, e.g. "cameras[1]").
   std::vector<ConfigNode> childList(const std::string& key) const;
 
   /// Marks a key as read without reading it (a documented key that this program ignores).
@@ -100,8 +105,10 @@ public:
   /// Throws InvalidInput listing every key under this node (recursively) that was never read,
   /// each with its file:line:col and key path. Call once, after reading everything.
   void finish() const;
+  /// Same as finish(): throws InvalidInput for every key never read.
   void requireAllUsed() const { finish(); }
 
+  /// Name of the file the node was read from (or the name given to fromString).
   const std::string& fileName() const;
   /// Key path of this node ("" for the root, "tracker", "cameras[0]").
   const std::string& path() const { return path_; }
@@ -110,6 +117,7 @@ public:
   /// "<file>:<line>:<col>" of a key (or of this node when key is empty or absent).
   std::string location(const std::string& key = {}) const;
 
+  /// The underlying yaml-cpp node (read access; does not mark keys as read).
   const YAML::Node& yaml() const { return node_; }
 
 private:
@@ -129,20 +137,35 @@ private:
   std::string path_;
 };
 
+/// Reads a boolean (YAML true/false).
 template <> bool ConfigNode::get<bool>(const std::string& key) const;
+/// Reads an int; a non-integer or out-of-range value is refused.
 template <> int ConfigNode::get<int>(const std::string& key) const;
+/// Reads an unsigned int; a negative value is refused.
 template <> unsigned ConfigNode::get<unsigned>(const std::string& key) const;
+/// Reads a long long.
 template <> long long ConfigNode::get<long long>(const std::string& key) const;
+/// Reads an unsigned long; a negative value is refused.
 template <> unsigned long ConfigNode::get<unsigned long>(const std::string& key) const;
+/// Reads an unsigned long long (seeds); a negative value is refused.
 template <> unsigned long long ConfigNode::get<unsigned long long>(const std::string& key) const;
+/// Reads a finite double.
 template <> double ConfigNode::get<double>(const std::string& key) const;
+/// Reads a string scalar.
 template <> std::string ConfigNode::get<std::string>(const std::string& key) const;
+/// Reads a list of finite numbers.
 template <> std::vector<double> ConfigNode::get<std::vector<double>>(const std::string& key) const;
+/// Reads a list of integers.
 template <> std::vector<int> ConfigNode::get<std::vector<int>>(const std::string& key) const;
+/// Reads a list of strings.
 template <> std::vector<std::string> ConfigNode::get<std::vector<std::string>>(const std::string& key) const;
+/// Reads a 2-vector from a list of 2 numbers.
 template <> Eigen::Vector2d ConfigNode::get<Eigen::Vector2d>(const std::string& key) const;
+/// Reads a 3-vector from a list of 3 numbers.
 template <> Eigen::Vector3d ConfigNode::get<Eigen::Vector3d>(const std::string& key) const;
+/// Reads a vector from a list of numbers of any length.
 template <> Eigen::VectorXd ConfigNode::get<Eigen::VectorXd>(const std::string& key) const;
+/// Reads a 3x3 matrix from 3 rows of 3 numbers.
 template <> Eigen::Matrix3d ConfigNode::get<Eigen::Matrix3d>(const std::string& key) const;
 
 }  // namespace viewline::io

@@ -24,8 +24,9 @@
 
 namespace viewline::io {
 
+/// One segment of a dotted key: a map key, optionally indexed into a list ("cameras[1]").
 struct KeySegment {
-  std::string key;
+  std::string key;  ///< map key of the segment
   int index = -1;  ///< list index when the segment is "name[i]"
 };
 

@@ -14,6 +14,7 @@
 
 namespace viewline::io {
 
+/// One CSV file: header line, then rows of numbers or text; disabled writers discard rows.
 class CsvWriter {
 public:
   /// A disabled writer: rows are discarded.
@@ -21,15 +22,20 @@ public:
   /// Creates (truncates) `path` and writes the header. Throws InvalidInput naming the path.
   CsvWriter(const std::string& path, std::vector<std::string> header, int precision = 12);
 
+  /// True when a file is open (rows are written).
   bool enabled() const { return out_.is_open(); }
+  /// Column names, as written in the header line.
   const std::vector<std::string>& header() const { return header_; }
+  /// Path of the CSV file ("" when disabled).
   const std::string& path() const { return path_; }
+  /// Number of rows written so far.
   std::size_t rows() const { return rows_; }
 
   /// Numbers (NaN is written as "nan": a missing value). Throws when the count differs from the header.
   void row(const std::vector<double>& values);
   /// Text fields (quoted when they contain a comma, quote or newline).
   void rowText(const std::vector<std::string>& fields);
+  /// Flushes the file to disk (no-op when disabled).
   void flush();
 
 private:
@@ -41,16 +47,20 @@ private:
   std::size_t rows_ = 0;
 };
 
+/// The folder of a run's CSV logs (--log DIR): one CsvWriter per stream, all no-ops when disabled.
 class LogDirectory {
 public:
   /// `dir` empty: disabled. Otherwise the directory is created when missing.
   explicit LogDirectory(const std::string& dir = {});
+  /// True when logging to a folder.
   bool enabled() const { return !dir_.empty(); }
+  /// The log folder ("" when disabled).
   const std::string& dir() const { return dir_; }
   /// The writer of `<dir>/<name>.csv`, created on first use. Asking again with a different
   /// header throws. When disabled, a shared no-op writer. `precision`: significant digits (17: every
   /// double reads back exactly, for logs that are replayed).
   CsvWriter& stream(const std::string& name, const std::vector<std::string>& header, int precision = 12);
+  /// Flushes every stream.
   void flush();
 
 private:

@@ -18,6 +18,7 @@
 
 namespace viewline::planning {
 
+/// Parameters of the shortest-time capture planner ([K] eq 30).
 struct CapturePlannerParams {
   double period = 0.1;      ///< T, s between predictions
   double robot_speed = 0.3; ///< v_max, m/s
@@ -28,8 +29,9 @@ struct CapturePlannerParams {
   void validate() const;
 };
 
+/// Result of planCapture(): where and when the robot meets the object.
 struct CapturePlan {
-  bool reachable = false;
+  bool reachable = false;  ///< true when the robot reaches p(k+m*) no later than the object (else the least-late point)
   int steps = 0;                          ///< m* (1-based)
   double time = 0.0;                      ///< m* T, s from now
   Eigen::Vector2d point = Eigen::Vector2d::Zero();  ///< capture point p(k+m*)
@@ -38,8 +40,8 @@ struct CapturePlan {
 
 /// Robot pose on the floor for planning: position (m) and heading (rad).
 struct PlannerRobot {
-  Eigen::Vector2d position = Eigen::Vector2d::Zero();
-  double heading = 0.0;
+  Eigen::Vector2d position = Eigen::Vector2d::Zero();  ///< axle-centre position on the floor (world frame), m
+  double heading = 0.0;  ///< heading in the floor plane from the world x axis, rad
 };
 
 /// Time the robot needs to get the point within reach (τ above).

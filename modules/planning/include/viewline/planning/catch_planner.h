@@ -34,8 +34,9 @@
 
 namespace viewline::planning {
 
+/// Configuration of the ball-catching interception planner ([L] §VI.C).
 struct CatchPlannerConfig {
-  CrossingModel model;
+  CrossingModel model;  ///< flight model used to predict the crossing (ballistic or drag)
   Eigen::Vector3d home = Eigen::Vector3d(0.0, 0.0, 1.2);   ///< hole centre at rest, world, m
   Eigen::Vector3d normal = Eigen::Vector3d::UnitX();         ///< box-front normal (unit, towards the thrower)
   robots::CartesianLimits limits;                            ///< per-axis limits of the hole (robot's, see below)
@@ -56,9 +57,12 @@ struct CatchPlannerConfig {
   void validate() const;
 };
 
+/// Phase of the catch planner: waiting, chasing the prediction, committed, gave up (unreachable), going home.
 enum class CatchPhase { Idle, Tracking, Committed, GaveUp, Homing };
+/// Lower-case name of a phase ("idle", "tracking", "committed", "gave_up", "homing").
 const char* toString(CatchPhase p);
 
+/// What one tracker update did to the plan.
 struct PlannerUpdate {
   std::optional<Crossing> crossing;  ///< predicted crossing of this update (if any)
   bool replanned = false;            ///< a new profile was started
@@ -66,6 +70,7 @@ struct PlannerUpdate {
   double arrival = 0.0;              ///< predicted arrival of the box at the target (absolute, with latency)
 };
 
+/// Moves the box's hole to the predicted crossing of a tracked ball, in time and within the robot's limits.
 class CatchPlanner {
 public:
   /// `workspace(p)`: can the hole be at p (robot workspace / IK); empty = everywhere.
@@ -81,19 +86,29 @@ public:
   /// The set point to stream at time t (non-decreasing); switches to homing after the crossing.
   robots::CartesianState setpoint(double t);
 
+  /// Current phase.
   CatchPhase phase() const { return phase_; }
+  /// True once the target was committed (crossing std below commit_sigma).
   bool committed() const { return commit_time_.has_value(); }
+  /// Time of the first tracker update of this throw (s).
   std::optional<double> firstUpdateTime() const { return first_update_; }
+  /// Time of the commitment (s), if any.
   std::optional<double> commitTime() const { return commit_time_; }
+  /// Time the throw was declared unreachable (s), if any.
   std::optional<double> giveUpTime() const { return give_up_time_; }
   /// First update that moved the box towards a predicted crossing.
   std::optional<double> firstMoveTime() const { return first_move_; }
   /// The crossing the current plan aims at (last accepted prediction).
   const std::optional<Crossing>& target() const { return target_; }
+  /// The profile the set points currently follow.
   const SyncProfile& profile() const { return profile_; }
+  /// Tracker updates seen since reset().
   int updates() const { return updates_; }
+  /// Number of profiles planned since reset().
   int replans() const { return replans_; }
+  /// The configuration in use (limits and latency as asked from the robot when built from one).
   const CatchPlannerConfig& config() const { return cfg_; }
+  /// The plane the ball must cross: through home, with the box-front normal.
   CrossingPlane plane() const { return {cfg_.home, cfg_.normal}; }
 
 private:

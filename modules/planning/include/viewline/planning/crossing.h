@@ -27,17 +27,21 @@
 
 namespace viewline::planning {
 
+/// A plane {p : n·(p − c) = 0} in the world frame, normal towards the incoming object.
 struct CrossingPlane {
-  Eigen::Vector3d point = Eigen::Vector3d::Zero();
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();  ///< a point c of the plane, world frame, m
   Eigen::Vector3d normal = Eigen::Vector3d::UnitX();  ///< unit, towards the incoming object
 };
 
+/// Flight model of the crossing prediction: drag-free ballistic or quadratic drag.
 enum class FlightModel { Ballistic, Drag };
+/// Lower-case name of a flight model ("ballistic", "drag").
 const char* toString(FlightModel m);
 
+/// How crossings are predicted: flight model, gravity, drag, process noise and horizon.
 struct CrossingModel {
-  FlightModel kind = FlightModel::Drag;
-  Eigen::Vector3d gravity_w = Eigen::Vector3d(0.0, 0.0, -9.81);
+  FlightModel kind = FlightModel::Drag;  ///< flight model
+  Eigen::Vector3d gravity_w = Eigen::Vector3d(0.0, 0.0, -9.81);  ///< gravity in the world frame, m/s² (z up by default)
   double drag_k = 0.0;       ///< k = ρ Cd A / (2 m), 1/m (Drag only)
   double accel_psd = 0.0;    ///< process noise q of the prediction, m²/s³ (0: none)
   double max_horizon = 3.0;  ///< s; no crossing further ahead is reported
@@ -46,6 +50,7 @@ struct CrossingModel {
   void validate() const;
 };
 
+/// A predicted plane crossing: time, point, velocity and their uncertainty.
 struct Crossing {
   core::Timestamp t = 0.0;           ///< absolute crossing time
   Eigen::Vector3d p = Eigen::Vector3d::Zero();  ///< crossing point (on the plane)

@@ -34,8 +34,11 @@
 
 namespace viewline::planning {
 
+/// Position, velocity and acceleration of one axis (m, m/s, m/s²).
 struct AxisState {
-  double p = 0.0, v = 0.0, a = 0.0;
+  double p = 0.0,  ///< position, m
+         v = 0.0,  ///< velocity, m/s
+         a = 0.0;  ///< acceleration, m/s²
 };
 
 /// One axis of the family above. Valid for t in [0, ∞) (holds pf after T).
@@ -47,8 +50,11 @@ public:
   /// Time-optimal arrival time (>= 0). v0 is clamped to ±v_max first. Throws InvalidInput on bad limits.
   static double minimumTime(double p0, double v0, double pf, double v_max, double a_max);
 
+  /// Position, velocity and acceleration at time t (s from the start of the profile).
   AxisState at(double t) const;
+  /// Arrival time T (s from the start).
   double duration() const { return T_; }
+  /// Cruise velocity vc of phase 2 (m/s, signed).
   double cruiseVelocity() const { return vc_; }
 
 private:
@@ -60,8 +66,11 @@ private:
 /// Distance covered by the family for cruise speed vc (exposed for tests).
 double profileDistance(double v0, double vc, double a_max, double T);
 
+/// Position, velocity and acceleration of the three axes (world frame; m, m/s, m/s²).
 struct CartesianSample {
-  Eigen::Vector3d p = Eigen::Vector3d::Zero(), v = Eigen::Vector3d::Zero(), a = Eigen::Vector3d::Zero();
+  Eigen::Vector3d p = Eigen::Vector3d::Zero(),  ///< position, world frame, m
+                  v = Eigen::Vector3d::Zero(),  ///< velocity, world frame, m/s
+                  a = Eigen::Vector3d::Zero();  ///< acceleration, world frame, m/s²
 };
 
 /// Three synchronised axes starting at absolute time t0.
@@ -77,9 +86,13 @@ public:
                                 const Eigen::Vector3d& v_max, const Eigen::Vector3d& a_max);
   /// Sample at absolute time t (before t0: the start state; after arrival: at rest at pf).
   CartesianSample at(double t) const;
+  /// Start time t0 (s, absolute).
   double startTime() const { return t0_; }
+  /// Arrival time t0 + T (s, absolute).
   double arrivalTime() const { return t0_ + T_; }
+  /// Duration T (s).
   double duration() const { return T_; }
+  /// Goal position (m, world frame).
   const Eigen::Vector3d& goal() const { return pf_; }
 
 private:

@@ -41,15 +41,18 @@ struct CartesianLimits {
 
 /// Tool point position and velocity at time t.
 struct CartesianState {
-  core::Timestamp t = 0.0;
-  Eigen::Vector3d p = Eigen::Vector3d::Zero();
-  Eigen::Vector3d v = Eigen::Vector3d::Zero();
+  core::Timestamp t = 0.0;  ///< time of the state, s
+  Eigen::Vector3d p = Eigen::Vector3d::Zero();  ///< tool point position, world frame, m
+  Eigen::Vector3d v = Eigen::Vector3d::Zero();  ///< tool point velocity, world frame, m/s
 };
 
+/// A robot carrying the catching box, commanded by streamed Cartesian set points of its tool point (world frame).
 class CartesianRobot {
 public:
   virtual ~CartesianRobot() = default;
+  /// Short name for logs and summaries.
   virtual std::string name() const = 0;
+  /// Per-axis Cartesian limits of the tool point (the planner asks the robot, their owner).
   virtual const CartesianLimits& limits() const = 0;
   /// Delay between a set point's issue and its effect (s).
   virtual double commandLatency() const = 0;
@@ -71,7 +74,9 @@ public:
   ViperArmKinematics(const Eigen::Isometry3d& w_M_f, const Eigen::Matrix3d& w_R_box,
                      const Eigen::Vector3d& tool_offset);
   ~ViperArmKinematics();
+  /// Copies the model (deep copy of the ViSP robot).
   ViperArmKinematics(const ViperArmKinematics&);
+  /// Assigns the model (deep copy of the ViSP robot).
   ViperArmKinematics& operator=(const ViperArmKinematics&);
 
   /// Joint solution (6) for the box at p_w, nearest to `q_seed`, within the joint limits
@@ -81,8 +86,11 @@ public:
                                                      double margin = 0.0) const;
   /// Box pose in the world for joints q (forward kinematics, vpViper::get_fMc).
   Eigen::Isometry3d forward(const Eigen::Matrix<double, 6, 1>& q) const;
+  /// Lower joint limits (6 joints, rad).
   Eigen::Matrix<double, 6, 1> jointMin() const;
+  /// Upper joint limits (6 joints, rad).
   Eigen::Matrix<double, 6, 1> jointMax() const;
+  /// Fixed orientation of the box in the world (w_R_box).
   const Eigen::Matrix3d& boxRotation() const { return w_R_box_; }
 
 private:
@@ -92,23 +100,29 @@ private:
   Eigen::Matrix3d w_R_box_;
 };
 
+/// Kinematics of the simulated Cartesian robot: a gantry stage or the vpViper850 arm.
 enum class CartesianBackEnd { Stage, Arm };
+/// Lower-case name of a back end ("stage", "arm").
 const char* toString(CartesianBackEnd k);
 
+/// Configuration of the simulated Cartesian robot (limits, latency, workspace; arm mounting).
 struct SimulatedCartesianConfig {
-  CartesianBackEnd kind = CartesianBackEnd::Stage;
-  CartesianLimits limits;
+  CartesianBackEnd kind = CartesianBackEnd::Stage;  ///< stage or arm
+  CartesianLimits limits;  ///< per-axis velocity and acceleration limits of the tool point
   double latency = 0.008;          ///< s between a set point's issue and its effect
   Eigen::Vector3d home = Eigen::Vector3d(0.0, 0.0, 1.2);      ///< tool point at rest, world
   Eigen::Vector3d workspace_min = Eigen::Vector3d(-0.1, -0.6, 0.7);  ///< stage box (and arm bounds)
+  /// Upper corner of the stage box (and arm bounds), world, m
   Eigen::Vector3d workspace_max = Eigen::Vector3d(0.1, 0.6, 1.7);
   // Arm only.
-  Eigen::Isometry3d w_M_base = Eigen::Isometry3d::Identity();
-  Eigen::Matrix3d w_R_box = Eigen::Matrix3d::Identity();
+  Eigen::Isometry3d w_M_base = Eigen::Isometry3d::Identity();  ///< arm only: pose of the robot base in the world
+  Eigen::Matrix3d w_R_box = Eigen::Matrix3d::Identity();  ///< arm only: fixed box orientation in the world
+  /// Arm only: flange to hole centre, in the flange frame, m
   Eigen::Vector3d tool_offset = Eigen::Vector3d(0.0, 0.0, 0.2);
   double joint_margin = 0.02;      ///< rad kept from each joint limit
   /// Tolerance of the limit check of the streamed set points (relative).
   double limit_tolerance = 1e-6;
+  /// Throws core::InvalidInput naming the field.
   void validate() const;
 };
 
@@ -118,8 +132,11 @@ struct SimulatedCartesianConfig {
 /// between consecutive set points over their interval) and the workspace / IK.
 class SimulatedCartesianRobot : public CartesianRobot {
 public:
+  /// Builds the robot (validates the config, throws core::InvalidInput); the tool rests at home at t = 0.
   explicit SimulatedCartesianRobot(SimulatedCartesianConfig cfg);
+  /// "simulated Cartesian stage" or "simulated vpViper850 arm".
   std::string name() const override;
+  /// The configured limits.
   const CartesianLimits& limits() const override { return cfg_.limits; }
   double commandLatency() const override { return cfg_.latency; }
   bool reachable(const Eigen::Vector3d& p_w) const override;
@@ -128,15 +145,21 @@ public:
 
   /// Forget the history; the tool is at `home` at rest (as if a set point (home, 0) was issued at t).
   void reset(core::Timestamp t);
+  /// The configuration in use.
   const SimulatedCartesianConfig& config() const { return cfg_; }
+  /// Number of set points received.
   std::size_t setpoints() const { return setpoints_; }
+  /// Set points whose velocity exceeded the limits (tests assert 0).
   std::size_t velocityViolations() const { return v_violations_; }
+  /// Set points whose implied acceleration exceeded the limits (tests assert 0).
   std::size_t accelerationViolations() const { return a_violations_; }
+  /// Set points refused (no IK solution within the joint limits, or outside the workspace).
   std::size_t refusedSetpoints() const { return refused_; }
   double maxSpeedSeen() const { return max_v_; }       ///< max |v_i| over set points
   double maxAccelerationSeen() const { return max_a_; } ///< max |Δv_i / Δt|
   /// Last joint solution (arm back end), zeros for the stage.
   const Eigen::Matrix<double, 6, 1>& joints() const { return q_; }
+  /// The arm's kinematics (nullptr for the stage).
   const ViperArmKinematics* arm() const { return arm_ ? &*arm_ : nullptr; }
 
 private:

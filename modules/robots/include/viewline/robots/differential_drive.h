@@ -26,13 +26,17 @@
 
 namespace viewline::robots {
 
+/// Pose of the mobile base on the floor: position and heading θ from the world x axis.
 struct BasePose {
-  double x = 0.0, y = 0.0, theta = 0.0;  ///< m, m, rad (world frame)
+  double x = 0.0,      ///< position x, world frame, m
+         y = 0.0,      ///< position y, world frame, m
+         theta = 0.0;  ///< heading from the world x axis (counter-clockwise), rad
 };
 
 /// Exact unicycle motion over dt with constant (v, ω) (circular arc).
 BasePose integrateUnicycle(const BasePose& p, double v, double omega, double dt);
 
+/// Parameters of the differential-drive base: geometry, limits, motor lag and wheel PID ([K]).
 struct DifferentialDriveParams {
   double track = 0.30;             ///< b, distance between the wheels, m
   double max_speed = 0.30;         ///< |v| limit, m/s ([K]: 30 cm/s)
@@ -41,15 +45,19 @@ struct DifferentialDriveParams {
   double motor_time_constant = 0.08;  ///< τ, s
   double control_period = 0.01;    ///< wheel PID period, s ([K]: 10 ms)
   int substeps = 5;                ///< pose integration sub-steps per control period
-  double kp = 2.0, ki = 4.0, kd = 0.0;  ///< wheel speed PID gains (on rim speed, 1, 1/s, s)
+  double kp = 2.0,                 ///< wheel speed PID proportional gain (on rim speed), 1
+         ki = 4.0,                 ///< integral gain, 1/s
+         kd = 0.0;                 ///< derivative gain, s
   double encoder_noise = 0.0;      ///< std of the measured wheel speed, m/s
 
   /// Throws core::InvalidInput naming the field.
   void validate() const;
 };
 
+/// Simulated differential-drive base: wheel PID, first-order motors and exact unicycle integration.
 class DifferentialDrive {
 public:
+  /// Base at `start` at rest, time 0 (validates params; throws core::InvalidInput).
   DifferentialDrive(const DifferentialDriveParams& params, const BasePose& start);
 
   /// Desired body velocities; see the header comment for limits.
@@ -58,14 +66,19 @@ public:
   /// `rng` is used only when encoder_noise > 0.
   void step(core::Rng& rng);
 
+  /// Current true pose on the floor (world frame).
   const BasePose& pose() const { return pose_; }
   /// Current body velocities from the true wheel speeds.
   double speed() const { return 0.5 * (wheel_.x() + wheel_.y()); }
+  /// Current turn rate from the true wheel speeds, rad/s.
   double turnRate() const { return (wheel_.y() - wheel_.x()) / params_.track; }
   /// Wheel rim speeds (left, right) and their references.
   const Eigen::Vector2d& wheelSpeeds() const { return wheel_; }
+  /// Wheel speed references (left, right) of the PID, m/s.
   const Eigen::Vector2d& wheelReferences() const { return ref_; }
+  /// Simulated time, s.
   double time() const { return t_; }
+  /// The parameters in use.
   const DifferentialDriveParams& params() const { return params_; }
 
 private:
@@ -81,6 +94,7 @@ private:
 /// Rate-limited position servo of the pan/tilt joints (the head's own drive): each control
 /// period every joint moves towards its set point by at most rate_max · dt.
 struct JointRateLimiter {
+  /// Joint position after one period of dt: moves from current towards target by at most rate_max · dt (rad, rad/s, s).
   static double step(double current, double target, double rate_max, double dt);
 };
 

@@ -31,18 +31,23 @@ namespace viewline::robots {
 std::optional<Eigen::Vector2d> groundPointExact(const core::Camera& camera, const Eigen::Vector2d& uv,
                                                 double plane_z = 0.0);
 
+/// Which range [K]'s angle-per-pixel method uses: the slant range as printed, or the corrected horizontal distance.
 enum class AngleRange { PrintedSlant, Horizontal };
 
+/// [K]'s angle-per-pixel model: fields of view and range variant.
 struct AnglePerPixel {
   double hfov = 0.0;  ///< θ_rx, rad (image width)
   double vfov = 0.0;  ///< θ_ry, rad (image height)
-  AngleRange range = AngleRange::PrintedSlant;
+  AngleRange range = AngleRange::PrintedSlant;  ///< slant range as printed in [K], or the corrected horizontal range
 };
 
 /// Yaw ψ, depression δ and roll φ of a camera pose (definitions above), rad.
 struct CameraAttitude {
-  double yaw = 0.0, depression = 0.0, roll = 0.0;
+  double yaw = 0.0,         ///< ψ, optical axis about world z from world x, rad
+         depression = 0.0,  ///< δ, optical axis below the horizon, rad
+         roll = 0.0;        ///< φ, rotation about the optical axis, rad
 };
+/// Yaw, depression and roll of the camera's optical axis in the world (z up).
 CameraAttitude cameraAttitude(const core::Camera& camera);
 
 /// [K]'s angle-per-pixel localisation; nothing when the ray points at or above the horizon.

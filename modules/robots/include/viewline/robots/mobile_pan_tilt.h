@@ -48,10 +48,10 @@ namespace viewline::robots {
 
 /// One Denavit-Hartenberg row (standard convention), angles in rad, lengths in m.
 struct DhRow {
-  double theta = 0.0;
-  double d = 0.0;
-  double a = 0.0;
-  double alpha = 0.0;
+  double theta = 0.0;  ///< joint angle θ, rad
+  double d = 0.0;  ///< offset d along the previous z, m
+  double a = 0.0;  ///< link length a along the new x, m
+  double alpha = 0.0;  ///< twist α about the new x, rad
 };
 
 /// (i-1)_M_i = Rz(θ) Tz(d) Tx(a) Rx(α), built with ViSP (vpHomogeneousMatrix).
@@ -59,26 +59,34 @@ vpHomogeneousMatrix dhTransform(const DhRow& row);
 /// Product of the rows' transforms: 0_M_n.
 vpHomogeneousMatrix dhChain(const std::vector<DhRow>& rows);
 
+/// Joint angles of the mobile robot's pan/tilt head (corrected DH convention), rad.
 struct PanTiltJoints {
   double tilt = 0.0;  ///< α_t, rad (> 0: camera looks down)
   double pan = 0.0;   ///< β_p, rad (> 0: camera looks left)
 };
 
+/// Link lengths and joint limits of the mobile robot's pan/tilt head ([K], SPEC §4).
 struct MobilePanTiltParams {
   double l1 = 0.40;   ///< shoulder height above the floor, m
   double l2 = 0.075;  ///< tilt link, m
   double l3 = 0.04;   ///< pan link (to the camera centre), m
-  double tilt_min = -0.6, tilt_max = 1.45;   ///< rad (about -34°..83°)
-  double pan_min = -2.97, pan_max = 2.97;    ///< rad (about ±170°)
-  double tilt_rate_max = 3.14, pan_rate_max = 3.14;  ///< rad/s
+  double tilt_min = -0.6,   ///< lower tilt limit, rad (about -34°)
+         tilt_max = 1.45;   ///< upper tilt limit, rad (about 83°)
+  double pan_min = -2.97,   ///< lower pan limit, rad (about -170°)
+         pan_max = 2.97;    ///< upper pan limit, rad (about 170°)
+  double tilt_rate_max = 3.14,  ///< tilt rate limit, rad/s
+         pan_rate_max = 3.14;   ///< pan rate limit, rad/s
 
   /// Throws core::InvalidInput naming the field.
   void validate() const;
 };
 
+/// Kinematics of the mobile robot's pan/tilt head: DH chain, camera pose r_M_c and inverse kinematics (pointAt).
 class MobilePanTilt {
 public:
+  /// Head with these parameters (validated; throws core::InvalidInput).
   explicit MobilePanTilt(const MobilePanTiltParams& params = {});
+  /// The parameters in use.
   const MobilePanTiltParams& params() const { return params_; }
 
   /// The DH rows as printed in SPEC §4 (link 2 θ = 90° - α_t): kept to document the erratum.
@@ -106,7 +114,9 @@ public:
   /// Angle between the optical axis for q and the direction from the camera centre to p_r.
   double pointingError(const PanTiltJoints& q, const Eigen::Vector3d& p_r) const;
 
+  /// True when both joints are within their limits (+ tol, rad).
   bool withinLimits(const PanTiltJoints& q, double tol = 1e-9) const;
+  /// The joints clamped to their limits.
   PanTiltJoints clampToLimits(const PanTiltJoints& q) const;
 
 private:

@@ -24,6 +24,7 @@ namespace viewline::robots {
 /// Names of the hardware back ends compiled into this build (empty on Debian's ViSP).
 std::vector<std::string> panTiltHardwareAvailable();
 
+/// Which hardware pan-tilt unit to open and how (ViSP driver, device, limits, latency).
 struct PanTiltHardwareConfig {
   std::string backend;          ///< "flir_ptu", "ptu46" or "biclops"
   std::string device;           ///< serial port (flir_ptu, ptu46) or Biclops config file

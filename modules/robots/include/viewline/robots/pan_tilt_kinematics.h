@@ -36,6 +36,7 @@
 
 namespace viewline::robots {
 
+/// vpPtu46 kinematics of the pan-tilt head with a given camera mount e_M_c: camera pose f_M_c(q), Jacobian, pointing.
 class PanTiltKinematics {
 public:
   /// vpPtu46's nominal camera mount.

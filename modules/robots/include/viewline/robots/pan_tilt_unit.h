@@ -24,8 +24,8 @@ namespace viewline::robots {
 
 /// Joint and rate limits of a pan-tilt unit (rad, rad/s, rad/s²).
 struct PanTiltLimits {
-  Eigen::Vector2d q_min = Eigen::Vector2d::Zero();
-  Eigen::Vector2d q_max = Eigen::Vector2d::Zero();
+  Eigen::Vector2d q_min = Eigen::Vector2d::Zero();  ///< lower joint limits (pan, tilt), rad
+  Eigen::Vector2d q_max = Eigen::Vector2d::Zero();  ///< upper joint limits (pan, tilt), rad
   Eigen::Vector2d qdot_max = Eigen::Vector2d::Zero();   ///< |q̇| per axis
   Eigen::Vector2d qddot_max = Eigen::Vector2d::Zero();  ///< |q̈| per axis (the drive's acceleration)
 
@@ -38,15 +38,18 @@ struct PanTiltLimits {
 
 /// Joint positions and velocities at time t.
 struct JointState {
-  core::Timestamp t = 0.0;
-  Eigen::Vector2d q = Eigen::Vector2d::Zero();
-  Eigen::Vector2d qdot = Eigen::Vector2d::Zero();
+  core::Timestamp t = 0.0;  ///< time of the state, s
+  Eigen::Vector2d q = Eigen::Vector2d::Zero();  ///< joint positions (pan, tilt), rad
+  Eigen::Vector2d qdot = Eigen::Vector2d::Zero();  ///< joint velocities (pan, tilt), rad/s
 };
 
+/// A velocity-controlled pan-tilt unit (simulated or hardware); joints q = (pan, tilt), vpPtu46 conventions.
 class PanTiltUnit {
 public:
   virtual ~PanTiltUnit() = default;
+  /// Short name for logs and summaries.
   virtual std::string name() const = 0;
+  /// The unit's joint and rate limits (controllers ask the unit, their owner).
   virtual const PanTiltLimits& limits() const = 0;
   /// Nominal delay between a command's issue and its effect (s).
   virtual double commandLatency() const = 0;
@@ -61,8 +64,8 @@ public:
 
 /// A velocity command as issued (issue time t, before the latency).
 struct IssuedCommand {
-  core::Timestamp t = 0.0;
-  Eigen::Vector2d qdot = Eigen::Vector2d::Zero();
+  core::Timestamp t = 0.0;  ///< issue time, s
+  Eigen::Vector2d qdot = Eigen::Vector2d::Zero();  ///< commanded joint velocities (pan, tilt), rad/s
 };
 
 /// Predicts the joint state at time t (>= now.t) from the state `now`, the commands issued

@@ -22,7 +22,9 @@
 
 namespace viewline::robots {
 
+/// Parameters of the simulated pan-tilt unit: limits, latency, integration sub-step, history and initial joints.
 struct SimulatedPanTiltParams {
+  /// Joint, rate and acceleration limits (default: FLIR PTU-D46-17.5)
   PanTiltLimits limits = PanTiltLimits::flirPtuD46();
   double latency = 0.03;          ///< s, command issue -> effect
   double substep = 1e-3;          ///< s
@@ -32,8 +34,10 @@ struct SimulatedPanTiltParams {
   void validate() const;  ///< throws core::InvalidInput naming the field
 };
 
+/// Simulated pan-tilt unit: delayed commands, acceleration-limited velocity, hard stops, counted violations.
 class SimulatedPanTiltUnit : public PanTiltUnit {
 public:
+  /// Unit at q0 at rest at time t0 (validates params; throws core::InvalidInput).
   explicit SimulatedPanTiltUnit(const SimulatedPanTiltParams& params = {}, core::Timestamp t0 = 0.0);
 
   std::string name() const override { return "simulated FLIR PTU-D46-17.5"; }
@@ -46,11 +50,16 @@ public:
 
   /// Advances the simulation to t (>= now).
   void advanceTo(core::Timestamp t);
+  /// Current simulated state (at the simulated time).
   const JointState& now() const { return state_; }
 
+  /// Commands above qdot_max (clipped; tests assert 0).
   std::size_t rateViolations() const { return rate_violations_; }
+  /// Times a joint reached a hard stop while moving towards it (tests assert 0).
   std::size_t limitHits() const { return limit_hits_; }
+  /// Every command received, with its issue time.
   const std::vector<IssuedCommand>& commands() const { return log_; }
+  /// The parameters in use.
   const SimulatedPanTiltParams& params() const { return params_; }
 
 private:

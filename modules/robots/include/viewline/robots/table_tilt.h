@@ -22,6 +22,7 @@
 
 namespace viewline::robots {
 
+/// Limits of the table's wrist: angle, rate and actuator delay.
 struct TableTiltLimits {
   double max_angle = 0.35;  ///< |θ| limit per axis, rad (> 0)
   double max_rate = 1.5;    ///< |θ̇| limit per axis, rad/s (> 0)
@@ -43,6 +44,7 @@ public:
   virtual void command(double t, const Eigen::Vector2d& tilt) = 0;
   /// The actual tilt at time t (s); t must not decrease between calls.
   virtual Eigen::Vector2d actual(double t) = 0;
+  /// The wrist's limits (controllers ask the table, their owner).
   virtual const TableTiltLimits& limits() const = 0;
 };
 

@@ -16,6 +16,8 @@
 namespace viewline::runtime {
 
 template <typename T>
+/// A FIFO latency: values of type T sent with an availability time (s) and received once the consumer's time
+/// reaches it.
 class DelayLine {
 public:
   /// Queues `value`, available from `t_available` on. Deliveries keep the order of sending, so
@@ -42,10 +44,13 @@ public:
     return n;
   }
 
+  /// True when no value is in flight.
   bool empty() const { return queue_.empty(); }
+  /// Number of values in flight.
   std::size_t size() const { return queue_.size(); }
   /// Availability time of the oldest value in flight (undefined when empty()).
   double nextAvailable() const { return queue_.front().first; }
+  /// Drops every value in flight.
   void clear() { queue_.clear(); }
 
 private:

@@ -17,6 +17,7 @@
 
 namespace viewline::runtime {
 
+/// One image from a camera of the rig, with its capture time and the driver's time stamp.
 struct Frame {
   std::size_t camera = 0;             ///< index of the camera in its rig
   std::uint64_t sequence = 0;         ///< per-camera frame counter
@@ -25,6 +26,7 @@ struct Frame {
   cv::Mat image;                      ///< CV_8UC3 BGR or CV_8UC1
 };
 
+/// Where images come from (renderer, live camera, video, recording, remote node), polled by the scheduler.
 class FrameSource {
 public:
   virtual ~FrameSource() = default;

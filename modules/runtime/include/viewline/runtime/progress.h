@@ -15,6 +15,7 @@
 
 namespace viewline::runtime {
 
+/// Progress line of a long run ("throws 37 / 100"): redrawn in place on a terminal, plain rate-limited lines in a log.
 class Progress {
 public:
   /// Reports "<what> <done> / <total>" on `out` (stderr by default). `interactive`: -1 asks
@@ -26,6 +27,7 @@ public:
   ~Progress();
   Progress(const Progress&) = delete;
   Progress& operator=(const Progress&) = delete;
+  /// Takes over another progress line (the moved-from one prints nothing more).
   Progress(Progress&&) noexcept;
   Progress& operator=(Progress&&) = delete;
 
@@ -33,6 +35,7 @@ public:
   void update(long done);
   /// Ends the line (the last count is printed if it was not). Idempotent.
   void finish();
+  /// True when the line redraws in place (a terminal).
   bool interactive() const { return interactive_; }
 
 private:

@@ -36,24 +36,33 @@ namespace viewline::runtime {
 /// these name the usual order: the plant is advanced, deliveries reach their consumer, the
 /// controller runs, then a frame is captured and processed.
 namespace priority {
+/// Plant and simulated-world steps run first.
 inline constexpr int Physics = 0;
+/// Delayed deliveries (DelayLine) reach their consumer.
 inline constexpr int Delivery = 10;
+/// Controllers and planners run on what was delivered.
 inline constexpr int Control = 20;
+/// Frames are captured and processed.
 inline constexpr int Capture = 30;
+/// Telemetry sampling runs last, on the settled state.
 inline constexpr int Telemetry = 40;
 }  // namespace priority
 
+/// Identifier of a scheduled event (for Scheduler::cancel()).
 using EventId = std::uint64_t;
 
 /// How a run relates to the wall clock.
 struct Pacing {
   /// Simulated seconds per wall-clock second; 0 = as fast as possible.
   double factor = 0.0;
+  /// True when the run is paced to the wall clock (factor > 0).
   bool paced() const { return factor > 0.0; }
 };
 
+/// Discrete-event scheduler: the one clock of a scenario, events ordered by (time, priority, order of scheduling).
 class Scheduler {
 public:
+  /// What an event runs, called with the event's time t (s).
   using Action = std::function<void(double t)>;
 
   /// Starts the clock at t0 (s). Throws core::InvalidInput for a non-finite t0.
@@ -87,16 +96,20 @@ public:
 
   /// Events still to run (a periodic event counts once).
   std::size_t pending() const { return entries_.size(); }
+  /// Number of events run so far.
   std::uint64_t eventsRun() const { return events_run_; }
 
   /// Wall-clock pacing from now on (the paced run starts at the next event run).
   void setPacing(Pacing pacing);
+  /// The pacing in use.
   Pacing pacing() const { return pacing_; }
 
   /// Asks runUntil()/step() to return before the next event (e.g. a display's quit key or
   /// SIGINT); stopRequested() stays true until clearStop().
   void requestStop() { stop_ = true; }
+  /// True after requestStop() until clearStop().
   bool stopRequested() const { return stop_; }
+  /// Clears a stop request so that runUntil()/step() run events again.
   void clearStop() { stop_ = false; }
 
 private:

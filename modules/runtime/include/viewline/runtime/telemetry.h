@@ -48,39 +48,45 @@ struct InnovationRecord {
   Eigen::VectorXd innovation;    ///< d = z − h(x̂(k|k−1)) (empty when the decision is Start)
   Eigen::MatrixXd S;             ///< innovation covariance
   double nis = 0.0;              ///< dᵀ S⁻¹ d
+  /// The gate's decision (accept, reject, start a new track...)
   tracking::GateDecision decision = tracking::GateDecision::Accept;
 };
 
 /// A state estimate after an update (or a prediction published to a consumer).
 struct EstimateRecord {
-  std::string channel;
-  double t = 0.0;
-  Eigen::VectorXd x;
+  std::string channel;  ///< the track or estimator
+  double t = 0.0;  ///< time of the estimate, s
+  Eigen::VectorXd x;  ///< the state mean
   Eigen::MatrixXd P;             ///< may be empty
 };
 
 /// A command sent to an actuator (joint velocities, a set point...).
 struct CommandRecord {
-  std::string channel;
-  double t = 0.0;
-  Eigen::VectorXd u;
+  std::string channel;  ///< the actuator
+  double t = 0.0;  ///< issue time, s
+  Eigen::VectorXd u;  ///< the command (joint velocities, a set point...)
 };
 
 /// A named scalar sample (an error, a flag, a metric's running value).
 struct ScalarRecord {
-  std::string channel;
-  double t = 0.0;
-  double value = 0.0;
+  std::string channel;  ///< e.g. "error_px"
+  double t = 0.0;  ///< time of the sample, s
+  double value = 0.0;  ///< the value (units in the channel name or the scenario's docs)
 };
 
 /// Receives every record of a run. The defaults ignore them.
 class TelemetrySink {
 public:
   virtual ~TelemetrySink() = default;
+  /// A measurement delivered to an estimator (ignored by default).
   virtual void measurement(const MeasurementRecord& /*r*/) {}
+  /// One gated update of a track with its diagnostics (ignored by default).
   virtual void innovation(const InnovationRecord& /*r*/) {}
+  /// A state estimate (ignored by default).
   virtual void estimate(const EstimateRecord& /*r*/) {}
+  /// A command sent to an actuator (ignored by default).
   virtual void command(const CommandRecord& /*r*/) {}
+  /// A named scalar sample (ignored by default).
   virtual void scalar(const ScalarRecord& /*r*/) {}
   /// Written files are flushed (end of a run, or before a crash report).
   virtual void flush() {}
@@ -99,16 +105,17 @@ public:
   std::vector<InnovationRecord> innovationsOf(const std::string& channel) const;
   /// How many innovations of `channel` (all when empty) had decision d.
   std::size_t count(tracking::GateDecision d, const std::string& channel = {}) const;
+  /// Forgets every record.
   void clear();
 
-  std::vector<MeasurementRecord> measurements;
-  std::vector<InnovationRecord> innovations;
-  std::vector<EstimateRecord> estimates;
-  std::vector<CommandRecord> commands;
-  std::vector<ScalarRecord> scalars;
+  std::vector<MeasurementRecord> measurements;  ///< every measurement, in arrival order
+  std::vector<InnovationRecord> innovations;  ///< every innovation, in arrival order
+  std::vector<EstimateRecord> estimates;  ///< every estimate, in arrival order
+  std::vector<CommandRecord> commands;  ///< every command, in arrival order
+  std::vector<ScalarRecord> scalars;  ///< every scalar, in arrival order
 };
 
-/// Writes records as CSV into a log directory: <kind>_<channel>.csv, one row per record, the
+/// Writes records as CSV into a log directory: `<kind>_<channel>.csv`, one row per record, the
 /// columns fixed by the first record of the channel (a later record of another size throws).
 class CsvSink : public TelemetrySink {
 public:

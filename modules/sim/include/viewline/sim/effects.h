@@ -52,12 +52,12 @@ struct Illumination {
 /// apparent disc so that `fraction` of its area is hidden. The edge normal points along
 /// `direction` (rad, image x towards image y) or a uniform random direction per frame.
 struct Occlusion {
-  std::string target = "ball";
+  std::string target = "ball";  ///< name of the occluded primitive
   double fraction = 0.0;                                          ///< [0, 1]
-  bool random_direction = true;
+  bool random_direction = true;  ///< draw the edge direction uniformly per frame (else `direction`)
   double direction = 0.0;                                         ///< rad, used when not random
   double depth_ratio = 0.5;                                       ///< (0, 1)
-  Eigen::Vector3d colour_bgr = Eigen::Vector3d(0.35, 0.33, 0.3);
+  Eigen::Vector3d colour_bgr = Eigen::Vector3d(0.35, 0.33, 0.3);  ///< occluder reflectance (BGR, [0, 1])
 };
 
 /// Faults of the camera link: frames lost and imprecise time stamps.
@@ -68,12 +68,13 @@ struct FrameFaults {
                                    ///< (clamped to ±0.45 period so frames keep their order)
 };
 
+/// Every imaging effect of one simulated camera (all off by default).
 struct ImagingEffects {
-  SensorNoise noise;
-  MotionBlur blur;
-  Illumination illumination;
-  Occlusion occlusion;
-  FrameFaults faults;
+  SensorNoise noise;  ///< sensor noise
+  MotionBlur blur;  ///< motion blur
+  Illumination illumination;  ///< illumination and white balance
+  Occlusion occlusion;  ///< partial occlusion of a target
+  FrameFaults faults;  ///< frame drops and time-stamp jitter
 };
 
 /// Throws core::InvalidInput naming the field for out-of-range settings.
@@ -88,11 +89,14 @@ void applyIllumination(cv::Mat& bgr8, const Illumination& illumination, double t
 class NoisePool {
 public:
   static constexpr double kMaxPoolSigma = 40.0;  ///< above: per-frame cv::randn (no clipping)
+  /// Draws pool_size rounded N(0, sigma²) values from rng (none for sigma 0 or above kMaxPoolSigma); throws
+  /// core::InvalidInput for bad settings.
   NoisePool(const SensorNoise& noise, core::Rng& rng);
   /// Adds noise to an 8-bit image in place; the offset is drawn from rng.
   void apply(cv::Mat& image8, core::Rng& rng) const;
   /// Per-channel gains (illuminationGain) then noise, in a single pass over the image.
   void applyWithGain(cv::Mat& image8, const Eigen::Vector3d& gain_bgr, core::Rng& rng) const;
+  /// Noise standard deviation, grey levels.
   double sigma() const { return sigma_; }
 
 private:

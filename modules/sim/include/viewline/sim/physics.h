@@ -52,6 +52,7 @@ struct DragBody {
   static DragBody vacuum() { return {0.057, 0.025, 0.0, 0.0}; }
 };
 
+/// Position and velocity of a body in flight (world frame).
 struct FlightState {
   Eigen::Vector3d p = Eigen::Vector3d::Zero();  ///< position (world), m
   Eigen::Vector3d v = Eigen::Vector3d::Zero();  ///< velocity (world), m/s
@@ -73,9 +74,13 @@ public:
 
   /// State at time t in [t0, t0 + duration]; throws InvalidInput outside.
   FlightState state(double t) const;
+  /// Start of the precomputed flight, s.
   double startTime() const { return t0_; }
+  /// End of the precomputed flight, s.
   double endTime() const { return t0_ + duration_; }
+  /// Drag constant k = ρ Cd A / (2 m), 1/m.
   double dragPerMass() const { return k_; }
+  /// Aerodynamic parameters of the body.
   const DragBody& body() const { return body_; }
 
 private:
@@ -96,6 +101,7 @@ Eigen::Isometry3d dartPose(const Eigen::Vector3d& position_w, const Eigen::Vecto
 // ----------------------------------------------------------------------------------------------
 // Ball rolling on an actuated tilting table.
 
+/// Geometry, limits, delay and integration settings of the simulated tilting table.
 struct TiltTableParams {
   double side = 0.3;                   ///< L, m (red surface, SPEC §3)
   double ball_radius = 0.025;          ///< r, m
@@ -110,7 +116,7 @@ struct TiltTableParams {
 
 /// State of the table-ball system at one instant.
 struct TiltTableState {
-  double t = 0.0;
+  double t = 0.0;  ///< time of the state, s
   Eigen::Vector2d tilt = Eigen::Vector2d::Zero();  ///< (about base x, then about tilted y), rad
   Eigen::Vector2d p = Eigen::Vector2d::Zero();     ///< ball centre on the table (table frame), m
   Eigen::Vector2d v = Eigen::Vector2d::Zero();     ///< ball velocity on the table, m/s
@@ -120,6 +126,7 @@ struct TiltTableState {
 /// Rx(tilt.x) · Ry(tilt.y); the ball centre is at (px, py, r) in the table frame.
 class TiltTable {
 public:
+  /// Table with these parameters, starting from `initial` (time, tilt, ball position and velocity).
   explicit TiltTable(const TiltTableParams& params, const TiltTableState& initial = {});
 
   /// Command tilt angles (rad) at time t (>= the last command's time); applied after the delay,
@@ -130,7 +137,9 @@ public:
   /// Advance the simulation to time t (>= current time) with sub-steps.
   void advanceTo(double t);
 
+  /// Current state (at the simulated time).
   const TiltTableState& state() const { return state_; }
+  /// The parameters in use.
   const TiltTableParams& params() const { return params_; }
   /// State at an earlier time (linear interpolation of the recorded history, clamped to it).
   TiltTableState stateAt(double t) const;
@@ -155,10 +164,12 @@ private:
 // ----------------------------------------------------------------------------------------------
 // Screen target ([T]).
 
+/// Shape of the screen target's path: rectangle, circle or random polyline ([T]).
 enum class PathShape { Rectangle, Circle, Random };
 
+/// Path of the screen target: shape, speed and size (screen frame, m).
 struct ScreenPathParams {
-  PathShape shape = PathShape::Rectangle;
+  PathShape shape = PathShape::Rectangle;  ///< path shape
   double speed = 0.2;                                    ///< constant speed, m/s
   Eigen::Vector2d center = Eigen::Vector2d::Zero();      ///< path centre on the screen, m
   double width = 1.2;                                    ///< rectangle width / random box width, m
@@ -179,11 +190,14 @@ class ScreenPath {
 public:
   /// rng is used only by the random path (drawn at construction).
   ScreenPath(const ScreenPathParams& params, core::Rng& rng);
+  /// Target position at time t (s) on the screen plane (screen frame, m).
   Eigen::Vector2d position(double t) const;
+  /// Target velocity at time t (s) on the screen plane (screen frame, m/s).
   Eigen::Vector2d velocity(double t) const;
   /// Times in (0, t_end] at which the target passes a vertex of the polyline (its corners); empty for the
   /// circle; with rounded corners, the times at the middle of each arc.
   std::vector<double> cornerTimes(double t_end) const;
+  /// The parameters in use.
   const ScreenPathParams& params() const { return params_; }
 
 private:
@@ -204,13 +218,15 @@ private:
 // ----------------------------------------------------------------------------------------------
 // Ground target ([K]).
 
+/// Speed and turn-rate profile of the ground target ([K]'s two test profiles).
 enum class GroundProfile {
   Capture,     ///< v = 0.30 (cos(0.01k) + 1) + ξv m/s, ω = 0.7 sin(0.03k + π/1.5) + ξω (var 2 cm²/s², 0.1)
   FilterTest,  ///< v = 0.15 (sin(0.02k) + 1) + ξv,  ω = 0.7 cos(0.01k) + ξω  (var 3 cm²/s², 0.1)
 };
 
+/// Profile, start pose, duration and integration of the simulated ground target ([K]).
 struct GroundTargetParams {
-  GroundProfile profile = GroundProfile::Capture;
+  GroundProfile profile = GroundProfile::Capture;  ///< which of [K]'s profiles drives the target
   double profile_period = 0.1;                                  ///< s per profile index k ([K]: vision period)
   Eigen::Vector2d start = Eigen::Vector2d(-2.5, 3.0);           ///< m ([K]: (-250, 300) cm)
   double heading = 0.0;                                         ///< initial θ, rad
@@ -219,19 +235,26 @@ struct GroundTargetParams {
   bool noise = true;                                            ///< add ξv, ξω (else the nominal profile)
 };
 
+/// State of the ground target on the floor (world frame).
 struct GroundState {
-  double x = 0.0, y = 0.0, theta = 0.0;  ///< m, m, rad
-  double v = 0.0, omega = 0.0;           ///< m/s, rad/s
+  double x = 0.0,      ///< position x, world frame, m
+         y = 0.0,      ///< position y, world frame, m
+         theta = 0.0;  ///< heading from the world x axis, rad
+  double v = 0.0,      ///< forward speed, m/s
+         omega = 0.0;  ///< turn rate, rad/s
 };
 
+/// A unicycle target on the floor driven by [K]'s profiles, precomputed over [0, duration] (seeded noise).
 class GroundTarget {
 public:
+  /// Precomputes the trajectory; rng draws the profile noise ξv, ξω when params.noise.
   GroundTarget(const GroundTargetParams& params, core::Rng& rng);
   /// State at t in [0, duration] (exact within a sub-step: the unicycle is re-integrated from the
   /// knot before t with the constant (v, ω) of that profile step).
   GroundState state(double t) const;
   /// Nominal profile (without ξ) at index k, SI units.
   static Eigen::Vector2d nominal(GroundProfile profile, double k);
+  /// The parameters in use.
   const GroundTargetParams& params() const { return params_; }
 
 private:

@@ -42,14 +42,18 @@ public:
   virtual const Scene& staticScene() const = 0;
   /// Appends the moving objects at time t (s) to `out`.
   virtual void dynamicObjects(double t, std::vector<Primitive>& out) const = 0;
+  /// The single directional light of the world (default: Lighting{}).
   virtual Lighting lighting() const { return Lighting{}; }
+  /// Version of the static scene; a change makes the renderer rebuild its cached layers.
   virtual std::uint64_t staticVersion() const { return 0; }
 };
 
 /// A world made of a fixed Scene plus a callback for the moving objects (handy in tests and apps).
 class SceneWorld : public World {
 public:
+  /// Appends the moving objects at time t (s) to the output list.
   using Dynamic = std::function<void(double t, std::vector<Primitive>& out)>;
+  /// A world of `scene` (static), `dynamic` (moving objects; may be empty) and one light.
   explicit SceneWorld(Scene scene, Dynamic dynamic = nullptr, Lighting lighting = {});
   const Scene& staticScene() const override { return scene_; }
   void dynamicObjects(double t, std::vector<Primitive>& out) const override;
@@ -64,6 +68,7 @@ private:
   std::uint64_t version_ = 0;
 };
 
+/// Quality and cache settings of the renderer.
 struct RenderSettings {
   int supersampling = 4;          ///< n: n x n sub-samples on edge pixels (1 = no anti-aliasing)
   double edge_threshold = 0.03;   ///< corner colour difference (reflectance units) that triggers it
@@ -77,11 +82,16 @@ struct ExposureSpec {
   int blur_samples = 1;     ///< instants averaged over the exposure (>= 1)
 };
 
+/// Ray-cast renderer of simulated cameras: exact ViSP kud projection, anti-aliased edges, cached static
+/// layers, motion blur.
 class Renderer {
 public:
+  /// Renderer with these settings.
   explicit Renderer(const RenderSettings& settings = {});
   ~Renderer();
+  /// Takes over another renderer's caches.
   Renderer(Renderer&&) noexcept;
+  /// Takes over another renderer's caches.
   Renderer& operator=(Renderer&&) noexcept;
 
   /// Renders `world` seen by `camera` over the exposure. `extra` are additional moving objects
@@ -94,6 +104,7 @@ public:
   /// Convenience: renders a scene with no moving objects, without caching.
   cv::Mat renderScene(const Scene& scene, const core::Camera& camera, const Lighting& lighting = {});
 
+  /// The settings in use.
   const RenderSettings& settings() const { return settings_; }
 
 private:

@@ -29,23 +29,26 @@
 
 namespace viewline::sim {
 
+/// Free-running clock of a simulated camera: rate, phase and drift.
 struct CameraClock {
   double rate = 50.0;    ///< frames per second, > 0
   double phase = 0.0;    ///< s, first capture after reset, >= 0
   double drift = 0.0;    ///< relative period error of the free-running clock (e.g. 50e-6), > -1
 };
 
+/// One simulated camera of a rig: camera model, clock, imaging effects and an optional moving pose.
 struct SimCamera {
   core::Camera camera;           ///< intrinsics, size, and pose (used when pose_at is empty)
-  CameraClock clock;
-  ImagingEffects effects;
+  CameraClock clock;  ///< capture schedule
+  ImagingEffects effects;  ///< noise, blur, illumination, occlusion, frame faults
   /// Optional moving camera: c_M_w at time t (pan-tilt head, mobile robot).
   std::function<Eigen::Isometry3d(double t)> pose_at;
 };
 
+/// A rendered frame of a simulated camera, with its time stamps and the ground truth of named objects.
 struct Frame {
-  std::size_t camera_index = 0;
-  std::string camera_name;
+  std::size_t camera_index = 0;  ///< index of the camera in the rig
+  std::string camera_name;  ///< name of the camera
   std::uint64_t sequence = 0;        ///< per camera, counts dropped frames too
   core::Timestamp stamp = 0.0;       ///< reported capture time (with jitter), s
   double capture_time = 0.0;         ///< true capture time (middle of the exposure), s
@@ -58,13 +61,14 @@ struct Frame {
 
 /// A scheduled capture (no image): what the rig will produce next.
 struct Capture {
-  std::size_t camera_index = 0;
-  std::uint64_t sequence = 0;
-  double capture_time = 0.0;
-  core::Timestamp stamp = 0.0;
-  bool dropped = false;
+  std::size_t camera_index = 0;  ///< index of the camera in the rig
+  std::uint64_t sequence = 0;  ///< per-camera frame number (dropped frames use theirs up)
+  double capture_time = 0.0;  ///< true capture time (middle of the exposure), s
+  core::Timestamp stamp = 0.0;  ///< reported capture time (with jitter), s
+  bool dropped = false;  ///< the frame will be lost
 };
 
+/// A rig of free-running simulated cameras producing time-stamped frames of a World in capture-time order.
 class CameraRig {
 public:
   /// Throws core::InvalidInput (naming camera and field) for bad clocks, effects or cameras.
@@ -85,9 +89,11 @@ public:
   /// The captures of [t0, t1) (dropped ones flagged) without rendering; leaves the rig reset.
   std::vector<Capture> schedule(double t0, double t1);
 
+  /// The cameras of the rig.
   const std::vector<SimCamera>& cameras() const { return cameras_; }
   /// Frames dropped per camera since the last reset.
   const std::vector<std::uint64_t>& dropped() const { return dropped_; }
+  /// The renderer (its settings and caches).
   Renderer& renderer() { return renderer_; }
 
 private:

@@ -23,15 +23,17 @@ namespace viewline::sim {
 /// of about floor_size / 1024).
 struct RoomParams {
   double floor_size = 14.0;     ///< m
-  bool walls = true;
+  bool walls = true;  ///< four textured walls around the floor
   double wall_height = 6.0;     ///< m
-  NoiseTextureParams floor_texture{1024, 8, 8, 0.5, 0.75, Eigen::Vector3d(0.35, 0.42, 0.45)};
-  NoiseTextureParams wall_texture{1024, 8, 6, 0.45, 0.75, Eigen::Vector3d(0.62, 0.6, 0.55)};
+  NoiseTextureParams floor_texture{1024, 8, 8, 0.5, 0.75, Eigen::Vector3d(0.35, 0.42, 0.45)};  ///< floor texture
+  NoiseTextureParams wall_texture{1024, 8, 6, 0.45, 0.75, Eigen::Vector3d(0.62, 0.6, 0.55)};  ///< wall texture
 };
+/// A textured closed room (floor and walls) to surround a scenario with texture (seeded).
 Scene makeRoom(const RoomParams& params, core::Rng& rng);
 
+/// Name, radius and colour of the flying ball.
 struct BallAppearance {
-  std::string name = "ball";
+  std::string name = "ball";  ///< name in the ground truth
   double radius = 0.025;                                        ///< m (the 5 cm ball)
   Eigen::Vector3d albedo_bgr = Eigen::Vector3d(0.08, 0.45, 0.95);  ///< orange
 };
@@ -40,11 +42,13 @@ struct BallAppearance {
 /// flight covers t). Flights must not overlap in time.
 class BallFlightWorld : public World {
 public:
+  /// A world of ball flights (non-overlapping in time) inside a static environment.
   BallFlightWorld(std::vector<DragFlight> flights, Scene environment, BallAppearance ball = {},
                   Lighting lighting = {});
   const Scene& staticScene() const override { return environment_; }
   void dynamicObjects(double t, std::vector<Primitive>& out) const override;
   Lighting lighting() const override { return lighting_; }
+  /// The flights, in time order.
   const std::vector<DragFlight>& flights() const { return flights_; }
   /// The flight covering t, or nullptr.
   const DragFlight* flightAt(double t) const;
@@ -64,6 +68,7 @@ public:
   const Scene& staticScene() const override { return environment_; }
   void dynamicObjects(double t, std::vector<Primitive>& out) const override;
   Lighting lighting() const override { return lighting_; }
+  /// The dart's flight.
   const DragFlight& flight() const { return flight_; }
 
 private:
@@ -72,6 +77,7 @@ private:
   Lighting lighting_;
 };
 
+/// Colours and geometry of the tilting table (surface, borders, ball, optional tags).
 struct TableAppearance {
   Eigen::Vector3d surface_bgr = Eigen::Vector3d(0.12, 0.1, 0.8);    ///< red
   Eigen::Vector3d border_bgr = Eigen::Vector3d(0.05, 0.05, 0.05);   ///< black
@@ -88,6 +94,7 @@ struct TableAppearance {
 /// motion blur; querying a time outside the history clamps to it).
 class TableWorld : public World {
 public:
+  /// A world following `table` (owned and advanced by the caller, must outlive the world).
   TableWorld(const TiltTable& table, Scene environment, TableAppearance appearance = {}, Lighting lighting = {});
   const Scene& staticScene() const override { return environment_; }
   void dynamicObjects(double t, std::vector<Primitive>& out) const override;
@@ -99,6 +106,7 @@ public:
   /// table tag in the table frame: table_M_tag(i) * simTag_M_vispTag(). This is what a
   /// vision::TagOnTable layout needs.
   Eigen::Isometry3d table_M_vispTag(int i) const;
+  /// The appearance in use.
   const TableAppearance& appearance() const { return look_; }
 
 private:
@@ -108,8 +116,10 @@ private:
   Lighting lighting_;
 };
 
+/// Size and colours of the projection screen and the projected disc.
 struct ScreenAppearance {
-  double width = 2.4, height = 1.8;                                  ///< m
+  double width = 2.4,                                                ///< screen width, m
+         height = 1.8;                                               ///< screen height, m
   Eigen::Vector3d screen_bgr = Eigen::Vector3d(0.85, 0.85, 0.85);    ///< lit by the projector (unlit)
   double disc_radius = 0.06;                                         ///< m
   Eigen::Vector3d disc_bgr = Eigen::Vector3d(0.08, 0.08, 0.08);      ///< the projected dark circle
@@ -118,11 +128,13 @@ struct ScreenAppearance {
 /// [T]'s scene: a dark disc projected on a screen, moving along a ScreenPath (screen frame).
 class ScreenWorld : public World {
 public:
+  /// A world of a disc moving along `path` on a screen at pose w_M_screen (screen frame x right, y down, z into it).
   ScreenWorld(ScreenPath path, const Eigen::Isometry3d& w_M_screen, Scene environment,
               ScreenAppearance appearance = {}, Lighting lighting = {});
   const Scene& staticScene() const override { return scene_; }
   void dynamicObjects(double t, std::vector<Primitive>& out) const override;
   Lighting lighting() const override { return lighting_; }
+  /// The target's path (screen frame).
   const ScreenPath& path() const { return path_; }
   /// World position of the target centre at time t.
   Eigen::Vector3d target_w(double t) const;
@@ -135,6 +147,7 @@ private:
   Lighting lighting_;
 };
 
+/// Size and colour of the ground target box.
 struct GroundObjectAppearance {
   Eigen::Vector3d extents = Eigen::Vector3d(0.08, 0.06, 0.05);      ///< m (8 x 6 cm footprint)
   Eigen::Vector3d albedo_bgr = Eigen::Vector3d(0.1, 0.1, 0.85);     ///< red
@@ -143,10 +156,12 @@ struct GroundObjectAppearance {
 /// [K]'s scene: a red object driven by a GroundTarget on a textured floor.
 class GroundWorld : public World {
 public:
+  /// A world of the ground target box driven by `target` on a floor.
   GroundWorld(GroundTarget target, Scene environment, GroundObjectAppearance appearance = {}, Lighting lighting = {});
   const Scene& staticScene() const override { return environment_; }
   void dynamicObjects(double t, std::vector<Primitive>& out) const override;
   Lighting lighting() const override { return lighting_; }
+  /// The ground target's trajectory.
   const GroundTarget& target() const { return target_; }
 
 private:

@@ -19,9 +19,12 @@
 
 namespace viewline::tracking {
 
+/// Ballistic state (p, v) in the world frame, m and m/s.
 using Vector6 = Eigen::Matrix<double, 6, 1>;
+/// 6 x 6 matrix on the ballistic state (covariances, transitions).
 using Matrix6 = Eigen::Matrix<double, 6, 6>;
 
+/// Drag-free ballistic motion with white acceleration noise on x = (p, v), world frame (exact discretisation).
 struct BallisticModel {
   Eigen::Vector3d gravity_w{0.0, 0.0, -9.81};  ///< m/s², world frame
   double accel_psd = 0.0;                       ///< q, m²/s³ (white acceleration), >= 0

@@ -18,17 +18,25 @@
 
 namespace viewline::tracking {
 
+/// Image-space EKF baseline: the ballistic state updated with pixel measurements (linearised projection), for
+/// comparison with the viewline tracker.
 class ImageSpaceEkf {
 public:
+  /// EKF over `cameras` (intrinsics, distortion, c_M_w) with the tracker's model, prior, gate and restart settings.
   ImageSpaceEkf(std::vector<core::Camera> cameras, TrackerConfig cfg);
 
   /// Fuses one image (must not be older than the previous one: TooOld otherwise).
   Refusal submit(const ImageMeasurement& m);
 
+  /// True while a track is live.
   bool initialised() const { return active_; }
+  /// The estimate after the last fused image (world frame, time = its capture time).
   const estimation::StateEstimate& state() const { return est_; }
+  /// Images rejected by the gate (or skipped) so far.
   std::size_t gated() const { return gated_; }
+  /// Images skipped because the predicted point was behind the camera.
   std::size_t skippedBehindCamera() const { return skipped_; }
+  /// Tracks restarted after rejections in a row.
   std::size_t restarts() const { return restarts_; }
   /// Fate of the last submitted image (Fused or Gated; Gated also when skipped).
   Fate lastFate() const { return last_fate_; }

@@ -37,10 +37,12 @@ enum class GateDecision : int {
   Reject = 2,   ///< NIS outside the gate: do not fuse; the track coasts
   Restart = 3,  ///< the restart_after-th rejection in a row: restart the track from it
 };
+/// Lower-case name of a decision ("start", "accept", "reject", "restart").
 const char* toString(GateDecision d);
 /// Start, Accept and Restart use the measurement; Reject does not.
 inline bool uses(GateDecision d) { return d != GateDecision::Reject; }
 
+/// Configuration of a track's chi-square gate, restart and coasting life cycle.
 struct TrackGateConfig {
   /// Chi-square acceptance probability, in (0, 1]; 1 turns the test off (every measurement with a
   /// finite NIS is accepted, so the track never restarts) for filters shipped without a gate.
@@ -50,11 +52,18 @@ struct TrackGateConfig {
   void validate(const char* what = "gate") const;  ///< throws core::InvalidInput naming `what`
 };
 
+/// How many measurements each decision took.
 struct GateCounts {
-  std::uint64_t starts = 0, accepted = 0, rejected = 0, restarts = 0;
+  std::uint64_t starts = 0,    ///< Start decisions
+                accepted = 0,  ///< Accept decisions
+                rejected = 0,  ///< Reject decisions
+                restarts = 0;  ///< Restart decisions
+  /// Every decision counted.
   std::uint64_t total() const { return starts + accepted + rejected + restarts; }
 };
 
+/// The chi-square gate + restart + coasting life cycle every track shares: decides Start, Accept, Reject or
+/// Restart per measurement.
 class TrackGate {
 public:
   /// `dof`: rows of the update (the NIS's degrees of freedom); `sources`: how many independent
@@ -67,13 +76,18 @@ public:
 
   /// Forget the track: the next measurement starts a new one.
   void drop();
+  /// True while a track is live (started, not dropped, not stale).
   bool active() const { return active_; }
 
+  /// NIS threshold χ²(dof, probability).
   double threshold() const { return threshold_; }
+  /// The configuration in use.
   const TrackGateConfig& config() const { return config_; }
   /// The longest current run of rejections over the sources.
   int rejectedInARow() const;
+  /// Time of the last measurement the track used (Start, Accept or Restart), s.
   double lastUsedTime() const { return last_used_t_; }
+  /// Decisions taken since construction.
   const GateCounts& counts() const { return counts_; }
 
 private:

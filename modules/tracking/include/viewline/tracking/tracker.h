@@ -71,6 +71,7 @@ struct ImageMeasurement {
   double sigma_px = 0.5;         ///< pixel noise std, px
 };
 
+/// Why the tracker refused a measurement (None: accepted for processing).
 enum class Refusal : int {
   None = 0,
   NonFinite,      ///< NaN/Inf stamp or pixel
@@ -82,18 +83,24 @@ enum class Refusal : int {
   FarFuture,      ///< more than max_forward_gap after the newest stamp
   kCount
 };
+/// Lower-case name of a refusal ("none", "non_finite", "too_old", ...).
 const char* toString(Refusal r);
 
+/// Time handling: exact propagation to every capture time, or a fixed grid with Δt-offset rows ([L] eq 26).
 enum class TimeMode { Exact, DtOffset };
+/// Lower-case name of a time mode ("exact", "dt_offset").
 const char* toString(TimeMode m);
 
+/// What became of a processed image: fused, gated out, or dropped when its track restarted.
 enum class Fate { Fused, Gated, DroppedOnRestart };
+/// Lower-case name of a fate ("fused", "gated", "dropped_on_restart").
 const char* toString(Fate f);
 
+/// The outcome of one processed image: its fate, gate statistics and the track gate's decision.
 struct MeasurementOutcome {
-  ImageMeasurement m;
-  Fate fate = Fate::Fused;
-  GateReport gate;
+  ImageMeasurement m;  ///< the measurement
+  Fate fate = Fate::Fused;  ///< fused, gated or dropped
+  GateReport gate;  ///< both gates' statistics for the image
   bool seed = false;   ///< started a track (fused without gating)
   /// The track gate's decision when the image was processed: Start for a seed, Accept / Reject
   /// for a fused / gated image, Restart for the rejection that restarted the track (a restart
@@ -104,8 +111,8 @@ struct MeasurementOutcome {
 /// The update's own diagnostics for one submitted image, as the tracker formed them when the
 /// image was processed (for the new track's prior when the decision is Start).
 struct ImageUpdate {
-  ImageMeasurement m;
-  GateDecision decision = GateDecision::Start;
+  ImageMeasurement m;  ///< the measurement
+  GateDecision decision = GateDecision::Start;  ///< the track gate's decision
   Eigen::Vector2d innovation = Eigen::Vector2d::Zero();  ///< d = y − C x̂(t|t−) of the image's two viewline rows
   Eigen::Matrix2d S = Eigen::Matrix2d::Identity();       ///< R2 + C P Cᵀ
   Eigen::Matrix2d R = Eigen::Matrix2d::Identity();       ///< R2, the rows' own noise (viewline.h)
@@ -113,12 +120,14 @@ struct ImageUpdate {
   int fused_before = 0;  ///< fused images of the track the image was tested against (0 for Start)
 };
 
+/// Configuration of the viewline tracker: model, prior, gate, time handling, late-data horizon, restarts and
+/// noise model.
 struct TrackerConfig {
-  BallisticModel model;
+  BallisticModel model;  ///< ballistic motion model (gravity, acceleration noise)
   Vector6 prior_mean = (Vector6() << 0.0, 0.0, 3.0, 0.0, 0.0, -8.0).finished();  ///< SPEC §2 ([L])
   Matrix6 prior_cov = 100.0 * Matrix6::Identity();                              ///< 10² I
-  GateConfig gate;
-  TimeMode time_mode = TimeMode::Exact;
+  GateConfig gate;  ///< outlier gate of each image's two rows
+  TimeMode time_mode = TimeMode::Exact;  ///< exact propagation or fixed grid
   double sample_period = 0.01;        ///< s, grid of TimeMode::DtOffset
   double late_horizon = 0.2;          ///< s
   double max_forward_gap = 1.0;       ///< s
@@ -142,15 +151,16 @@ struct TrackerConfig {
 
 /// Track state: what a snapshot holds (the estimate and the track bookkeeping).
 struct TrackState {
+  /// A track state with this gate and no estimate yet.
   explicit TrackState(TrackGate g) : gate(std::move(g)) {}
-  estimation::StateEstimate est;
+  estimation::StateEstimate est;  ///< the estimate (x = (p, v) world frame, time)
   /// Life cycle: live track, time of the last fused image, rejections in a row per camera.
   TrackGate gate;
-  int fused_in_track = 0;
+  int fused_in_track = 0;  ///< images fused since the track's seed
   core::Timestamp track_start_t = 0.0;      ///< sample time of the track's prior
   std::vector<MeasurementOutcome> history;  ///< since the track's seed (capped)
-  int tracks_started = 0;
-  int restarts = 0;
+  int tracks_started = 0;  ///< tracks started so far (seeds)
+  int restarts = 0;  ///< restarts after rejections in a row
 };
 
 /// One image fused into an estimate at the estimate's time + dt_offset: builds the rows, gates
@@ -160,23 +170,31 @@ MeasurementOutcome fuseImage(estimation::StateEstimate& s, const core::Camera& c
                              const GateConfig& gate, double dt_offset, double min_depth, bool force,
                              bool depth_variance_in_noise = true);
 
+/// The multi-view asynchronous viewline tracker ([L]): images of any calibrated camera fused as plane
+/// constraints, late images re-processed.
 class ViewlineTracker {
 public:
+  /// Tracker over `cameras` (intrinsics, distortion, c_M_w; validated config, throws core::InvalidInput).
   ViewlineTracker(std::vector<core::Camera> cameras, TrackerConfig cfg);
 
   /// Validates, buffers and fuses one measurement (re-processing later ones when it is late).
   Refusal submit(const ImageMeasurement& m);
 
+  /// True while a track is live.
   bool initialised() const { return state_.gate.active(); }
   /// The estimate after the newest processed measurement (time = its capture time, or its grid
   /// instant in DtOffset mode).
   const estimation::StateEstimate& state() const { return state_.est; }
+  /// The estimate and the track bookkeeping.
   const TrackState& trackState() const { return state_; }
   /// The estimate propagated to t >= state().t() (no measurement fused).
   estimation::StateEstimate predictAt(core::Timestamp t) const;
 
+  /// How many measurements were refused for reason r.
   std::size_t refusalCount(Refusal r) const { return refusals_[static_cast<std::size_t>(r)]; }
+  /// How many late measurements were inserted into the buffer (and the later ones re-processed).
   std::size_t lateInserted() const { return late_inserted_; }
+  /// Measurements kept in the late-data buffer.
   std::size_t bufferSize() const { return buffer_.size(); }
   /// The update of the image the last submit() processed (as it was processed then: a later
   /// restart or late insertion may change its outcome); empty when that image was refused.
@@ -187,9 +205,12 @@ public:
   std::optional<MeasurementOutcome> outcome(std::uint64_t id) const;
   /// Outcomes of every processed measurement since the last clearOutcomes().
   std::vector<MeasurementOutcome> outcomes() const;
+  /// Forgets the outcomes recorded so far.
   void clearOutcomes() { final_.clear(); }
 
+  /// The cameras of the rig.
   const std::vector<core::Camera>& cameras() const { return cameras_; }
+  /// The configuration in use.
   const TrackerConfig& config() const { return cfg_; }
   /// Forget everything (state, buffer, outcomes, counters).
   void reset();

@@ -35,6 +35,7 @@
 
 namespace viewline::tracking {
 
+/// Configuration of the unicycle ground tracker: model noise, two-point start, gate and predictor window.
 struct UnicycleTrackerConfig {
   estimation::UnicycleModel model{0.01, 0.5};  ///< random-walk intensities q_v (m²/s³), q_w (rad²/s³)
   double init_speed_sigma = 0.3;               ///< m/s, prior speed spread of a two-point start
@@ -57,6 +58,8 @@ struct UnicycleUpdate {
   estimation::UpdateReport report;
 };
 
+/// Unicycle ground tracker on the floor: EKF with two-point starts, TrackGate life cycle and a least-squares
+/// trajectory predictor.
 class UnicycleTracker {
 public:
   /// Throws core::InvalidInput for an invalid config.
@@ -64,9 +67,13 @@ public:
 
   /// A track exists (started and not restarted since).
   bool valid() const { return valid_; }
+  /// The estimate x = (x, y, θ, v, ω) on the floor (world frame; m, rad, m/s, rad/s).
   const estimation::StateEstimate& state() const { return est_; }
+  /// The trajectory predictor fed with the track's (t, v, ω).
   const estimation::UnicycleTrajectoryPredictor& predictor() const { return predictor_; }
+  /// The track's gate (decisions, counts, life cycle).
   const TrackGate& gate() const { return gate_; }
+  /// The configuration in use.
   const UnicycleTrackerConfig& config() const { return config_; }
 
   /// Time update to t (no-op without a track or when t is not after the state's time).

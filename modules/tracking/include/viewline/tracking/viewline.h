@@ -109,9 +109,9 @@ Eigen::Matrix2d viewlineRowNoise(const core::Camera& camera, const Eigen::Vector
 
 /// Two rows of C, y and their 2x2 noise for one image.
 struct ViewlineRows {
-  Eigen::Matrix<double, 2, 6> C;
-  Eigen::Vector2d y;
-  Eigen::Matrix2d R;
+  Eigen::Matrix<double, 2, 6> C;  ///< two rows of the measurement matrix (on x = (p, v))
+  Eigen::Vector2d y;  ///< two measurement values
+  Eigen::Matrix2d R;  ///< their 2 x 2 noise covariance
 };
 
 /// Rows for one image. `predicted` = filter mean at the state's time, `P` its covariance (for

@@ -13,7 +13,7 @@ namespace viewline::tuning {
 
 class HtmlReport {
 public:
-  /// Plots go to <dir>/plots.
+  /// Plots go to `dir/plots`.
   HtmlReport(std::string title, std::string dir);
 
   void heading(const std::string& text, int level = 2);
@@ -21,11 +21,11 @@ public:
   void preformatted(const std::string& text);
   void table(const std::vector<std::string>& header, const std::vector<std::vector<std::string>>& rows,
              const std::vector<std::string>& row_classes = {});
-  /// Writes `data` to plots/<name>.dat and `script` (gnuplot, may refer to '<name>.dat' and other
-  /// files written with dataFile()) to plots/<name>.gp, runs gnuplot, embeds plots/<name>.png.
+  /// Writes `data` to `plots/name.dat` and `script` (gnuplot, may refer to `'name.dat'` and other
+  /// files written with dataFile()) to `plots/name.gp`, runs gnuplot, embeds `plots/name.png`.
   /// Returns false (and notes it in the report) when gnuplot failed.
   bool plot(const std::string& name, const std::string& script, const std::string& caption);
-  /// Writes a data file plots/<file>; returns its file name (relative to plots/).
+  /// Writes a data file `plots/file`; returns its file name (relative to plots/).
   std::string dataFile(const std::string& file, const std::string& content);
 
   std::size_t plotCount() const { return plots_; }

@@ -45,6 +45,7 @@
 
 namespace viewline::vision {
 
+/// Configuration of the colour-blob ball detector (HSV range, morphology, size and roundness gates, noise model).
 struct BallDetectorConfig {
   ColorRange hsv{35, 85, 80, 255, 30, 255};  ///< HSV range of the ball (default: green)
   int open_kernel_px = 3;      ///< elliptic opening kernel size (odd, 0 or 1 = none)
@@ -64,6 +65,7 @@ struct BallDetectorConfig {
   void validate() const;
 };
 
+/// A detected ball: centre pixel (sphere-corrected with a camera) with covariance, radius and blob shape.
 struct BallMeasurement : Measurement {
   double radius_px = 0.0;  ///< minEnclosingCircle radius + edge offset
   Eigen::Vector2d circle_center = Eigen::Vector2d::Zero();  ///< minEnclosingCircle centre (px)
@@ -73,6 +75,7 @@ struct BallMeasurement : Measurement {
   Eigen::Vector2d blob_center = Eigen::Vector2d::Zero();  ///< contour centroid (px)
 };
 
+/// Colour-blob ball detector with sub-pixel centre, covariance from the edge noise and an optional search window.
 class BallDetector {
 public:
   /// With a camera, `pixel` is corrected to the image of the sphere centre (see above).
@@ -83,6 +86,7 @@ public:
   Result<BallMeasurement> detect(const cv::Mat& bgr, core::Timestamp stamp,
                                  const std::optional<Eigen::Vector2d>& predicted = std::nullopt);
 
+  /// The configuration in use.
   const BallDetectorConfig& config() const { return config_; }
 
 private:

@@ -75,6 +75,7 @@
 
 namespace viewline::vision {
 
+/// Parameters of the sub-pixel ball outline and sphere-cone fit (rays, reach, cleanliness and acceptance gates).
 struct BallOutlineParams {
   int rays = 48;                 ///< rays from the centre, evenly spread
   double reach_px = 2.0;         ///< each ray spans ρ ± reach (clamped to [1.5, 0.45 ρ])
@@ -100,10 +101,10 @@ std::vector<Eigen::Vector2d> ballOutlinePoints(const cv::Mat& bgr, const Circle&
 
 /// Viewing cone of a sphere: unit axis v (camera frame, towards the centre) and half angle α.
 struct SphereCone {
-  Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();  ///< unit axis v towards the sphere centre, camera frame
   double alpha = 0.0;    ///< rad
   double rms_px = 0.0;   ///< RMS angular residual of the inliers, times the focal length (px)
-  int inliers = 0;
+  int inliers = 0;  ///< outline points kept by the fit
   double max_gap_rad = 0.0;  ///< largest gap between consecutive inliers around the axis
   double alpha_sigma_px = 0.0;  ///< standard deviation of α from the fit (residuals and spread), times f
 };

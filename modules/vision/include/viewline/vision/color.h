@@ -11,17 +11,20 @@
 
 namespace viewline::vision {
 
+/// An 8-bit hue range and two channel ranges (OpenCV conventions; hue in [0, 180) wraps when hue_lo > hue_hi).
 struct ColorRange {
   int hue_lo = 0;    ///< inclusive, [0, 179]
   int hue_hi = 179;  ///< inclusive, [0, 179]; < hue_lo means the range wraps through 0
   int c1_lo = 0;     ///< 2nd channel (S for HSV, L for HLS), inclusive
-  int c1_hi = 255;
+  int c1_hi = 255;  ///< 2nd channel upper bound, inclusive
   int c2_lo = 0;     ///< 3rd channel (V for HSV, S for HLS), inclusive
-  int c2_hi = 255;
+  int c2_hi = 255;  ///< 3rd channel upper bound, inclusive
 
+  /// True when the hue range wraps through 0 (hue_lo > hue_hi).
   bool wraps() const { return hue_lo > hue_hi; }
   /// Throws core::InvalidInput naming `what` unless every bound is in range and lo <= hi.
   void validate(const std::string& what) const;
+  /// True when the pixel (h, c1, c2) lies in the range.
   bool contains(int h, int c1, int c2) const {
     const bool hue_ok = wraps() ? (h >= hue_lo || h <= hue_hi) : (h >= hue_lo && h <= hue_hi);
     return hue_ok && c1 >= c1_lo && c1 <= c1_hi && c2 >= c2_lo && c2 <= c2_hi;

@@ -20,8 +20,12 @@
 
 namespace viewline::vision {
 
+/// Configuration of [T]'s dark-disc-on-screen detector: crop, scale, threshold, median filter, gates and noise.
 struct ScreenTargetDetectorConfig {
-  int crop_left = 0, crop_top = 0, crop_right = 0, crop_bottom = 0;  ///< margins removed (px)
+  int crop_left = 0,    ///< margin removed on the left, px
+      crop_top = 0,     ///< margin removed at the top, px
+      crop_right = 0,   ///< margin removed on the right, px
+      crop_bottom = 0;  ///< margin removed at the bottom, px
   double scale = 0.5;      ///< resize factor ([T]: 50 %)
   int threshold = -1;      ///< binarisation level on the grey image, or < 0 for Otsu
   bool dark_target = true; ///< the target is darker than the screen
@@ -29,24 +33,28 @@ struct ScreenTargetDetectorConfig {
   double min_area_px = 20.0;     ///< full-resolution pixels; fewer -> TooSmall
   double min_fill = 0.5;         ///< foreground / bounding-box area below this -> Ambiguous
   double edge_noise_px = 0.5;    ///< σe at the processing resolution
-  double min_sigma_px = 0.1;
+  double min_sigma_px = 0.1;  ///< σ floor of the centre, px
 
   void validate() const;  ///< throws core::InvalidInput naming the field
 };
 
+/// The detected screen target: centroid pixel (full resolution) with covariance, area and fill.
 struct ScreenTargetMeasurement : Measurement {
   double area_px = 0.0;  ///< foreground area in full-resolution pixels
   double fill = 0.0;     ///< foreground / bounding-box area (π/4 for a disc)
-  int threshold_used = 0;
+  int threshold_used = 0;  ///< binarisation level actually used (Otsu's when config.threshold < 0)
 };
 
+/// [T]'s screen target detector: crop, half-resolution, binarise, median filter, centroid.
 class ScreenTargetDetector {
 public:
+  /// Detector with this configuration (validated; throws core::InvalidInput).
   explicit ScreenTargetDetector(ScreenTargetDetectorConfig config = {});
 
   /// `image` is grey CV_8UC1 or BGR CV_8UC3, captured at `stamp`.
   Result<ScreenTargetMeasurement> detect(const cv::Mat& image, core::Timestamp stamp);
 
+  /// The configuration in use.
   const ScreenTargetDetectorConfig& config() const { return config_; }
 
 private:

@@ -60,6 +60,7 @@
 
 namespace viewline::vision {
 
+/// Configuration of [M]'s table-ball detector (geometry in m, colour ranges, morphology, refinements).
 struct TableDetectorConfig {
   double side_m = 0.3;            ///< L, side of the red square (m)
   /// Height of raised borders around the red square (m); 0 = flat. With `refine`, sides seen
@@ -73,14 +74,14 @@ struct TableDetectorConfig {
   int close_kernel_px = 5;        ///< table mask closing
   int ball_open_kernel_px = 3;    ///< ball mask opening
   CornerSearchParams corners;     ///< approxPolyDP ε, ball exclusion, |ta|·|tb|
-  double min_table_area_px = 300.0;
-  double min_ball_area_px = 8.0;
+  double min_table_area_px = 300.0;  ///< smallest red blob accepted as the table, px
+  double min_ball_area_px = 8.0;  ///< smallest green blob accepted as the ball, px
   double roi_margin_fraction = 0.1;  ///< window = last table box grown by this fraction ...
   int roi_margin_px = 10;            ///< ... plus this many pixels on each side
   bool refine = true;                ///< production refinements (see above); false = [M] exactly
   /// Ball outline with `refine`: SphereCone (production) or GreennessEllipse (the earlier one).
   enum class BallOutline { GreennessEllipse, SphereCone };
-  BallOutline ball_outline = BallOutline::SphereCone;
+  BallOutline ball_outline = BallOutline::SphereCone;  ///< outline method of the ball circle with `refine`
   BallOutlineParams ball_outline_params;  ///< rays, reach, background separation (ball_outline.h)
   double max_reprojection_px = 2.0;  ///< corner reprojection RMS above which the pose is refused
   double corner_sigma_px = 0.5;      ///< corner noise used for the table "pixel" covariance
@@ -89,28 +90,34 @@ struct TableDetectorConfig {
   void validate() const;  ///< throws core::InvalidInput naming the field
 };
 
+/// Table pose c_M_t from the red square's four corners.
 struct TableMeasurement : Measurement {  ///< pixel = mean of the four corners
   Eigen::Isometry3d c_M_t = Eigen::Isometry3d::Identity();  ///< table frame in the camera frame
   std::array<Eigen::Vector2d, 4> corners;  ///< image corners of P0..P3 (see orderTableCorners)
-  double reprojection_rms_px = 0.0;
-  bool used_roi = false;
+  double reprojection_rms_px = 0.0;  ///< RMS reprojection error of the four corners, px
+  bool used_roi = false;  ///< found in the window around the last table
 };
 
+/// The ball on the table: its circle and its centre with known and unknown radius.
 struct BallOnTableMeasurement : Measurement {  ///< pixel = ball circle centre
   Circle circle;                       ///< image circle used for the geometry
   BallOnTableGeometry known_radius;    ///< with config.ball_radius_m
   std::optional<BallOnTableGeometry> unknown_radius;  ///< radius solved from z = r
 };
 
+/// What one image gave: the table pose, the ball on the table and the ball's circle.
 struct TableScene {
+  /// The table pose, or why there is none
   Result<TableMeasurement> table = Result<TableMeasurement>::fail(FailureReason::NotFound, "");
-  Result<BallOnTableMeasurement> ball =
+  Result<BallOnTableMeasurement> ball =  ///< the ball on the table (needs the table pose), or why there is none
       Result<BallOnTableMeasurement>::fail(FailureReason::NotFound, "");
   std::optional<Circle> ball_circle;  ///< the ball in the image, even without a table pose
 };
 
+/// [M]'s table-ball detector, production version: windowed, bit-exact masks, sub-pixel refinements.
 class TableDetector {
 public:
+  /// Detector for `camera` (intrinsics and distortion) with this configuration (validated; throws core::InvalidInput).
   TableDetector(core::Camera camera, TableDetectorConfig config = {});
 
   /// Detect the table and the ball in a BGR CV_8UC3 image captured at `stamp`.
@@ -122,7 +129,9 @@ public:
   /// Forget the window and the prior (next frame searches the full image).
   void reset();
 
+  /// The configuration in use.
   const TableDetectorConfig& config() const { return config_; }
+  /// The camera in use.
   const core::Camera& camera() const { return camera_; }
 
 private:

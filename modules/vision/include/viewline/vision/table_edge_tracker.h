@@ -25,17 +25,20 @@
 
 namespace viewline::vision {
 
+/// Settings of TableEdgeTracker (pixels of the raw image).
 struct TableEdgeTrackerConfig {
-  int samples_per_side = 14;
-  double search_px = 5.0;
+  int samples_per_side = 14;   ///< edge samples spread over the middle 70 % of each side
+  double search_px = 5.0;      ///< px, search along the outward normal (and largest corner motion)
   double min_contrast = 40.0;  ///< grey levels of R − max(G, B)
-  int min_points = 7;
+  int min_points = 7;          ///< fewer edge points kept on a side: tracking fails
   double ball_window_factor = 2.2;  ///< window half size = factor · radius + motion margin
-  double ball_margin_px = 6.0;
+  double ball_margin_px = 6.0;  ///< px, the motion margin of the ball window
 };
 
+/// The observer's fast path: the table's sides and the ball followed from the previous frame.
 class TableEdgeTracker {
 public:
+  /// `detector`: [M]'s ball steps and thresholds (shared with TableDetector); both are copied.
   TableEdgeTracker(const TableDetectorConfig& detector, const TableEdgeTrackerConfig& config = {});
 
   /// New corners (order P0..P3 kept) from the previous ones, or nullopt.

@@ -24,6 +24,7 @@
 
 namespace viewline::vision {
 
+/// A circle in the image (px).
 struct Circle {
   Eigen::Vector2d center = Eigen::Vector2d::Zero();  ///< px
   double radius = 0.0;                               ///< px
@@ -36,6 +37,7 @@ struct CornerSearchParams {
   double max_ta_tb = 1.5;                 ///< keep intersections with |ta|·|tb| below this
 };
 
+/// Four table corners found in the image, with the simplified polygon and the sides they come from.
 struct TableCorners {
   std::array<Eigen::Vector2d, 4> corners;  ///< unordered as found (see orderTableCorners)
   std::vector<cv::Point> polygon;          ///< simplified hull after dropping points near the ball
@@ -69,10 +71,12 @@ std::array<Eigen::Vector2d, 4> orderTableCorners(const std::array<Eigen::Vector2
 /// turn about z closest to it is chosen.
 /// Fails (PoseFailed) when the solution puts the table behind the camera or seen from below.
 struct TablePose {
-  Eigen::Isometry3d c_M_t = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d c_M_t = Eigen::Isometry3d::Identity();  ///< table frame in the camera frame (p_c = c_M_t * p_t)
   std::array<Eigen::Vector2d, 4> corners;  ///< ordered like P0..P3 after the prior shift
-  double reprojection_rms_px = 0.0;
+  double reprojection_rms_px = 0.0;  ///< RMS reprojection error of the four corners, px
 };
+/// Table pose c_M_t from four ordered corners (PnP AP3P, optional Gauss-Newton refinement, prior's quarter
+/// turn); PoseFailed when behind or seen from below.
 Result<TablePose> solveTablePose(const std::array<Eigen::Vector2d, 4>& ordered_corners,
                                  const core::Camera& camera, double side_m, bool refine,
                                  const std::optional<Eigen::Isometry3d>& prior);
@@ -109,7 +113,8 @@ Eigen::Isometry3d turnTableFrame(const Eigen::Isometry3d& c_M_t, int quarter_tur
 ///   r = t'_z / (σ - v1_z / sin α),
 /// then d = r / sin α as above.
 struct BallOnTableGeometry {
-  Eigen::Vector3d va = Eigen::Vector3d::UnitZ(), vb = Eigen::Vector3d::UnitZ();  ///< camera frame
+  Eigen::Vector3d va = Eigen::Vector3d::UnitZ(),  ///< unit ray of the major axis end a, camera frame
+                  vb = Eigen::Vector3d::UnitZ();  ///< unit ray of the major axis end b, camera frame
   Eigen::Vector3d ray_c = Eigen::Vector3d::UnitZ();  ///< v̂, camera frame
   double alpha = 0.0;       ///< half angle of the viewing cone (rad)
   double radius_m = 0.0;    ///< r (given, or solved)

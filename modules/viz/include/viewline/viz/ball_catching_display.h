@@ -12,6 +12,8 @@
 
 namespace viewline::viz {
 
+/// Live view of the ball-catching scenario: per camera the image, detection, estimate, predicted crossing (2σ
+/// ellipse) and the hole.
 class BallCatchingDisplay {
 public:
   /// Opens the windows; throws core::InvalidInput when ViSP has no X11 display.

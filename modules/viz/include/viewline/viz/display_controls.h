@@ -20,6 +20,7 @@
 
 namespace viewline::viz {
 
+/// Keys of every scenario window (space pause, n step, q quit) and staying open after the run.
 class DisplayControls {
 public:
   /// Polls the keyboard of the window showing I (no wait). While paused, waits for a key:
@@ -31,7 +32,9 @@ public:
   /// quit was already asked).
   void waitForClose(const vpImage<vpRGBa>& I) const;
 
+  /// True while the viewer has paused the run (space).
   bool paused() const { return paused_; }
+  /// True once the viewer pressed q or Escape: the run should stop.
   bool quitRequested() const { return quit_; }
 
 private:

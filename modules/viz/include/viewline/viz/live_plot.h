@@ -13,8 +13,10 @@
 
 namespace viewline::viz {
 
+/// Live curves of one tuning run (ViSP vpPlot): error and NIS with its moving mean and chi-square band.
 class LivePlot {
 public:
+  /// True when a plot can open (ViSP built with X11 and a DISPLAY set); false headless.
   static bool available();
   /// Throws core::InvalidInput when !available().
   LivePlot(const std::string& title, const std::string& error_label, double nis_dof, double confidence);

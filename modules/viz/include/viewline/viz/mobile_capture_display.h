@@ -18,6 +18,8 @@
 
 namespace viewline::viz {
 
+/// Live view of the mobile-capture scenario: head camera image and a top view of robot, object, estimate,
+/// path and capture point.
 class MobileCaptureDisplay {
 public:
   /// `top_size` pixels for `top_span` metres of floor. Throws core::InvalidInput without X11.

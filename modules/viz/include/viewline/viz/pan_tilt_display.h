@@ -12,6 +12,8 @@
 
 namespace viewline::viz {
 
+/// Live view of the pan-tilt scenario: camera image with centre, measured, predicted and true target and the
+/// error vector.
 class PanTiltDisplay : public scenarios::pan_tilt::FrameSink {
 public:
   /// Throws core::InvalidInput when ViSP has no X11 support or no X display is available.
@@ -20,7 +22,9 @@ public:
   PanTiltDisplay(const PanTiltDisplay&) = delete;
   PanTiltDisplay& operator=(const PanTiltDisplay&) = delete;
 
+  /// Draws one frame of the loop and polls the keys (blocks while paused).
   void frame(const scenarios::pan_tilt::FrameRecord& r) override;
+  /// True once the viewer pressed q: the loop ends the run.
   bool quitRequested() const override;
   /// After the run: waits for a click or a key (at once when the viewer quit).
   void close();

@@ -18,8 +18,12 @@
 
 namespace viewline::viz {
 
+/// Live view of the table-ball scenario: camera image with corners, table axes, ball and predictions, and a
+/// top view of the tracks.
 class TableBallDisplay {
 public:
+  /// Opens both windows: table side and ball radius in metres, top view of `top_view_px` pixels, the last
+  /// `track_length` positions drawn; throws core::InvalidInput without X11.
   TableBallDisplay(double table_side, double ball_radius, int top_view_px = 360, std::size_t track_length = 250);
   ~TableBallDisplay();
   TableBallDisplay(const TableBallDisplay&) = delete;

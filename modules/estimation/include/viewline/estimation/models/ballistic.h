@@ -21,16 +21,19 @@
 
 namespace viewline::estimation {
 
+/// Drag-free ballistic flight in the world frame: state (p, v) [m, m/s], gravity along −up ([L] eqs 19-20).
 struct BallisticModel {
   Eigen::Vector3d up = Eigen::Vector3d::UnitZ();  ///< world up axis (normalised on use; non-zero)
   double g = 9.81;                                 ///< gravity [m/s²], >= 0
   double q = 1.0;                                  ///< acceleration noise spectral density [m²/s³], >= 0
 
+  /// State dimension n = 6.
   static constexpr Eigen::Index kStateDim = 6;
   /// Φ, Γ (6x1), u = (1), Q for dt > 0.
   LinearTransition transition(double dt) const;
   /// Gravity vector −g·up/|up| [m/s²].
   Eigen::Vector3d gravity() const;
+  /// Throws core::InvalidInput naming the field (up zero, g or q negative or not finite).
   void validate() const;
 };
 

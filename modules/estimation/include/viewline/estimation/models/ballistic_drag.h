@@ -26,6 +26,7 @@
 
 namespace viewline::estimation {
 
+/// Ballistic flight with quadratic air drag in the world frame: state (p, v) [m, m/s], RK4 mean, analytic Jacobian.
 struct DragBallisticModel {
   Eigen::Vector3d up = Eigen::Vector3d::UnitZ();  ///< world up axis (non-zero)
   double g = 9.81;                                 ///< gravity [m/s²], >= 0
@@ -33,12 +34,14 @@ struct DragBallisticModel {
   double q = 1.0;                                  ///< acceleration noise spectral density [m²/s³], >= 0
   int substeps = 4;                                ///< RK4 sub-steps per transition, >= 1
 
+  /// State dimension n = 6.
   static constexpr Eigen::Index kStateDim = 6;
 
   /// k = ρ Cd A / (2 m): air density ρ [kg/m³], drag coefficient Cd [-], cross-section A [m²],
   /// mass m [kg]; all finite, ρ, Cd, A >= 0, m > 0.
   static double dragConstant(double rho, double cd, double area, double mass);
 
+  /// Gravity vector −g·up/|up| [m/s²].
   Eigen::Vector3d gravity() const;
   /// Continuous dynamics ẋ = f_c(x) (noise-free).
   Eigen::Matrix<double, 6, 1> derivative(const Eigen::Matrix<double, 6, 1>& x) const;
@@ -52,6 +55,7 @@ struct DragBallisticModel {
   Eigen::MatrixXd processNoise(const Eigen::VectorXd& x, double dt) const;
   /// f, F and Q (Q linearised at x_lin, normally the current estimate) for dt > 0.
   NonlinearTransition transition(double dt, const Eigen::VectorXd& x_lin) const;
+  /// Throws core::InvalidInput naming the field (up, g, k, q, substeps).
   void validate() const;
 };
 

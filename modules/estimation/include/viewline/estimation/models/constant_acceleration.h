@@ -16,12 +16,16 @@
 
 namespace viewline::estimation {
 
+/// Constant acceleration model with white jerk: state (p, v, a) per axis in d = 1..3 dimensions.
 struct ConstantAccelerationModel {
   int dim = 3;     ///< spatial dimensions d (1, 2 or 3)
   double q = 1.0;  ///< jerk spectral density [m²/s⁵], >= 0
 
+  /// State dimension n = 3d.
   Eigen::Index stateDim() const { return 3 * dim; }
+  /// Φ, Q for dt > 0 (exact discretisation).
   LinearTransition transition(double dt) const;
+  /// Throws core::InvalidInput naming the bad field (dim, q).
   void validate() const;
 };
 

@@ -17,10 +17,12 @@
 
 namespace viewline::estimation {
 
+/// Constant velocity model with white acceleration: state (p, v) per axis in d = 1..3 dimensions ([T] eq 7).
 struct ConstantVelocityModel {
   int dim = 3;     ///< spatial dimensions d (1, 2 or 3)
   double q = 1.0;  ///< acceleration spectral density [m²/s³], >= 0
 
+  /// State dimension n = 2d.
   Eigen::Index stateDim() const { return 2 * dim; }
   /// Φ, Q for dt > 0. Throws core::InvalidInput naming the bad field (dim, q, dt).
   LinearTransition transition(double dt) const;

@@ -21,6 +21,7 @@
 
 namespace viewline::estimation::models {
 
+/// Process-noise densities of the coordinated-turn model.
 struct CoordinatedTurnParams {
   double q_accel = 1e-3;  ///< m²/s³, white acceleration density per axis
   double q_omega = 1e-3;  ///< rad²/s³, random-walk density of the turn rate

@@ -48,6 +48,8 @@ Eigen::Vector2d rollingBallAcceleration(const Eigen::Matrix3d& table_R_world, co
 /// e.g. solvePnP) and the known camera-to-ground rotation (c_R_world). Both must be rotations.
 Eigen::Matrix3d tableRotationInWorld(const Eigen::Matrix3d& c_R_table, const Eigen::Matrix3d& c_R_world);
 
+/// Ball rolling on a tilting table with disturbance states, in table coordinates ([M] §4.2): state (p_x, v_x,
+/// p_y, v_y, w2_x, w2_y).
 struct RollingBallModel {
   double sigma_w = 1.0;         ///< disturbance intensity σw (w1 density σw², w2 std σw), >= 0
   double beta = 1.0;            ///< inverse correlation time β of w2 [1/s], > 0
@@ -56,6 +58,7 @@ struct RollingBallModel {
   double ball_radius = 0.025;   ///< ball radius r [m], >= 0
   int prediction_steps = 10;    ///< N, predicted positions output every frame, >= 1
 
+  /// State dimension n = 6.
   static constexpr Eigen::Index kStateDim = 6;
 
   /// A, B, G, Qc of the continuous model (input a_xy, noise (w1_x, w1_y, ε_x, ε_y)).
@@ -82,6 +85,7 @@ struct RollingBallModel {
   /// One stationary-gain step: x⁻ = Φ x + Γ u, x⁺ = x⁻ + Kf (y − C x⁻); returns x⁺ (clamped).
   Eigen::VectorXd stationaryStep(const StationaryFilter& sf, const LinearTransition& tr, const Eigen::VectorXd& x,
                                  const Eigen::Vector2d& y) const;
+  /// Throws core::InvalidInput naming the field (sigma_w, beta, sigma_v, table_side, ball_radius, prediction_steps).
   void validate() const;
 };
 

@@ -31,13 +31,17 @@
 
 namespace viewline::estimation {
 
+/// Singer model: first-order Gauss-Markov acceleration, state (p, v, a) per axis in d = 1..3 dimensions.
 struct SingerModel {
   int dim = 3;          ///< spatial dimensions d (1, 2 or 3)
   double tau = 1.0;     ///< manoeuvre time constant τ [s], > 0
   double sigma_m = 1.0; ///< acceleration std σm [m/s²], >= 0
 
+  /// State dimension n = 3d.
   Eigen::Index stateDim() const { return 3 * dim; }
+  /// Φ, Q for dt > 0 (exact discretisation, stable for every τ > 0).
   LinearTransition transition(double dt) const;
+  /// Throws core::InvalidInput naming the bad field (dim, tau, sigma_m).
   void validate() const;
 };
 

@@ -30,10 +30,12 @@ namespace viewline::estimation {
 /// Angle wrapped to (−π, π].
 double wrapAngle(double a);
 
+/// Unicycle ground target ([K] eqs 16-20): state (x, y, θ, v, ω) [m, m, rad, m/s, rad/s] on the ground plane.
 struct UnicycleModel {
   double q_v = 0.1;   ///< speed random-walk intensity: var ξv = q_v dt [m²/s³], >= 0
   double q_w = 0.01;  ///< turn-rate random-walk intensity: var ξω = q_w dt [rad²/s³], >= 0
 
+  /// State dimension n = 5.
   static constexpr Eigen::Index kStateDim = 5;
 
   /// Noise-free step f(x) over dt (> 0); θ is not wrapped (normalize does it).
@@ -48,6 +50,7 @@ struct UnicycleModel {
   static NonlinearMeasurement positionMeasurement(const Eigen::Vector2d& y, double sigma);
   /// a − b with the heading difference wrapped (for errors and NEES).
   static Eigen::VectorXd difference(const Eigen::VectorXd& a, const Eigen::VectorXd& b);
+  /// Throws core::InvalidInput naming the field (q_v, q_w negative or not finite).
   void validate() const;
 };
 

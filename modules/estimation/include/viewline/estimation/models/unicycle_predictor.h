@@ -24,6 +24,7 @@
 
 namespace viewline::estimation {
 
+/// Least-squares trajectory predictor of a unicycle target from a window of recent (t, v, ω) estimates ([K] eqs 27-29).
 class UnicycleTrajectoryPredictor {
 public:
   /// `window` >= 2 samples are kept (oldest dropped first).
@@ -31,10 +32,14 @@ public:
 
   /// Adds an estimate at time t (strictly after the previous one); all values finite.
   void add(double t, double v, double omega);
+  /// Forgets every sample (e.g. when the track restarts).
   void clear() { samples_.clear(); }
+  /// Number of samples held (<= window()).
   std::size_t size() const { return samples_.size(); }
+  /// Maximum number of samples held.
   std::size_t window() const { return window_; }
 
+  /// Linear and angular accelerations fitted over the window.
   struct Accelerations {
     double a_v = 0.0;      ///< [m/s²]
     double a_omega = 0.0;  ///< [rad/s²]

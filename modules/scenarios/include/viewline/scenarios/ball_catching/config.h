@@ -25,37 +25,44 @@
 
 namespace viewline::scenarios {
 
+/// One simulated camera of the catching rig: intrinsics, world pose, clock and image defects.
 struct CatchCameraConfig {
-  std::string name = "camera";
-  unsigned width = 640, height = 480;
+  std::string name = "camera";  ///< label in logs, summaries and the rig folder
+  unsigned width = 640,   ///< image width, px
+           height = 480;  ///< image height, px
   double hfov_rad = 1.0471975511965976;  ///< 60°
-  double cx = -1.0, cy = -1.0;           ///< principal point, px (< 0: image centre)
+  double cx = -1.0,  ///< principal point u, px (< 0: image centre)
+         cy = -1.0;  ///< principal point v, px (< 0: image centre)
   double kud = 0.0;                      ///< ViSP forward radial distortion
+  /// Optical centre in the world frame, m (the pose c_M_w is built from it and look_at).
   Eigen::Vector3d position = Eigen::Vector3d(1.0, -3.2, 1.9);
+  /// World point on the optical axis, m.
   Eigen::Vector3d look_at = Eigen::Vector3d(2.2, 0.0, 1.3);
-  double rate_hz = 50.0;
+  double rate_hz = 50.0;  ///< frames per second (nominal, before drift)
   double drift = 0.0;                 ///< relative clock period error
   double exposure_s = 0.002;          ///< motion blur exposure (0: none)
-  int blur_samples = 3;
+  int blur_samples = 3;                ///< sub-frames averaged over the exposure for motion blur
   double noise_sigma = 2.0;           ///< grey levels
-  double drop_probability = 0.0;
-  double trigger_jitter_s = 0.0002;
-  double stamp_jitter_s = 0.0;
+  double drop_probability = 0.0;      ///< probability that a frame is lost (seeded)
+  double trigger_jitter_s = 0.0002;   ///< s, std of the true capture instant around the tick
+  double stamp_jitter_s = 0.0;        ///< s, std of the reported stamp's error (0: exact stamps)
   /// With a `rig:` (scenarios::loadSimulatedRig): the TRUE camera the simulator renders with
   /// (truth.yaml) and the CALIBRATED one the detector and tracker use (rig.yaml); the geometry
   /// fields above are then unused (width/height are copied from the truth). Without a rig both are
   /// built from the fields above: a perfectly calibrated rig.
-  std::optional<core::Camera> true_camera, calibrated_camera;
+  std::optional<core::Camera> true_camera,  ///< rig truth: what the simulator renders with
+                              calibrated_camera;  ///< rig calibration: what the estimators use
   core::Camera renderCamera() const;     ///< true_camera, or the one built from the fields
   core::Camera estimatorCamera() const;  ///< calibrated_camera, or the one built from the fields
 };
 
+/// How throws are drawn (uniformly, per seeded throw): release box, aim disc, speed, ball body.
 struct ThrowDistribution {
   Eigen::Vector3d release_min = Eigen::Vector3d(-1.0, -0.3, 1.0);  ///< m (x: 3-5 m from the box at x = 4)
-  Eigen::Vector3d release_max = Eigen::Vector3d(1.0, 0.3, 1.6);
+  Eigen::Vector3d release_max = Eigen::Vector3d(1.0, 0.3, 1.6);   ///< m, upper corner of the release box
   double aim_radius = 0.35;         ///< m, aim points uniform in this disc around home (box plane)
   double speed_min = 6.0;           ///< m/s, mean horizontal speed
-  double speed_max = 9.0;
+  double speed_max = 9.0;           ///< m/s, upper bound of the mean horizontal speed
   sim::DragBody body = sim::DragBody::ball5cm();  ///< 5 cm ball, 57 g, Cd 0.5, ρ 1.2 (k ≈ 0.0103 /m)
 };
 
@@ -75,24 +82,27 @@ struct ThrowDistribution {
 struct CatchRegistration {
   bool enabled = false;  ///< off unless the config's registration.enabled says so
   Eigen::Vector3d marker_offset = Eigen::Vector3d(0.15, 0.0, 0.175);  ///< m, from the hole centre (world axes)
-  double marker_radius = 0.025;
+  double marker_radius = 0.025;  ///< m, radius of the marker sphere
   Eigen::Vector3d marker_albedo_bgr = Eigen::Vector3d(0.15, 0.75, 0.15);  ///< green
-  vision::ColorRange marker_hsv{35, 85, 80, 255, 30, 255};
-  std::vector<double> offsets_x{-0.08, 0.08}, offsets_y{-0.4, 0.0, 0.4}, offsets_z{-0.3, 0.0, 0.3};  ///< m, from home
-  int min_points = 6;
+  vision::ColorRange marker_hsv{35, 85, 80, 255, 30, 255};  ///< HSV range the marker detector keeps
+  std::vector<double> offsets_x{-0.08, 0.08},        ///< m, set-point grid along world x, from home
+                      offsets_y{-0.4, 0.0, 0.4},     ///< m, set-point grid along world y, from home
+                      offsets_z{-0.3, 0.0, 0.3};  ///< m, from home
+  int min_points = 6;  ///< fewer marker detections: the camera keeps its calibrated pose
   double gate_px = 10.0;          ///< detections farther than this from the expected pixel are dropped
   double max_rms_px = 0.5;        ///< refuse a camera's registration above this reprojection RMS,
   double max_shift_m = 0.05;      ///< or moving its centre more than this,
   double max_rotation_rad = 0.0087;  ///< or rotating it more than this (0.5°)
 };
 
+/// The whole ball-catching scenario: cameras, throws, box, robot, tracker, planner and rendering.
 struct BallCatchingConfig {
-  std::string name = "ball_catching";
+  std::string name = "ball_catching";  ///< scenario name written into logs and summaries
   std::string rig;                   ///< rig folder as resolved ("" : inline cameras)
-  std::vector<CatchCameraConfig> cameras;
+  std::vector<CatchCameraConfig> cameras;  ///< every configured camera (registration uses all)
   std::size_t camera_count = 0;      ///< use the first N cameras (0: all)
   double rate_override_hz = 0.0;     ///< > 0: every camera at this rate (throws; registration keeps rate_hz)
-  ThrowDistribution throws;
+  ThrowDistribution throws;          ///< where, how fast and what is thrown
   Eigen::Vector3d ball_albedo_bgr = Eigen::Vector3d(0.08, 0.45, 0.95);  ///< orange (dart: flight colour)
   /// "ball" (a sphere of the body's radius) or "dart" (sim::makeDart oriented along its velocity;
   /// the detector then finds the coloured flights, 5 cm behind the centre of mass, and the
@@ -101,25 +111,25 @@ struct BallCatchingConfig {
   double hole_radius = 0.03;         ///< m (6 cm hole)
   Eigen::Vector3d box_normal = -Eigen::Vector3d::UnitX();  ///< box-front normal (unit), towards the thrower
   double box_size = 0.3;             ///< m, cube side (rendered)
-  bool render_box = true;
+  bool render_box = true;            ///< draw the box in the images (it can occlude the ball)
   robots::SimulatedCartesianConfig robot;   ///< kind, limits, latency, home, workspace, arm geometry (w_R_box from box_normal)
   double control_period = 0.004;     ///< s between set points (250 Hz)
   double processing_latency = 0.008; ///< s from capture to the tracker/planner update
   double post_crossing_s = 0.05;     ///< s simulated after the true crossing
   double prediction_lead_s = 0.2;    ///< the early-prediction metric uses the last prediction this long before the crossing
-  vision::BallDetectorConfig detector;
+  vision::BallDetectorConfig detector;  ///< colour segmentation of the ball in every frame
   double sigma_px_floor = 0.3;       ///< px, floor of the measurement std given to the tracker
   /// px per axis: white Gaussian noise added to every detected pixel (pixel-noise table; 0: none).
   /// The tracker is told: its σ is the detector's σ and this one added in quadrature. Drawn from
   /// its own stream (deriveSeed(throw seed, 0xD37)), so the rest of a throw is unchanged.
   double pixel_noise_px = 0.0;
-  tracking::TrackerConfig tracker;
+  tracking::TrackerConfig tracker;   ///< multi-camera ball tracker (world frame, drag model)
   /// The planner's own settings (model, thresholds). Home, limits and latency are the robot's and
   /// the plane normal is the box's: plannerConfig() and CatchPlanner(cfg, robot) ask their owners.
   planning::CatchPlannerConfig planner;
-  CatchRegistration registration;
-  sim::RenderSettings render;
-  sim::RoomParams room;
+  CatchRegistration registration;    ///< camera-to-robot registration before the throws
+  sim::RenderSettings render;        ///< renderer quality (supersampling, shading)
+  sim::RoomParams room;              ///< the simulated room around the scene (walls, floor, light)
   int threads = 2;                   ///< throws run in parallel (independent seeds: same results)
 
   /// The cameras a throw uses: the first camera_count (all when 0).

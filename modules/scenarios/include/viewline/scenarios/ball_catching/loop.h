@@ -45,17 +45,18 @@ namespace viewline::scenarios {
 
 /// What a live view gets for every image.
 struct CatchFrame {
-  int throw_index = 0;
-  std::size_t camera = 0;
+  int throw_index = 0;     ///< index of the throw in runBallCatching()
+  std::size_t camera = 0;  ///< index of the camera that took the image (config order)
   const core::Camera* camera_model = nullptr;   ///< what the estimator believes (calibrated with rig:)
-  double t = 0.0;
-  const cv::Mat* image = nullptr;
-  std::optional<Eigen::Vector2d> detection;
+  double t = 0.0;                               ///< s, capture stamp on the throw's clock (from 0)
+  const cv::Mat* image = nullptr;               ///< the rendered BGR image; valid during the call only
+  std::optional<Eigen::Vector2d> detection;     ///< detected ball pixel (u, v), px; empty: not found
   std::optional<planning::Crossing> crossing;   ///< planner's current target
-  Eigen::Vector3d hole = Eigen::Vector3d::Zero();
+  Eigen::Vector3d hole = Eigen::Vector3d::Zero();  ///< m, hole centre in the world frame (the robot's)
   std::optional<Eigen::Vector3d> estimate;      ///< tracker position
 };
 
+/// Optional observers of runBallCatching(): telemetry per throw, live view, progress, pacing.
 struct CatchHooks {
   /// The telemetry sink of throw i, or null. Called once per throw, from the thread running it:
   /// with threads > 1 return a distinct sink per throw. The throw flushes it and drops its
@@ -64,12 +65,14 @@ struct CatchHooks {
   /// Live view of every image (the session then runs on one thread). Returning false stops the
   /// session: the throw under way is dropped, the throws done are summarised.
   std::function<bool(const CatchFrame&)> on_frame;
+  /// Called after each finished throw with the throws done and the total (any thread).
   std::function<void(int done, int total)> progress;
   runtime::Pacing pacing;  ///< wall-clock pacing of every throw (0: as fast as possible)
 };
 
 /// A CatchHooks::telemetry that writes throw i's records as CSV (runtime::CsvSink: one file per
-/// record kind and channel) into <dir>/throw_<iii>/ (each throw has its own clock, from 0).
+/// record kind and channel) into `dir/throw_iii/` (iii: the throw index, 3 digits; each throw has
+/// its own clock, from 0).
 std::function<std::shared_ptr<runtime::TelemetrySink>(int throw_index)> csvTelemetry(const std::string& dir);
 
 /// One throw with its own seed. `interrupted` (optional) is set when hooks->on_frame stopped it.

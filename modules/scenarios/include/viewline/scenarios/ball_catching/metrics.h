@@ -36,59 +36,85 @@
 
 namespace viewline::scenarios {
 
+/// Everything one throw measured: the draw, the truth, what the tracker and planner did, the
+/// outcome (world frame, s and m unless the name says otherwise).
 struct ThrowResult {
-  int index = 0;
-  std::uint64_t seed = 0;
+  int index = 0;           ///< throw index (0-based)
+  std::uint64_t seed = 0;  ///< the throw's own seed (deriveSeed(runBallCatching's seed, index))
   // Throw
-  Eigen::Vector3d release = Eigen::Vector3d::Zero(), launch_velocity = Eigen::Vector3d::Zero();
-  double launch_speed = 0.0, launch_elevation_deg = 0.0, distance = 0.0;
+  Eigen::Vector3d release = Eigen::Vector3d::Zero(),          ///< release point, m (world)
+                  launch_velocity = Eigen::Vector3d::Zero();  ///< velocity at release, m/s (world)
+  double launch_speed = 0.0,          ///< |launch_velocity|, m/s
+         launch_elevation_deg = 0.0,  ///< launch angle above the horizontal, degrees
+         distance = 0.0;              ///< release to the box plane along its normal, m
   // Truth
   double t_cross = 0.0;                                 ///< true crossing time (release at 0)
   Eigen::Vector3d cross_true = Eigen::Vector3d::Zero(); ///< true crossing point
   double t_first_visible = -1.0;                        ///< first capture with the ball in an image
-  bool reachable = false;
+  bool reachable = false;                               ///< the oracle could have caught it
   double oracle_time = 0.0;                             ///< T_min home -> crossing, s
   // Run
-  int frames = 0, detections = 0, fused = 0, gated = 0;
-  double t_first_detection = -1.0;
+  int frames = 0,      ///< images captured over all cameras
+      detections = 0,  ///< images in which the detector found the ball
+      fused = 0,       ///< detections the tracker fused
+      gated = 0;       ///< detections the tracker's gate rejected
+  double t_first_detection = -1.0;                      ///< s, first detection's stamp (-1: none)
   double t_first_move = -1.0;                           ///< planner's first move towards a target
-  bool had_target = false, committed = false, gave_up = false;
+  bool had_target = false,  ///< the planner had a crossing target at some point
+       committed = false,   ///< the planner committed to a target
+       gave_up = false;     ///< the planner decided the throw was not catchable
   double give_up_lead = -1.0;                           ///< true crossing − give-up decision, s
   double decision_time = -1.0;                          ///< commit − first update, s
   Eigen::Vector3d target = Eigen::Vector3d::Zero();     ///< planner's final target
   double prediction_error = -1.0;                       ///< |target − true crossing|, m
   double prediction_error_lead = -1.0;                  ///< same, last prediction >= prediction_lead_s before it
-  Eigen::Vector3d hole_at_cross = Eigen::Vector3d::Zero();
+  Eigen::Vector3d hole_at_cross = Eigen::Vector3d::Zero();  ///< actual hole centre at t_cross, m
   double miss_distance = 0.0;                           ///< in-plane |ball − hole| at the crossing, m
-  bool caught = false;
+  bool caught = false;                                  ///< crossed within the clearance of the hole
   std::string miss_reason;                              ///< "" when caught
-  std::size_t limit_violations = 0, refused_setpoints = 0;
-  double wall_s = 0.0;
+  std::size_t limit_violations = 0,  ///< set points over the velocity or acceleration limits
+              refused_setpoints = 0;  ///< set points refused (no IK solution, or outside the workspace)
+  double wall_s = 0.0;  ///< wall-clock time the throw took to simulate, s
 };
 
+/// The figures of runBallCatching() (the summary JSON): catch rates, prediction errors, decisions, limits.
 struct CatchSummary {
-  std::uint64_t seed = 0;
-  int throws = 0, reachable_throws = 0, caught = 0, caught_reachable = 0;
-  double catch_rate_all = 0.0, catch_rate_reachable = 0.0;
-  std::map<std::string, int> miss_reasons;
-  double prediction_error_mm_median = 0.0, prediction_error_mm_p95 = 0.0;
-  double prediction_error_lead_mm_median = 0.0, prediction_error_lead_mm_p95 = 0.0;
-  int predictions_at_lead = 0;
-  double decision_time_s_median = 0.0, decision_time_s_p95 = 0.0;
-  int decisions = 0;
+  std::uint64_t seed = 0;  ///< the seed runBallCatching() was given
+  int throws = 0,            ///< throws run
+      reachable_throws = 0,  ///< throws the oracle could catch
+      caught = 0,            ///< throws caught
+      caught_reachable = 0;  ///< reachable throws caught
+  double catch_rate_all = 0.0,        ///< caught / throws
+         catch_rate_reachable = 0.0;  ///< caught_reachable / reachable_throws
+  std::map<std::string, int> miss_reasons;  ///< count per miss reason (see the file comment)
+  double prediction_error_mm_median = 0.0,  ///< median |final target − true crossing|, mm
+         prediction_error_mm_p95 = 0.0;     ///< 95th percentile of the same, mm
+  double prediction_error_lead_mm_median = 0.0,  ///< median error of the prediction_lead_s-early prediction, mm
+         prediction_error_lead_mm_p95 = 0.0;     ///< 95th percentile of the same, mm
+  int predictions_at_lead = 0;  ///< throws that had a prediction prediction_lead_s early
+  double decision_time_s_median = 0.0,  ///< median time from the first update to the commit, s
+         decision_time_s_p95 = 0.0;     ///< 95th percentile of the same, s
+  int decisions = 0;  ///< throws with a commit (the decision-time sample size)
   int gave_up_unreachable = 0;   ///< not-reachable throws the planner gave up on (early decision)
   int gave_up_reachable = 0;     ///< reachable throws it gave up on (wrong decisions)
   double give_up_lead_s_median = 0.0;  ///< how long before the crossing it gave up (unreachable ones)
-  double miss_distance_mm_median_reachable = 0.0;
-  std::size_t limit_violations = 0, refused_setpoints = 0;
-  int frames = 0, detections = 0;
-  double detection_rate = 0.0;
-  std::optional<RegistrationResult> registration;
-  double launch_speed_min = 0.0, launch_speed_max = 0.0, launch_speed_mean = 0.0;
-  double elevation_deg_min = 0.0, elevation_deg_max = 0.0;
-  double flight_time_min = 0.0, flight_time_max = 0.0;
-  double wall_s = 0.0, ms_per_frame = 0.0;
-  std::vector<ThrowResult> results;
+  double miss_distance_mm_median_reachable = 0.0;  ///< median in-plane miss of reachable throws, mm
+  std::size_t limit_violations = 0,   ///< sum over the throws
+              refused_setpoints = 0;  ///< sum over the throws
+  int frames = 0,      ///< images over all throws and cameras
+      detections = 0;  ///< of which the ball was detected in
+  double detection_rate = 0.0;  ///< detections / frames
+  std::optional<RegistrationResult> registration;  ///< the camera registration, when enabled
+  double launch_speed_min = 0.0,   ///< m/s, over the throws
+         launch_speed_max = 0.0,   ///< m/s
+         launch_speed_mean = 0.0;  ///< m/s
+  double elevation_deg_min = 0.0,  ///< launch elevation over the throws, degrees
+         elevation_deg_max = 0.0;  ///< degrees
+  double flight_time_min = 0.0,  ///< release to crossing over the throws, s
+         flight_time_max = 0.0;  ///< s
+  double wall_s = 0.0,        ///< wall-clock time of all throws, s (set by the caller)
+         ms_per_frame = 0.0;  ///< wall-clock per image, ms
+  std::vector<ThrowResult> results;  ///< every throw, in throw order
 };
 
 /// The end of a throw: caught or not (and why), the oracle, the planner's decisions, the robot's
@@ -101,6 +127,7 @@ void scoreThrow(ThrowResult& res, const BallCatchingConfig& cfg, const robots::S
 CatchSummary summarise(std::vector<ThrowResult> results, std::uint64_t seed,
                        std::optional<RegistrationResult> registration);
 
+/// The summary as JSON (rates, medians, miss reasons, registration) with the config's key values.
 nlohmann::json summaryJson(const CatchSummary& s, const BallCatchingConfig& cfg);
 
 /// The console summary: a figure over no throw says "not scored" instead of printing nan.

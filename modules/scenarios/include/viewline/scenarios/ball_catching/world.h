@@ -29,8 +29,9 @@ namespace viewline::scenarios {
 
 /// One drawn throw.
 struct ThrowDraw {
-  Eigen::Vector3d release = Eigen::Vector3d::Zero(), aim = Eigen::Vector3d::Zero();
-  Eigen::Vector3d launch_velocity = Eigen::Vector3d::Zero();
+  Eigen::Vector3d release = Eigen::Vector3d::Zero(),  ///< release point, m (world)
+                  aim = Eigen::Vector3d::Zero();      ///< aim point on the box-front plane, m (world)
+  Eigen::Vector3d launch_velocity = Eigen::Vector3d::Zero();  ///< solved launch velocity, m/s (world)
   double flight_time = 0.0;  ///< release to the aim point, s
   double distance = 0.0;     ///< release to the box plane along its normal, m
 };
@@ -54,6 +55,7 @@ void appendBox(const BallCatchingConfig& cfg, const Eigen::Matrix3d& R, const Ei
 /// The room and the box held still with its hole at `hole` (registration).
 class StaticBoxWorld : public sim::World {
 public:
+  /// Keeps references to room and cfg (they must outlive the world); hole in m, world frame.
   StaticBoxWorld(const sim::Scene& room, const BallCatchingConfig& cfg, const Eigen::Vector3d& hole)
       : room_(room), cfg_(cfg), hole_(hole), R_(boxRotation(cfg.box_normal)) {}
   const sim::Scene& staticScene() const override { return room_; }
@@ -70,6 +72,7 @@ private:
 /// holds it at time t (so the robot must have been commanded up to t before rendering).
 class CatchWorld : public sim::World {
 public:
+  /// Keeps references to all four (they must outlive the world); the box follows robot's hole.
   CatchWorld(const sim::Scene& room, const sim::DragFlight& flight, const BallCatchingConfig& cfg,
              const robots::CartesianRobot& robot)
       : room_(room), flight_(flight), cfg_(cfg), robot_(robot), R_(boxRotation(cfg.box_normal)) {}
@@ -95,6 +98,8 @@ std::vector<sim::SimCamera> throwCameras(const BallCatchingConfig& cfg, core::Rn
 /// The true objects of the last frame (a simulator's privilege) are kept for the metrics.
 class RigFrameSource : public runtime::FrameSource {
 public:
+  /// Builds the sim::CameraRig from `cameras` and rng (and throws as it does); world is kept by
+  /// reference; t_end in s on the throw's clock.
   RigFrameSource(std::vector<sim::SimCamera> cameras, core::Rng& rng, const sim::RenderSettings& render,
                  const sim::World& world, double t_end);
   std::size_t cameraCount() const override { return rig_.cameras().size(); }

@@ -35,17 +35,19 @@ namespace viewline::scenarios {
 
 /// One logged detection (for --log): experiment, run, detection and the estimate after it.
 struct DartLogRow {
-  std::string experiment;
-  int run = 0;
-  DartDetection det;
-  tracking::Fate fate = tracking::Fate::Fused;
-  tracking::Vector6 estimate;
+  std::string experiment;  ///< experiment and variant, e.g. "A_alternating", "D_scenario"
+  int run = 0;             ///< run index (its seed is deriveSeed(seed, run))
+  DartDetection det;       ///< the detection as generated (stamp, camera, pixel, outlier flag)
+  tracking::Fate fate = tracking::Fate::Fused;  ///< what the tracker did with it
+  tracking::Vector6 estimate;  ///< state after it: position m, velocity m/s (world)
 };
 
 /// The columns of the --log detections CSV and one row of it.
 std::vector<std::string> dartLogColumns();
+/// One row of that CSV, in dartLogColumns() order.
 std::vector<std::string> dartLogRow(const DartLogRow& r);
 
+/// Optional observers of runDartExperiments(): progress, per-detection log, telemetry, pacing.
 struct DartRunCallbacks {
   std::function<void(int done, int total)> progress;  ///< after each run
   std::function<void(const DartLogRow&)> log;         ///< per processed detection (optional)

@@ -15,58 +15,70 @@
 
 namespace viewline::scenarios {
 
+/// How well one gate separated gross outliers from good detections, and the RMSE it left.
 struct GateFigures {
-  std::string gate;
-  std::size_t outliers = 0, outliers_rejected = 0, inliers = 0, inliers_rejected = 0;
-  double outlier_rejected_fraction = 0.0;
-  double inlier_rejected_fraction = 0.0;
+  std::string gate;  ///< gate name ("directional", "mahalanobis"; D: the configured kind)
+  std::size_t outliers = 0,           ///< generated outliers submitted
+              outliers_rejected = 0,  ///< of which the gate rejected
+              inliers = 0,            ///< good detections submitted
+              inliers_rejected = 0;   ///< of which the gate rejected (wrongly)
+  double outlier_rejected_fraction = 0.0;  ///< outliers_rejected / outliers
+  double inlier_rejected_fraction = 0.0;   ///< inliers_rejected / inliers
   double rmse_position = 0.0;  ///< pooled over settled measurements, m
 };
 
+/// The figures of experiments A-E over all runs (see loop.h for what each experiment does).
 struct DartSummary {
-  std::uint64_t seed = 0;
-  int runs = 0;
+  std::uint64_t seed = 0;  ///< the seed runDartExperiments() was given
+  int runs = 0;            ///< seeded runs (one flight per experiment each)
   // A
   double nees_mean = 0.0;             ///< 6-dof state NEES, one sample per run
-  core::Interval nees_bounds;
-  std::size_t nees_samples = 0;
+  core::Interval nees_bounds;         ///< two-sided χ² bounds of the mean NEES at cfg.confidence
+  std::size_t nees_samples = 0;       ///< samples in nees_mean (runs reaching nees_index)
   double nees_position_mean = 0.0;    ///< 3-dof
-  core::Interval nees_position_bounds;
+  core::Interval nees_position_bounds;  ///< χ² bounds of nees_position_mean
   double rmse_position = 0.0;         ///< m (A, settled)
   double pcrlb_position = 0.0;        ///< m (A, settled)
-  double rmse_to_pcrlb = 0.0;
+  double rmse_to_pcrlb = 0.0;         ///< rmse_position / pcrlb_position (1: efficient)
   double rmse_to_pcrlb_final = 0.0;   ///< at the last measurement of each flight
-  double measurements_per_flight = 0.0;
+  double measurements_per_flight = 0.0;  ///< mean in-image detections per flight (A)
   // B
-  GateFigures gate_directional, gate_mahalanobis;
-  std::string better_gate;
+  GateFigures gate_directional,   ///< the directional gate on B's data
+              gate_mahalanobis;   ///< the Mahalanobis gate on the same data
+  std::string better_gate;        ///< the gate with fewer errors (outliers passed + inliers rejected)
   double outlier_rejected_fraction = 0.0;  ///< better gate
   double inlier_rejected_fraction = 0.0;   ///< better gate
-  double rmse_image_ekf_alternating = 0.0;
+  double rmse_image_ekf_alternating = 0.0;  ///< image-space EKF baseline on B's data, m
   // C
-  double rmse_async_exact = 0.0, rmse_async_dt_offset = 0.0, rmse_async_image_ekf = 0.0;
-  double nees_async_exact = 0.0, nees_async_dt_offset = 0.0;  ///< position NEES, pooled settled
+  double rmse_async_exact = 0.0,      ///< exact propagation to each stamp, m
+         rmse_async_dt_offset = 0.0,  ///< Δt-offset rows on a fixed grid, m
+         rmse_async_image_ekf = 0.0;  ///< image-space EKF, m
+  double nees_async_exact = 0.0,      ///< position NEES of the exact filter, pooled settled
+         nees_async_dt_offset = 0.0;  ///< position NEES, pooled settled
   double update_time_us = 0.0;  ///< mean ViewlineTracker::submit time in C (exact)
   // D
   GateFigures scenario_gate;    ///< full scenario with the configured gate (rmse_position = scenario RMSE)
+  /// Largest difference of the final x, P and time between arrival and capture order.
   double late_vs_inorder_max_diff = 0.0;
-  std::size_t late_inserted = 0;
-  std::size_t late_outcome_mismatches = 0;
-  std::size_t late_refused = 0;
+  std::size_t late_inserted = 0;            ///< late measurements inserted into the past (replayed)
+  std::size_t late_outcome_mismatches = 0;  ///< detections whose fate differs between the two orders
+  std::size_t late_refused = 0;             ///< arrivals refused (e.g. older than late_horizon)
   // E
+  /// 95th percentile (nearest rank) of the measurements needed to stay within single_tolerance of
+  /// the filter started at the truth (a count).
   double single_camera_convergence_p95 = 0.0;
-  double single_camera_convergence_median = 0.0;
-  std::size_t single_camera_not_converged = 0;
-  double runtime_s = 0.0;
+  double single_camera_convergence_median = 0.0;  ///< median of the same count
+  std::size_t single_camera_not_converged = 0;    ///< runs still off at their last measurement
+  double runtime_s = 0.0;  ///< wall-clock time of all experiments, s
 };
 
 /// Squared position errors (and the bound, the position NEES) pooled over the settled
 /// measurements of many flights.
 struct PooledError {
-  double se = 0.0;
-  double bound = 0.0;
-  double nees = 0.0;
-  std::size_t n = 0;
+  double se = 0.0;     ///< sum of squared position errors, m²
+  double bound = 0.0;  ///< sum of the position PCRLB traces, m²
+  double nees = 0.0;   ///< sum of the position NEES
+  std::size_t n = 0;   ///< measurements pooled
   /// √(se / n); 0 when nothing was pooled.
   double rmse() const;
   /// Adds the estimate's error against the truth (and its position NEES).

@@ -21,12 +21,17 @@ namespace viewline::scenarios {
 
 /// Gripper zones in the robot frame (x forward from the axle centre, y left), m.
 struct GripperZone {
-  double x_min = 0.12, x_max = 0.28, half_width = 0.07;
+  double x_min = 0.12,       ///< m, nearest edge ahead of the axle centre
+         x_max = 0.28,       ///< m, farthest edge
+         half_width = 0.07;  ///< m, half the lateral extent (|y| bound)
+  /// True when the point p_r (robot frame, m) lies in the zone, edges included.
   bool contains(const Eigen::Vector2d& p_r) const {
     return p_r.x() >= x_min && p_r.x() <= x_max && std::abs(p_r.y()) <= half_width;
   }
 };
 
+/// The mobile-capture scenario's parameters ([K]): start poses, timing, camera, robot, detection,
+/// estimation, planning and the filter and field-of-view tests (SI units, world floor frame).
 struct MobileCaptureConfig {
   // Start ([K]) and world.
   Eigen::Vector2d robot_start = Eigen::Vector2d(-0.5, -0.5);  ///< m
@@ -38,7 +43,8 @@ struct MobileCaptureConfig {
   double floor_size = 30.0;             ///< m (textured floor square centred at the origin)
   /// Camera blackout (lens covered: frames give no detection) on [start, start + duration), s;
   /// start < 0: none. Exercises losing the target and finding it again.
-  double blackout_start = -1.0, blackout_duration = 0.0;
+  double blackout_start = -1.0,    ///< s (< 0: no blackout)
+         blackout_duration = 0.0;  ///< s
 
   // Timing.
   double vision_period = 0.1;           ///< s ([K]); also the profile step and the planner's T
@@ -46,7 +52,8 @@ struct MobileCaptureConfig {
   // base.control_period ([K]: 10 ms): controlPeriod() asks it.
 
   // Camera (320x240, 50° x 40°).
-  unsigned width = 320, height = 240;
+  unsigned width = 320,   ///< image width, px
+           height = 240;  ///< image height, px
   double hfov = 0.8726646259971648;     ///< rad (50°)
   double vfov = 0.6981317008965228;     ///< rad (40°)
   double sensor_noise = 2.0;            ///< grey levels (std)
@@ -54,17 +61,17 @@ struct MobileCaptureConfig {
 
   /// Calibrated rig (key `rig`): replaces width, height, hfov, vfov (see mobile_capture.h).
   struct RigCameras {
-    std::string folder;
+    std::string folder;                 ///< the rig folder as resolved
     core::Camera truth;                 ///< renders (intrinsics; its pose is the DH head at q0)
     core::Camera calibrated;            ///< estimators (intrinsics; c_M_w = calibrated pose at q0)
     robots::PanTiltJoints q0;           ///< head joints of truth.yaml's pose
     Eigen::Isometry3d cal_M_c = Eigen::Isometry3d::Identity();  ///< c'_M_c, calibrated vs DH camera
   };
-  std::optional<RigCameras> rig;
+  std::optional<RigCameras> rig;  ///< empty: an ideal camera from width, height, hfov, vfov
 
   // Robot.
-  robots::MobilePanTiltParams head;
-  robots::DifferentialDriveParams base;
+  robots::MobilePanTiltParams head;       ///< pan-tilt head on the base: DH geometry, joint limits
+  robots::DifferentialDriveParams base;   ///< the base: wheels, speed limits, wheel-PID period
   GripperZone jaws;                                 ///< grasp succeeds when the true object is here
   GripperZone trigger{0.14, 0.26, 0.045};           ///< grasp is attempted when the estimate is here
   double grasp_cooldown = 0.5;                      ///< s after a failed grasp
@@ -77,7 +84,7 @@ struct MobileCaptureConfig {
 
   // Estimation: the target track (keys filter.q_v, q_w, init_speed_sigma, init_turn_sigma,
   // gate_probability, predictor_window; it restarts after 5 rejections in a row).
-  tracking::UnicycleTrackerConfig filter;
+  tracking::UnicycleTrackerConfig filter;  ///< unicycle EKF of the object, gate and restart rule
   double init_speed = 0.3;              ///< m/s (key filter.init_speed; the two-point start measures it)
   /// The LS accelerations are used only once the window is full, clamped to these (physically
   /// plausible) bounds; 0 switches them off (constant v, ω prediction).
@@ -91,7 +98,7 @@ struct MobileCaptureConfig {
   planning::CapturePlannerParams planner;
   /// The go-to-point law's gains; its speed and turn-rate limits are the base's (goParams()).
   control::GoToPointParams go;
-  control::SearchParams search;
+  control::SearchParams search;  ///< how the head and base search when the target is lost
 
   // Filter test ([K] §3.2).
   double filter_test_duration = 60.0;        ///< s
@@ -99,7 +106,7 @@ struct MobileCaptureConfig {
   double filter_test_q_v = 0.003;            ///< m²/s³ (ξv variance 3 (cm/s)² per 0.1 s step)
   double filter_test_q_w = 1.0;              ///< rad²/s³ (ξω variance 0.1 (rad/s)² per step)
   double convergence_time = 10.0;            ///< s: RMSE is taken after this
-  int filter_test_runs = 20;
+  int filter_test_runs = 20;                 ///< seeded runs of the filter test
 
   // Field-of-view sweep of the ground localisation.
   int fov_sweep_poses = 50;             ///< random head/base poses

@@ -21,13 +21,18 @@ namespace viewline::scenarios::mobile_capture {
 
 /// Independent random streams of one run, all derived from the run seed.
 struct Streams {
-  core::Rng object, room, render, drive;
+  core::Rng object,  ///< the object's input noise (ξv, ξω)
+            room,    ///< the floor texture
+            render,  ///< image sensor noise (and the filter test's measurement noise)
+            drive;   ///< the base's encoder noise
+  /// Stream k (1..4 in the order above) is seeded with deriveSeed(seed, k).
   explicit Streams(std::uint64_t seed);
 };
 
 /// The camera that renders (truth: the rig's truth.yaml, or the inline pinhole) and the one the
 /// estimators use (the rig's calibration; the same perfect pinhole without a rig).
 core::Camera renderCamera(const MobileCaptureConfig& cfg);
+/// The estimators' camera (rig calibration, or the same perfect pinhole as renderCamera()).
 core::Camera estimatorCamera(const MobileCaptureConfig& cfg);
 /// c_M_w of the true head camera at joints q on the base pose (x, y, θ): the DH head.
 Eigen::Isometry3d trueCamera_c_M_w(const robots::MobilePanTilt& head, const robots::PanTiltJoints& q, double x,
@@ -46,9 +51,11 @@ Eigen::Vector2d toRobot(const robots::BasePose& pose, const Eigen::Vector2d& p_w
 /// Control ticks i = 0..last at t = i · control_period (the product, not a running sum: every
 /// time stamp of the scenario is computed this one way).
 struct TickClock {
-  double period = 0.01;
-  long last = 0;
+  double period = 0.01;  ///< s, the control period
+  long last = 0;         ///< index of the last tick (max_time / period, rounded)
+  /// Time of tick i, s.
   double time(long i) const { return static_cast<double>(i) * period; }
+  /// The clock of a run: period = cfg.controlPeriod(), up to max_time.
   static TickClock of(const MobileCaptureConfig& cfg);
   /// Control ticks per vision frame (vision_period / control_period, an integer).
   static long visionEvery(const MobileCaptureConfig& cfg);
@@ -56,10 +63,11 @@ struct TickClock {
 
 /// One simulated robot: base (wheels, PID, odometry) and rate-limited head joints.
 struct RobotSim {
-  const MobileCaptureConfig& cfg;
-  robots::MobilePanTilt head;
-  robots::DifferentialDrive base;
-  robots::PanTiltJoints q;
+  const MobileCaptureConfig& cfg;  ///< the run's config (must outlive the robot)
+  robots::MobilePanTilt head;      ///< head kinematics (DH) on the base
+  robots::DifferentialDrive base;  ///< base dynamics, wheel PID and odometry
+  robots::PanTiltJoints q;         ///< current head joints (tilt, pan), rad
+  /// The base at the config's start pose, at rest; the head pointed 2 m ahead of it.
   explicit RobotSim(const MobileCaptureConfig& c);
   /// One control period of the head servo towards `target` (clamped to the joint limits).
   void stepHead(const robots::PanTiltJoints& target);
@@ -73,6 +81,8 @@ class RenderedHeadCamera final : public runtime::FrameSource {
 public:
   /// c_M_w of the true camera at the time of a grab.
   using PoseProvider = std::function<Eigen::Isometry3d()>;
+  /// Renders `target` on the textured floor (rng.room: texture, rng.render: noise); cfg, target
+  /// and rng are kept by reference.
   RenderedHeadCamera(const MobileCaptureConfig& cfg, const sim::GroundTarget& target, Streams& rng,
                      PoseProvider camera_pose);
   ~RenderedHeadCamera() override;

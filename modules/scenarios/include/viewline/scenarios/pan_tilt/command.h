@@ -20,16 +20,18 @@
 
 namespace viewline::scenarios::pan_tilt {
 
+/// The pan_tilt_tracking command line, parsed: scenario file and edits, seed, outputs, mode.
 struct CommandOptions {
-  std::string config_path;
+  std::string config_path;              ///< the scenario YAML (--config)
   std::vector<std::string> sets;        ///< --set KEY=VALUE, recorded in the summary (config_set)
   std::vector<std::string> shorthands;  ///< further KEY=VALUE edits from shorthand flags (not recorded)
-  std::uint64_t seed = 1;
-  std::string log_dir, summary_path;
+  std::uint64_t seed = 1;               ///< run seed (--seed): path, noise, [T] draws
+  std::string log_dir,                  ///< --log folder for the CSV logs ("" : none)
+              summary_path;             ///< --summary JSON file ("" : none)
   bool quiet = false;                   ///< no progress lines
-  runtime::Pacing pacing;
+  runtime::Pacing pacing;               ///< wall-clock pacing of the loop (default: as fast as possible)
   std::string replay;                   ///< frames CSV of a logged run: filter-only replay instead of the loop
-  PanTiltReplayEstimator estimator = PanTiltReplayEstimator::Filter;
+  PanTiltReplayEstimator estimator = PanTiltReplayEstimator::Filter;  ///< the replay's estimator
   std::size_t particles = 20000;        ///< of PanTiltReplayEstimator::WaypointParticles
 };
 

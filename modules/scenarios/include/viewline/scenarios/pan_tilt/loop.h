@@ -37,7 +37,11 @@
 
 namespace viewline::scenarios {
 
-enum class PanTiltControllerKind { Predictive, Baseline };
+/// Which law closes the loop: ours ([T]'s predictive controller) or ViSP's visual servo.
+enum class PanTiltControllerKind {
+  Predictive,  ///< the predictive controller (filter, delay compensation, reacquisition)
+  Baseline     ///< ViSP's image-based visual servo (control.servo), the comparison
+};
 
 /// Where a run reports, and how it relates to the wall clock.
 struct PanTiltRunIo {
@@ -51,6 +55,7 @@ struct PanTiltRunIo {
 /// and the commands on `controller`; the truth on `controller`_truth; the image error (px) as a
 /// scalar on `controller`_image_error_px. Measurement and innovation ids are the frame index + 1.
 std::string truthChannel(const std::string& controller);
+/// The scalar channel of the image error (px) of `controller`'s run.
 std::string imageErrorChannel(const std::string& controller);
 
 /// Runs one controller on the scenario; deterministic for (config, seed) whatever the pacing and

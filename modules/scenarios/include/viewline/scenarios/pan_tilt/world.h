@@ -54,28 +54,37 @@ struct FrameTruth {
 /// offset) and the camera rig on it. Holds references into itself: neither copied nor moved.
 class World {
 public:
+  /// Builds the world of `seed` (path, rendering and noise streams derived from it); config is not
+  /// kept.
   World(const PanTiltScenarioConfig& config, std::uint64_t seed);
   World(const World&) = delete;
   World& operator=(const World&) = delete;
 
+  /// The target's path on the screen (m, screen frame).
   const sim::ScreenPath& path() const { return path_; }
+  /// Pose of the screen in the unit's base frame f.
   const Eigen::Isometry3d& f_M_screen() const { return f_M_screen_; }
+  /// [T]'s measurement noise std (x, y) on this path, m.
   const Eigen::Vector2d& sigma() const { return sigma_; }
+  /// diag(σ²) of [T]'s noise (kept positive definite), m².
   const Eigen::Matrix2d& R() const { return R_; }
   /// [T]'s noise of the next frame (drawn for every frame, detected or not).
   Eigen::Vector2d drawNoise();
+  /// The simulated unit (true mount; joints, limits, latency).
   robots::SimulatedPanTiltUnit& unit() { return unit_; }
   /// The unit as the controllers know it (calibrated camera mount).
   const robots::PanTiltKinematics& modelKinematics() const { return kin_model_; }
+  /// The camera rig on the unit (true camera; renders the frames).
   sim::CameraRig& rig() { return rig_; }
+  /// What the camera sees: screen and disc, the disc hidden during the occlusion window.
   const sim::World& scene() const { return occluded_; }
   /// Truth at capture time tc, through the camera as it was at capture (true pose).
   FrameTruth truth(const core::Camera& camera_at_capture, double tc) const;
   /// The true camera's principal point (px): the image error is measured from it.
   const Eigen::Vector2d& principal() const { return principal_; }
   double occlusionStart() const { return occ0_; }  ///< 1e300 without one
-  double occlusionEnd() const { return occ1_; }
-  double exposure() const { return exposure_; }
+  double occlusionEnd() const { return occ1_; }    ///< s, end of the occlusion window (exclusive)
+  double exposure() const { return exposure_; }    ///< s, the camera's exposure (0: no motion blur)
 
 private:
   class Occluded : public sim::World {

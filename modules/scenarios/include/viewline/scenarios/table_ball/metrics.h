@@ -17,45 +17,61 @@
 
 namespace viewline::scenarios {
 
+/// One scored set-point step (changes of at least min_step), from the ball's true path.
 struct StepMetrics {
-  double t = 0.0;
-  double size_m = 0.0;
-  double overshoot_pct = 0.0;
+  double t = 0.0;                 ///< s, time of the set-point change
+  double size_m = 0.0;            ///< m, distance between the old and the new set point
+  double overshoot_pct = 0.0;     ///< max travel past the new set point along the step, % of size_m
   double settling_time_s = 0.0;   ///< step axis (the stepped coordinate); +inf when it never settles
   double settling_time_2d_s = 0.0;  ///< same with the 2-D distance (includes the cross axis)
-  double steady_state_error_mm = 0.0;
+  double steady_state_error_mm = 0.0;  ///< mean |p − set point| over the window's last steady_window, mm
 };
+/// One scored push: how far the ball was knocked from its set point and how long recovery took.
 struct PushMetrics {
-  double t = 0.0;
+  double t = 0.0;                 ///< s, time of the push
   double speed = 0.0;             ///< |Δv|, m/s
   double recovery_s = 0.0;        ///< +inf when it never recovers in its window
-  double peak_excursion_mm = 0.0;
+  double peak_excursion_mm = 0.0;  ///< largest |p − set point| in the push's window, mm
 };
 
+/// The figures of one run (definitions in table_ball.h): counts, observer and prediction errors,
+/// step and push responses, timing and command limits. NaN: not scored.
 struct TableBallResult {
-  std::uint64_t seed = 0;
-  double duration = 0.0;
-  int frames = 0, frames_dropped = 0, table_detections = 0, ball_detections = 0;
+  std::uint64_t seed = 0;   ///< the run's seed
+  double duration = 0.0;    ///< s, simulated time
+  int frames = 0,            ///< frames captured (dropped ones included)
+      frames_dropped = 0,    ///< frames lost (the observer predicted through them)
+      table_detections = 0,  ///< frames in which the table was found
+      ball_detections = 0;   ///< frames in which the ball was found
   int tracked_frames = 0;  ///< frames measured by the fast path (edge tracking), not [M]'s full pipeline
-  double observer_rmse_mm = 0.0;
-  double measurement_rmse_mm = 0.0;
+  double observer_rmse_mm = 0.0;     ///< RMS |p̂ − p| after warmup, mm
+  double measurement_rmse_mm = 0.0;  ///< RMS |y − p| of the ball measurements after warmup, mm
   double observer_rmse_mm_M_sw1_sv0005 = 0.0;   ///< [M]'s best tuning (side filter)
   double observer_rmse_mm_M_sw1_sv1 = 0.0;      ///< [M]'s lagging tuning (side filter)
   double observer_rmse_mm_stationary = 0.0;     ///< stationary (DARE) gain, configured σ
   double prediction_rmse_mm_10 = 0.0;           ///< 10-step (0.2 s) prediction vs truth
   double tilt_rmse_deg = 0.0;                   ///< measured table tilt vs truth
-  double nis_mean = 0.0;
-  std::vector<StepMetrics> steps;
-  std::vector<PushMetrics> pushes;
-  double overshoot_pct = 0.0, settling_time_s = 0.0, steady_state_error_mm = 0.0, push_recovery_s = 0.0;
-  double observer_frame_ms = 0.0, reference_frame_ms = 0.0, frame_time_ratio_to_reference = 0.0;
-  double observer_frame_cpu_ms = 0.0, reference_frame_cpu_ms = 0.0, frame_cpu_ratio_to_reference = 0.0;
-  double max_commanded_angle_deg = 0.0, max_commanded_rate_deg_s = 0.0;
-  bool limits_respected = true;
+  double nis_mean = 0.0;                         ///< mean NIS of the ball measurements after warmup (2 dof: 2 expected)
+  std::vector<StepMetrics> steps;    ///< every scored step, in time order
+  std::vector<PushMetrics> pushes;   ///< every scored push, in time order
+  double overshoot_pct = 0.0,          ///< worst step overshoot, %
+         settling_time_s = 0.0,        ///< worst step settling time, s (+inf: one never settled)
+         steady_state_error_mm = 0.0,  ///< worst step steady-state error, mm
+         push_recovery_s = 0.0;        ///< worst push recovery time, s (+inf: one never recovered)
+  double observer_frame_ms = 0.0,              ///< mean wall-clock per frame of the observer, ms
+         reference_frame_ms = 0.0,             ///< the same for the plain OpenCV reference, ms
+         frame_time_ratio_to_reference = 0.0;  ///< observer_frame_ms / reference_frame_ms
+  double observer_frame_cpu_ms = 0.0,         ///< mean thread-CPU per frame of the observer, ms
+         reference_frame_cpu_ms = 0.0,        ///< the same for the reference, ms
+         frame_cpu_ratio_to_reference = 0.0;  ///< observer_frame_cpu_ms / reference_frame_cpu_ms
+  double max_commanded_angle_deg = 0.0,   ///< largest |tilt| commanded on either axis, degrees
+         max_commanded_rate_deg_s = 0.0;  ///< largest commanded tilt rate, degrees/s
+  bool limits_respected = true;  ///< every command within the wrist's angle and rate limits
   bool stopped_early = false;  ///< the run was stopped before its duration (a display's quit key)
-  double wall_seconds = 0.0;
+  double wall_seconds = 0.0;   ///< wall-clock time of the run, s
 };
 
+/// The result as the summary JSON (NaN and ±inf as null; steps and pushes as arrays).
 nlohmann::json toJson(const TableBallResult& r);
 
 /// The summary a person reads (stdout of the app). A figure the run could not score says why
@@ -66,8 +82,10 @@ void printTableBallSummary(std::FILE* out, const TableBallResult& r, const Table
 /// stationary gain), in the order of the result's fields.
 using SideFilters = std::vector<std::pair<std::string, tracking::RollingBallTracker>>;
 
+/// The accumulators the loop feeds as the run goes; result() turns them into a TableBallResult.
 class TableBallMetrics {
 public:
+  /// config is kept by reference (it must outlive the metrics).
   explicit TableBallMetrics(const TableBallConfig& config);
 
   /// A position command sent to the wrist (one per physics tick, kTick apart).

@@ -26,9 +26,12 @@ namespace viewline::scenarios {
 /// Head sway: small rotations about the camera axes and a small translation, sums of sines at
 /// incommensurate frequencies around f (deterministic; phases from the seed).
 struct HeadSway {
-  Eigen::Isometry3d c_M_w0;
-  double amplitude, f, translation;
-  std::array<double, 6> phase{};
+  Eigen::Isometry3d c_M_w0;  ///< the camera's rest pose (world to camera)
+  double amplitude,          ///< rad, rotation amplitude about x and y (half of it about z)
+         f,                  ///< Hz, base frequency
+         translation;        ///< m, translation amplitude per axis
+  std::array<double, 6> phase{};  ///< rad, phases of the 3 rotation and 3 translation sines
+  /// The swayed camera pose c_M_w at time t (s): the sway applied to c_M_w0.
   Eigen::Isometry3d at(double t) const;
 };
 
@@ -36,6 +39,8 @@ struct HeadSway {
 /// in vpDetectorAprilTag's tag frame: sim::TableWorld::table_M_vispTag).
 std::vector<vision::TagOnTable> tableTagLayout(const sim::TableWorld& world);
 
+/// The simulated table-ball world: the tilting table and ball (physics at kTick), the wrist that
+/// tilts it, the swaying head camera and the rendered scene. Neither copied nor moved.
 class TableBallWorld {
 public:
   /// Physics and command interpolation step, s.
@@ -52,16 +57,21 @@ public:
   /// table follows the wrist's actual tilt at the tick's end. Tick k starts at k · kTick
   /// (computed from k, not accumulated, so long runs do not drift).
   void step();
+  /// Simulated time, s (ticks() · kTick).
   double time() const { return static_cast<double>(ticks_) * kTick; }
+  /// Physics ticks done.
   long ticks() const { return ticks_; }
+  /// The true table and ball state now (tilt, ball position and velocity in the table frame).
   const sim::TiltTableState& state() const { return table_.state(); }
   /// The recorded state at an earlier time (a frame's capture instant).
   sim::TiltTableState stateAt(double t) const { return table_.stateAt(t); }
   /// The table pose the arm's kinematics predict for given tilt angles.
   Eigen::Isometry3d tablePose(const Eigen::Vector2d& tilt) const { return table_.tablePose(tilt); }
+  /// The wrist that tilts the table (the controller commands it; limits and delay apply).
   robots::TableTilt& wrist() { return wrist_; }
 
   // --- head camera ---------------------------------------------------------------------------
+  /// The true camera the renderer uses (rest pose; the sway is applied per frame).
   const core::Camera& renderCamera() const { return camera_; }
   /// The camera the observer believes in (calibrated with a rig, else the render camera).
   const core::Camera& observerCamera() const { return obs_camera_; }
@@ -75,7 +85,9 @@ public:
   /// fixes (L, r, border height, tag layout).
   TableBallObserverConfig observerConfig() const;
 
+  /// The head camera's rig (renders the frames: noise, blur, drops).
   sim::CameraRig& cameraRig() { return rig_; }
+  /// The rendered scene: room, table, borders, tags and ball.
   const sim::TableWorld& scene() const { return scene_; }
 
 private:

@@ -12,14 +12,18 @@
 
 namespace viewline::tracking {
 
+/// Motion model of the planar target filter (plane coordinates).
 enum class TargetModel { ConstantVelocity, ConstantAcceleration, Singer, CoordinatedTurn, Imm, WaypointParticles };
 /// "constant_velocity" | "cv", "constant_acceleration" | "ca", "singer", "coordinated_turn" | "ct", "imm",
 /// "waypoint_particles"
 TargetModel targetModelFromString(const std::string& name);
+/// The config spelling of a model ("constant_velocity", "constant_acceleration", "singer", ...).
 const char* toString(TargetModel model);
 
+/// Configuration of the planar target filter: model, noise densities, jump detection, constant-speed legs,
+/// region, particles and gate.
 struct TargetFilterConfig {
-  TargetModel model = TargetModel::ConstantVelocity;
+  TargetModel model = TargetModel::ConstantVelocity;  ///< motion model
   double q = 0.05;                 ///< CV: acceleration density (m²/s³); CA: jerk density (m²/s⁵)
   double singer_tau = 2.0;         ///< Singer manoeuvre time constant (s)
   double singer_sigma = 0.2;       ///< Singer acceleration std (m/s²)
@@ -50,14 +54,16 @@ struct TargetFilterConfig {
   /// this box (plane coordinates, m) and never leaves it. See waypoint_region.h.
   Eigen::Vector2d region_center = Eigen::Vector2d::Zero();
   Eigen::Vector2d region_size = Eigen::Vector2d::Zero();  ///< (width, height), m
+  /// True when a waypoint region is set (both sizes > 0).
   bool hasRegion() const { return region_size.x() > 0.0 && region_size.y() > 0.0; }
   /// waypoint_particles (not a Kalman filter; see waypoint_particles.h): particle count, the uniform
   /// prior of the target's one speed (m/s; equal ends: the speed is known), the generator's shortest leg
   /// (m) and the particles' random stream.
   std::size_t particles = 20000;
+  /// Waypoint_particles: uniform prior range (min, max) of the target's speed, m/s
   Eigen::Vector2d particle_speed{0.02, 0.5};
-  double particle_min_leg = 0.0;
-  std::uint64_t particle_seed = 1;
+  double particle_min_leg = 0.0;  ///< waypoint_particles: shortest leg of the waypoint generator, m
+  std::uint64_t particle_seed = 1;  ///< waypoint_particles: seed of the particles' random stream
   double gate_probability = 0.9999;      ///< chi-square (2 dof) gate on the NIS (TrackGate probability)
   int reinit_after = 3;                  ///< consecutive gated-out measurements that re-initialise (restart_after)
   void validate() const;  ///< throws core::InvalidInput naming the key
@@ -66,7 +72,9 @@ struct TargetFilterConfig {
 /// "auto" corner settings (TargetFilterConfig::jump_min_samples / jump_corner_sigma unset; see
 /// corner_detector.h, "Noise-scaled corner settings").
 inline constexpr double kAutoJumpSamplesScale = 2.44;
+/// Largest "auto" jump_min_samples (also used when speed, cadence or noise is unknown).
 inline constexpr int kAutoJumpSamplesMax = 30;
+/// "auto" jump_corner_sigma per unit of measurement noise std (σ_c = this × noise σ).
 inline constexpr double kAutoCornerSigmaPerNoise = 0.34;
 
 }  // namespace viewline::tracking

@@ -56,6 +56,7 @@ struct JumpScanSettings {
   double posterior_mass = 0.99;   ///< jump_posterior
 };
 
+/// Result of a jump scan: the declared jump (if any) and the soft mixture's log odds per tested time.
 struct JumpScan {
   int jump = -1;  ///< index into the history of the declared jump; -1: none
   /// Soft mixture: log(π_j BF_j) of "a jump at history[j]", for every tested j.
@@ -72,12 +73,14 @@ JumpScan scanForJump(const PlanarHistory& history, const JumpScanSettings& setti
 /// from the measurement noise and cadence (above).
 class CornerSettings {
 public:
+  /// The configured jump_min_samples / jump_corner_sigma; nullopt selects the noise-scaled "auto" value.
   CornerSettings(std::optional<int> min_samples, std::optional<double> corner_sigma)
       : min_samples_(min_samples), corner_sigma_(corner_sigma) {}
   /// A measurement at t with covariance R (keeps the latest R and the last 16 intervals).
   void note(core::Timestamp t, const Eigen::Matrix2d& R);
   /// `speed`: the target's speed (ŝ, or |v̂| once it exceeds its std), <= 0 when unknown.
   int minSamples(double speed) const;
+  /// σ_c added to a new leg's corner position std, m (configured or "auto").
   double cornerSigma() const;
   /// √(tr R / 2) of the latest measurement: the per-axis RMS noise (m).
   double noiseSigma() const;

@@ -50,36 +50,47 @@
 
 namespace viewline::tracking {
 
+/// Kalman (or IMM / particle) filter of a target moving on a known plane, plane coordinates in m, with a chi-
+/// square gate and jump handling.
 class PlanarTargetFilter {
 public:
+  /// Filter with this configuration (validated; throws core::InvalidInput).
   explicit PlanarTargetFilter(const TargetFilterConfig& config = {});
 
+  /// What one update did.
   struct Update {
-    bool accepted = false;
-    bool reinitialized = false;
+    bool accepted = false;  ///< the measurement was fused
+    bool reinitialized = false;  ///< the filter was (re)initialised at the measurement
     bool jump = false;  ///< a velocity jump was detected and the recent measurements processed again
     double nis = 0.0;   ///< of the innovation the gate tested (0 when the measurement started the track)
     std::optional<GateDecision> decision;  ///< the gate's decision (nullopt: no measurement)
   };
+  /// True once the first measurement initialised the filter.
   bool initialized() const { return initialized_; }
   /// (Re)initialises at the measurement: the gate's Start.
   void reset(core::Timestamp t, const Eigen::Vector2d& z, const Eigen::Matrix2d& R);
   /// Predicts to t (>= the state's time) and fuses z (gated). Initialises on the first call.
   Update update(core::Timestamp t, const Eigen::Vector2d& z, const Eigen::Matrix2d& R);
 
+  /// Position, velocity, acceleration (plane coordinates; m, m/s, m/s²) and position covariance at one time.
   struct Kinematics {
-    Eigen::Vector2d p = Eigen::Vector2d::Zero(), v = Eigen::Vector2d::Zero(), a = Eigen::Vector2d::Zero();
-    Eigen::Matrix2d P_pos = Eigen::Matrix2d::Zero();
+    Eigen::Vector2d p = Eigen::Vector2d::Zero(),  ///< position, m
+                    v = Eigen::Vector2d::Zero(),  ///< velocity, m/s
+                    a = Eigen::Vector2d::Zero();  ///< acceleration, m/s² (zero for models without it)
+    Eigen::Matrix2d P_pos = Eigen::Matrix2d::Zero();  ///< position covariance, m²
   };
   /// The state extrapolated to t (no change to the filter); t may be before the state's time
   /// only by rounding (it is then evaluated at the state's time). With an active waypoint region, an
   /// extrapolation that would leave the box stops on its boundary with v = a = 0 (the model's target
   /// never leaves it; it turns there, direction unknown): what coasting through an occlusion follows.
   Kinematics at(core::Timestamp t) const;
+  /// The filter state (mean and covariance in the model's layout, time of the last update).
   const estimation::StateEstimate& state() const { return state_; }
   /// The output estimate at the last measurement: the soft jump mixture when it applies, else state().
   const estimation::StateEstimate& estimate() const { return output_ ? *output_ : state_; }
+  /// The configuration in use.
   const TargetFilterConfig& config() const { return config_; }
+  /// Dimension of the model's state (e.g. 4 for CV on the plane).
   int stateDim() const;
   /// IMM mode probabilities (cv, ct, maneuver); empty for the other models.
   Eigen::VectorXd modeProbabilities() const;
@@ -98,9 +109,11 @@ public:
   void setSpeed(double speed, double variance);
   /// The corner settings in force now: the configured values, or the "auto" ones (corner_detector.h).
   int minSamples() const;
+  /// σ_c in force now, m.
   double cornerSigma() const;
   /// The learnt speed ŝ (m/s) and its variance; 0 / 1e300 before the first segment has ended.
   double speedEstimate() const { return speed_.estimate(); }
+  /// Variance of the learnt speed ŝ, m²/s² (1e300 before the first segment has ended).
   double speedVariance() const { return speed_.variance(); }
   /// The configured waypoint region was dropped because the measurements left it (waypoint_region.h).
   bool regionDropped() const { return region_.dropped(); }

@@ -13,13 +13,15 @@
 
 namespace viewline::tracking {
 
+/// One processed measurement of the planar target filter and the state after it (for jump re-processing).
 struct PlanarSnapshot {
-  core::Timestamp t = 0.0;
-  Eigen::Vector2d z = Eigen::Vector2d::Zero();
-  Eigen::Matrix2d R = Eigen::Matrix2d::Identity();
+  core::Timestamp t = 0.0;  ///< measurement time, s
+  Eigen::Vector2d z = Eigen::Vector2d::Zero();  ///< measured position on the plane, m
+  Eigen::Matrix2d R = Eigen::Matrix2d::Identity();  ///< its covariance, m²
   estimation::StateEstimate state;       ///< x(t|t) after this measurement
-  std::optional<estimation::Imm> imm;
+  std::optional<estimation::Imm> imm;  ///< the IMM's full state after this measurement (IMM models only)
 };
+/// The measurements of the last jump window, oldest first.
 using PlanarHistory = std::vector<PlanarSnapshot>;
 
 /// The position of state x run by its own model for τ (either sign): (p, v) constant velocity,

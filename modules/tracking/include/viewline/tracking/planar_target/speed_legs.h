@@ -46,18 +46,25 @@ namespace viewline::tracking {
 
 /// One leg's prior and the sufficient statistics of its measurements (the model above).
 struct ConstantSpeedLeg {
-  double t_c = 0.0;
+  double t_c = 0.0;  ///< corner time t_c, s
+  /// Prior mean β₀ = (ĉ_x, ĉ_y, ŝ) of the corner position (m) and speed (m/s)
   Eigen::Vector3d beta0 = Eigen::Vector3d::Zero();
-  Eigen::Matrix3d P0_inv = Eigen::Matrix3d::Identity();
+  Eigen::Matrix3d P0_inv = Eigen::Matrix3d::Identity();  ///< prior information P₀⁻¹ of β
   std::vector<double> prior_mu;  ///< μ_k (rad); empty: θ uniform
-  double prior_sigma = 0.1, prior_weight = 0.0;
+  double prior_sigma = 0.1,   ///< σ of each learnt-turn component, rad
+         prior_weight = 0.0;  ///< weight w of the learnt-turn mixture in θ's prior
   bool region = false;            ///< waypoint-region prior p(θ) = R(θ)² / (2A) from region_c
-  Eigen::Vector2d region_c = Eigen::Vector2d::Zero(), region_lo = Eigen::Vector2d::Zero(), region_hi = Eigen::Vector2d::Zero();
+  Eigen::Vector2d region_c = Eigen::Vector2d::Zero(),   ///< corner the region prior is taken from, m
+                  region_lo = Eigen::Vector2d::Zero(),  ///< lower corner of the waypoint box, m
+                  region_hi = Eigen::Vector2d::Zero();  ///< upper corner of the waypoint box, m
   double region_log_scale = 0.0;  ///< log(π / A)
   double log_norm = 0.0;          ///< normalises the product of the two priors (0 when at most one is on)
-  Eigen::Matrix2d A = Eigen::Matrix2d::Zero(), Bt = Eigen::Matrix2d::Zero(), Ctt = Eigen::Matrix2d::Zero();
-  Eigen::Vector2d Bz = Eigen::Vector2d::Zero(), Ctz = Eigen::Vector2d::Zero();
-  double zz = 0.0;
+  Eigen::Matrix2d A = Eigen::Matrix2d::Zero(),    ///< Σ R_i⁻¹
+                  Bt = Eigen::Matrix2d::Zero(),   ///< B_τ = Σ τ_i R_i⁻¹
+                  Ctt = Eigen::Matrix2d::Zero();  ///< C_ττ = Σ τ_i² R_i⁻¹
+  Eigen::Vector2d Bz = Eigen::Vector2d::Zero(),   ///< B_z = Σ R_i⁻¹ z_i
+                  Ctz = Eigen::Vector2d::Zero();  ///< C_τz = Σ τ_i R_i⁻¹ z_i
+  double zz = 0.0;  ///< Σ z_iᵀ R_i⁻¹ z_i
 
   /// Adds the measurement z (covariance R) at t to the statistics.
   void add(double t, const Eigen::Vector2d& z, const Eigen::Matrix2d& R);
@@ -83,10 +90,13 @@ public:
   /// s_k of the segment history[0..end] (skipped when shorter than 0.5 s or 2 min_samples measurements,
   /// or when its speed is not resolved).
   void learn(const PlanarHistory& history, std::size_t end, int min_samples);
+  /// Sets ŝ (m/s) and its variance (m²/s²) from outside.
   void set(double speed, double variance);
+  /// True once ŝ is known (learnt or set).
   bool known() const { return info_ > 0.0; }
   /// ŝ (m/s) and its variance; 0 / 1e300 before the first segment has ended.
   double estimate() const { return info_ > 0.0 ? sum_ / info_ : 0.0; }
+  /// Variance of ŝ, m²/s² (1e300 before the first segment has ended).
   double variance() const { return info_ > 0.0 ? 1.0 / info_ : 1e300; }
 
 private:
@@ -96,6 +106,7 @@ private:
 /// The turn angles of the last corners (turn_prior_weight > 0; the last 8 kept).
 class LearntTurns {
 public:
+  /// Learns turns only when `enabled` (turn_prior_weight > 0).
   explicit LearntTurns(bool enabled) : enabled_(enabled) {}
   /// A leg of this direction (rad; NaN: unknown) ended at a detected jump.
   void legEnded(double direction);

@@ -33,8 +33,9 @@
 
 namespace viewline::tracking {
 
+/// Configuration of the waypoint particle filter: particles, waypoint box, speed prior, jitters, outliers and seed.
 struct WaypointParticleConfig {
-  std::size_t particles = 20000;
+  std::size_t particles = 20000;  ///< number of particles
   Eigen::Vector2d region_center = Eigen::Vector2d::Zero();  ///< box B of the waypoints (m)
   Eigen::Vector2d region_size = Eigen::Vector2d::Zero();    ///< its width and height (m), > 0
   double min_leg = 0.0;             ///< m, shorter legs are drawn again (the simulator's min segment)
@@ -43,19 +44,25 @@ struct WaypointParticleConfig {
   double jitter_position = 0.0005;  ///< m, std of the position jitter after a resampling
   double jitter_waypoint = 0.005;   ///< m, std of the waypoint jitter after a resampling (kept in B)
   double jitter_speed = 0.0005;     ///< m/s, std of the speed jitter after a resampling
+  /// Probability that a measurement is an outlier (uniform over the grown box), in [0, 1)
   double outlier_probability = 0.01;
   /// Measurements in a row that no particle explains better than an outlier (the cloud lost the target,
   /// e.g. it turned during an occlusion) before the filter starts again from the measurement.
   int reinit_after = 3;
-  std::uint64_t seed = 1;
+  std::uint64_t seed = 1;  ///< seed of the filter's random stream
   void validate() const;  ///< throws core::InvalidInput
 };
 
+/// Particle filter of a target that runs at one speed between waypoints drawn uniformly in a box (plane
+/// coordinates, m).
 class WaypointParticleFilter {
  public:
+  /// Filter with this configuration (validated; throws core::InvalidInput).
   explicit WaypointParticleFilter(const WaypointParticleConfig& config);
 
+  /// True once the first measurement drew the prior.
   bool initialized() const { return initialized_; }
+  /// Time of the particles (last measurement or propagation), s.
   double t() const { return t_; }
   /// The first call draws the prior (p ~ N(z, R), W ~ U(B), s ~ U(speed_min, speed_max)); later calls
   /// propagate to t (t ≥ the last stamp) and weight (or draw the prior again: reinit_after). R: the
@@ -66,18 +73,24 @@ class WaypointParticleFilter {
   /// Posterior mean of the position at t ≥ t(): each particle run ahead once (fresh waypoints drawn
   /// from a stream of its own, so the estimate does not change the filter).
   Eigen::Vector2d predict(double t) const;
+  /// Posterior mean position at t(), m.
   Eigen::Vector2d mean() const { return predict(t_); }
   /// Posterior moments at t ≥ t() (particles run ahead as in predict()): the mean position and velocity
   /// (a particle's velocity is s_i towards its waypoint) and their 4 x 4 covariance, order (p, v).
   struct Moments {
-    Eigen::Vector2d p = Eigen::Vector2d::Zero(), v = Eigen::Vector2d::Zero();
-    Eigen::Matrix4d P = Eigen::Matrix4d::Zero();
+    Eigen::Vector2d p = Eigen::Vector2d::Zero(),  ///< mean position, m
+                    v = Eigen::Vector2d::Zero();  ///< mean velocity, m/s
+    Eigen::Matrix4d P = Eigen::Matrix4d::Zero();  ///< covariance of (p, v), order (p_x, p_y, v_x, v_y)
   };
+  /// Posterior moments of (p, v) at t ≥ t().
   Moments moments(double t) const;
   /// Posterior mean of the speed (m/s).
   double speedMean() const;
+  /// Effective sample size of the current weights.
   double effectiveSampleSize() const { return ess_; }
+  /// Number of resamplings so far.
   std::size_t resamplings() const { return resamplings_; }
+  /// Number of restarts from a measurement (reinit_after outliers in a row).
   std::size_t reinitialisations() const { return reinitialisations_; }
   /// The restart gate's decisions (Start: the first measurement; Reject: none of the particles explains it).
   const GateCounts& gateCounts() const { return gate_.counts(); }

@@ -41,13 +41,19 @@ public:
   /// size (width, height) 0: no region.
   WaypointRegion(const Eigen::Vector2d& center, const Eigen::Vector2d& size) : center_(center), size_(size) {}
 
+  /// True when a region was configured (size > 0).
   bool configured() const { return size_.x() > 0.0 && size_.y() > 0.0; }
   /// Configured and not dropped: the legs use it.
   bool active() const { return configured() && !dropped_; }
+  /// True once the measurements left the region (5 in a row): it is no longer used.
   bool dropped() const { return dropped_; }
+  /// Centre of the box B (plane coordinates), m.
   const Eigen::Vector2d& center() const { return center_; }
+  /// Width and height of B, m.
   const Eigen::Vector2d& size() const { return size_; }
+  /// Lower corner of B, m.
   Eigen::Vector2d lo() const { return center_ - 0.5 * size_; }
+  /// Upper corner of B, m.
   Eigen::Vector2d hi() const { return center_ + 0.5 * size_; }
   /// c clamped into B less an inset of 1e-3 of its size (an estimate can fall just outside B).
   Eigen::Vector2d clampInside(const Eigen::Vector2d& c) const;
