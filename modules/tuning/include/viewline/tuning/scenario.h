@@ -96,7 +96,7 @@ struct RunResult {
 
 /// Live samples for --display (called from the running thread).
 struct LiveSample {
-  double t = 0.0;
+  double t = 0.0;      ///< s, time of the sample (or its number in the run)
   double error = 0.0;  ///< NaN when none at this sample
   double nis = -1.0;   ///< < 0 when none
 };
@@ -116,7 +116,7 @@ struct NoiseParameter {
   std::string symbol;       ///< "q", "sigma_px"...
   std::string unit;         ///< its unit, e.g. "m^2/s^3"
   std::string config_key;   ///< dotted scenario key written to the tuned config ("" = not a config key)
-  std::string description;
+  std::string description;  ///< one line: what it is
   double value = 0.0;       ///< the value the instance uses
 };
 
@@ -153,6 +153,7 @@ public:
   /// replayed"). An instance that does not support it need not override the methods below: their
   /// defaults throw core::InvalidInput with that reason.
   virtual std::string autotuneUnsupported() const { return {}; }
+  /// The noise parameters the auto-tuner may change, with the values this instance uses.
   virtual std::vector<NoiseParameter> noiseParameters() const;
   /// Runs the scenario (`runs` seeded runs from `seed`) and records the replay data.
   virtual std::unique_ptr<ReplayData> record(std::uint64_t seed, int runs) const;
