@@ -51,8 +51,10 @@ struct CatchOptions {
 /// The adapter options: type, range, default and help of each, bound to its field.
 detail::OptionTable<CatchOptions> catchOptions() {
   detail::OptionTable<CatchOptions> options;
-  options.integer("throws", &CatchOptions::throws, "10", 1, 1e5, "throws per run (throw i from deriveSeed(seed, i), as ball_catching --throws)")
-      .integer("burn_in", &CatchOptions::burn_in, "4", 1, 1e6, "fused images of a track before its innovations count in NIS")
+  options.integer("throws", &CatchOptions::throws, "10", 1, 1e5,
+                  "throws per run (throw i from deriveSeed(seed, i), as ball_catching --throws)")
+      .integer("burn_in", &CatchOptions::burn_in, "4", 1, 1e6,
+               "fused images of a track before its innovations count in NIS")
       .integer("nees_fused", &CatchOptions::nees_fused, "8", 1, 1e6,
                "the NEES sample of a throw is taken after this many fused images");
   return options;

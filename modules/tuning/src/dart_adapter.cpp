@@ -72,7 +72,8 @@ detail::OptionTable<DartOptions> dartOptions() {
                     "gross outliers at the config's outlier_rate, or none")
       .number("assumed_pixel_noise_px", &DartOptions::assumed_sigma, "0", -detail::kUnbounded,
               detail::kUnbounded, "> 0: pixel noise the tracker assumes (simulation keeps pixel_noise_px)")
-      .integer("burn_in", &DartOptions::burn_in, "4", 1, 1e6, "fused images of a track before its innovations count in NIS / likelihood")
+      .integer("burn_in", &DartOptions::burn_in, "4", 1, 1e6,
+               "fused images of a track before its innovations count in NIS / likelihood")
       .choice<std::string>("log_experiment", &DartOptions::log_experiment, "A_alternating",
                            {{"A_alternating", "A_alternating"}, {"D_scenario", "D_scenario"}},
                            "which experiment of a dart_tracking --log folder the auto-tuner replays");

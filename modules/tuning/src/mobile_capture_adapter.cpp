@@ -48,9 +48,12 @@ struct MobileOptions {
 /// The adapter options: type, range, default and help of each, bound to its field.
 detail::OptionTable<MobileOptions> mobileOptions() {
   detail::OptionTable<MobileOptions> options;
-  options.number("max_time", &MobileOptions::max_time, "0", 0.0, detail::kUnbounded, "s, time limit of a chase (0: the config's world.max_time)")
-      .number("nees_spacing_s", &MobileOptions::nees_spacing, "1", 1e-9, detail::kUnbounded, "s between the 1-dof NEES samples (nearly independent)")
-      .number("settle_s", &MobileOptions::settle, "2", 0.0, detail::kUnbounded, "s a track must have been valid before its NEES samples count");
+  options.number("max_time", &MobileOptions::max_time, "0", 0.0, detail::kUnbounded,
+                 "s, time limit of a chase (0: the config's world.max_time)")
+      .number("nees_spacing_s", &MobileOptions::nees_spacing, "1", 1e-9, detail::kUnbounded,
+              "s between the 1-dof NEES samples (nearly independent)")
+      .number("settle_s", &MobileOptions::settle, "2", 0.0, detail::kUnbounded,
+              "s a track must have been valid before its NEES samples count");
   return options;
 }
 
