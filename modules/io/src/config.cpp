@@ -119,6 +119,20 @@ ConfigNode ConfigNode::fromString(const std::string& text, const std::string& na
   return ConfigNode(shared, root, "");
 }
 
+// A parsed tree read as it is: the checks fromString makes after parsing, on the same nodes (their
+// marks are those of the file they were parsed from).
+ConfigNode ConfigNode::fromTree(const YAML::Node& root, const std::string& name, const std::string& base_dir) {
+  YAML::Node tree = root;
+  if (!tree.IsDefined() || tree.IsNull()) tree = YAML::Node(YAML::NodeType::Map);
+  if (!tree.IsMap())
+    throw InvalidInput(name + ": expected a YAML map of keys at the top level, got " + describe(tree));
+  checkKeys(tree, name);
+  auto shared = std::make_shared<Shared>();
+  shared->file = name;
+  shared->dir = base_dir;
+  return ConfigNode(shared, tree, "");
+}
+
 const std::string& ConfigNode::fileName() const { return shared_->file; }
 
 std::string ConfigNode::keyPath(const std::string& key) const {

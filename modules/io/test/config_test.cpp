@@ -169,3 +169,42 @@ TEST(Config, AValueOrAuto) {
   EXPECT_NE(e.find("expected an integer >= 2 or auto, got 'atuo'"), std::string::npos) << e;
   c.finish();  // every key was read, "auto" ones included
 }
+
+// A tree parsed once and edited in code is read as it is: values from the file keep their lines in
+// messages, values set in code name the file alone, paths resolve against the given folder.
+TEST(Config, FromTreeKeepsTheFileLines) {
+  const YAML::Node parsed = YAML::Load("rate_hz: 50\ntracker:\n  sigma_px: abc\n  gate: 9\nrig: rigs/a\n");
+  YAML::Node edited(YAML::NodeType::Map);  // shares the parsed nodes, one value replaced
+  for (auto it = parsed.begin(); it != parsed.end(); ++it)
+    edited.force_insert(it->first, it->first.Scalar() == "rate_hz" ? YAML::Node("-3") : it->second);
+  const ConfigNode cfg = ConfigNode::fromTree(edited, "s.yaml", "/cfg");
+  EXPECT_EQ(cfg.fileName(), "s.yaml");
+  EXPECT_EQ(cfg.get<int>("rate_hz"), -3);
+  EXPECT_EQ(cfg.getPath("rig"), "/cfg/rigs/a");
+  const ConfigNode tracker = cfg.child("tracker");
+  const std::string bad = errorOf([&] { tracker.get<double>("sigma_px"); });
+  EXPECT_EQ(bad.rfind("s.yaml:3:3: key 'tracker.sigma_px'", 0), 0u) << bad;
+  const std::string range = errorOf([&] { cfg.fail("rate_hz", "a positive rate"); });
+  EXPECT_EQ(range.rfind("s.yaml:1:1: key 'rate_hz'", 0), 0u) << range;  // the key is the file's
+  const std::string unknown = errorOf([&] { cfg.finish(); });
+  EXPECT_NE(unknown.find("s.yaml:4:3: unknown key 'tracker.gate'"), std::string::npos) << unknown;
+  EXPECT_EQ(parsed["rate_hz"].as<int>(), 50);  // the parsed tree is not changed
+
+  // New nodes have no mark: the message names the file without a made-up line.
+  YAML::Node built(YAML::NodeType::Map);
+  built["n"] = "x";
+  const std::string no_line = errorOf([&] { ConfigNode::fromTree(built, "b.yaml").get<int>("n"); });
+  EXPECT_EQ(no_line.rfind("b.yaml: key 'n'", 0), 0u) << no_line;
+}
+
+TEST(Config, FromTreeRefusesWhatTheParserWould) {
+  EXPECT_FALSE(ConfigNode::fromTree(YAML::Node(), "e.yaml").has("a"));  // null: an empty map
+  const std::string list = errorOf([] { ConfigNode::fromTree(YAML::Load("[1, 2]"), "l.yaml"); });
+  EXPECT_NE(list.find("l.yaml: expected a YAML map"), std::string::npos) << list;
+  YAML::Node dup(YAML::NodeType::Map);
+  dup.force_insert("a", 1);
+  dup.force_insert("a", 2);
+  const std::string twice = errorOf([&] { ConfigNode::fromTree(dup, "d.yaml"); });
+  EXPECT_NE(twice.find("duplicate key 'a'"), std::string::npos) << twice;
+  EXPECT_EQ(twice.rfind("d.yaml", 0), 0u) << twice;
+}

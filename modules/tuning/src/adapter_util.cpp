@@ -11,7 +11,6 @@
 
 #include "viewline/core/error.h"
 #include "viewline/tracking/viewline.h"
-#include "viewline/io/config_edit.h"
 
 namespace viewline::tuning::detail {
 
@@ -140,7 +139,29 @@ ViewlineInnovation viewlineInnovation(const tracking::ImageUpdate& update, const
   return r;
 }
 
-ReplayResult replayResult(double cost, std::size_t terms, const Consistency& nis, std::shared_ptr<RunSeries> series) {
+std::string liveSource(int runs, std::uint64_t seed) {
+  return "live: " + std::to_string(runs) + " run(s) from seed " + std::to_string(seed);
+}
+
+bool logging(const RunOptions& ro) { return ro.log != nullptr && ro.log->enabled(); }
+
+io::CsvWriter* logStream(const RunOptions& ro, const std::string& name, const std::vector<std::string>& header) {
+  return logging(ro) ? &ro.log->stream(name, header) : nullptr;
+}
+
+void addNis(Consistency& nis, double value, double dof, double x, RunSeries* series) {
+  nis.add(value, dof);
+  if (series == nullptr) return;
+  series->nis_t.push_back(x);
+  series->nis.push_back(value);
+}
+
+void InnovationTally::addCost(double nis_value, double log_det_S, int dim, double eps, double log_u) {
+  cost += innovationCost(nis_value, log_det_S, dim, eps, log_u);
+  ++terms;
+}
+
+ReplayResult InnovationTally::replayResult(std::shared_ptr<RunSeries> series) const {
   ReplayResult r;
   r.cost = cost;
   r.terms = terms;
@@ -149,12 +170,29 @@ ReplayResult replayResult(double cost, std::size_t terms, const Consistency& nis
   return r;
 }
 
+std::shared_ptr<RunSeries> newSeries(bool wanted, const SeriesLabels& labels) {
+  if (!wanted) return nullptr;
+  auto s = std::make_shared<RunSeries>();
+  s->time_label = labels.time;
+  s->error_label = labels.error;
+  s->nis_x_label = labels.nis_x;
+  s->nis_dof = labels.nis_dof;
+  s->traj_x_label = labels.traj_x;
+  s->traj_y_label = labels.traj_y;
+  return s;
+}
+
+void TrackCurves::moveInto(RunSeries& series) {
+  for (auto [curve, into] : {std::pair{&error, &series.error}, std::pair{&truth, &series.truth},
+                             std::pair{&estimate, &series.estimate}, std::pair{&prediction, &series.prediction}})
+    if (!curve->x.empty()) into->push_back(std::move(*curve));
+}
+
 namespace {
 
 class InfoAdapter final : public ScenarioAdapter {
 public:
-  InfoAdapter(AdapterInfo info, AdapterLoader load) : info_(std::move(info)), load_(std::move(load)) {}
-  InfoAdapter(AdapterInfo info, ConfigLoader load) : info_(std::move(info)), load_config_(std::move(load)) {}
+  InfoAdapter(AdapterInfo info, ConfigLoader load) : info_(std::move(info)), load_(std::move(load)) {}
   std::string name() const override { return info_.name; }
   std::string description() const override { return info_.description; }
   std::string appCommand(const std::string& config_path) const override {
@@ -166,26 +204,18 @@ public:
   std::vector<AdapterOption> options() const override { return info_.options; }
   std::unique_ptr<ScenarioInstance> load(const YAML::Node& scenario, const std::string& name,
                                          const AdapterOptions& options) const override {
-    // A tree edited by the caller (a sweep setting): its text is the only way to a fresh ConfigNode.
-    if (load_config_) return load_config_(scenarioConfig(io::emitYaml(scenario), name), options);
-    return load_(io::emitYaml(scenario), name, options);
+    return loadConfig(scenarioConfig(scenario, name), options);
   }
   std::unique_ptr<ScenarioInstance> loadConfig(const io::ConfigNode& config, const AdapterOptions& options) const override {
-    if (load_config_) return load_config_(config, options);
-    return ScenarioAdapter::loadConfig(config, options);
+    return load_(config, checkedOptions(info_.options, options, info_.name));
   }
 
 private:
   AdapterInfo info_;
-  AdapterLoader load_;
-  ConfigLoader load_config_;
+  ConfigLoader load_;
 };
 
 }  // namespace
-
-std::unique_ptr<ScenarioAdapter> makeAdapter(AdapterInfo info, AdapterLoader load) {
-  return std::make_unique<InfoAdapter>(std::move(info), std::move(load));
-}
 
 std::unique_ptr<ScenarioAdapter> makeConfigAdapter(AdapterInfo info, ConfigLoader load) {
   return std::make_unique<InfoAdapter>(std::move(info), std::move(load));
@@ -193,6 +223,10 @@ std::unique_ptr<ScenarioAdapter> makeConfigAdapter(AdapterInfo info, ConfigLoade
 
 io::ConfigNode scenarioConfig(const std::string& yaml, const std::string& name) {
   return io::ConfigNode::fromString(yaml, name, std::filesystem::path(name).parent_path().string());
+}
+
+io::ConfigNode scenarioConfig(const YAML::Node& tree, const std::string& name) {
+  return io::ConfigNode::fromTree(tree, name, std::filesystem::path(name).parent_path().string());
 }
 
 }  // namespace viewline::tuning::detail

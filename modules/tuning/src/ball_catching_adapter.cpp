@@ -41,16 +41,33 @@ namespace viewline::tuning {
 
 namespace {
 
+/// The adapter options (declared with their defaults and ranges in registerBallCatchingAdapter).
 struct CatchOptions {
-  int throws = 10;
-  int burn_in = 4;
-  int nees_fused = 8;
+  int throws;      ///< throws per run
+  int burn_in;     ///< fused images of a track before its innovations count in NIS
+  int nees_fused;  ///< the NEES sample of a throw is taken after this many fused images
 };
 
-class CatchInstance final : public ScenarioInstance {
+/// The adapter options: type, range, default and help of each, bound to its field.
+detail::OptionTable<CatchOptions> catchOptions() {
+  detail::OptionTable<CatchOptions> options;
+  options.integer("throws", &CatchOptions::throws, "10", 1, 1e5,
+                  "throws per run (throw i from deriveSeed(seed, i), as ball_catching --throws)")
+      .integer("burn_in", &CatchOptions::burn_in, "4", 1, 1e6,
+               "fused images of a track before its innovations count in NIS")
+      .integer("nees_fused", &CatchOptions::nees_fused, "8", 1, 1e6,
+               "the NEES sample of a throw is taken after this many fused images");
+  return options;
+}
+
+const detail::SeriesLabels kLabels{"time since release [s]", "tracker position error |p_hat - p| [m]",
+                                   "innovation number (in the run)", 2.0, "world x (towards the box) [m]", "world y [m]"};
+
+class CatchInstance final : public detail::ConfiguredInstance<scenarios::BallCatchingConfig, CatchOptions> {
 public:
-  CatchInstance(scenarios::BallCatchingConfig cfg, CatchOptions opt) : cfg_(std::move(cfg)), opt_(opt) {
-    cfg_.threads = 1;  // loadBallCatchingConfig validated the rest
+  /// `cfg` as its reader validated it, on one thread (the sweep runs settings in parallel instead).
+  CatchInstance(scenarios::BallCatchingConfig cfg, CatchOptions opt) : ConfiguredInstance(std::move(cfg), opt) {
+    cfg_.threads = 1;
   }
 
   std::string autotuneUnsupported() const override {
@@ -70,11 +87,9 @@ public:
 
     RunResult r;
     r.seed = seed;
-    std::shared_ptr<RunSeries> series;
-    if (ro.series) series = makeSeries();
-    io::CsvWriter* inn_csv = nullptr;
-    if (ro.log != nullptr && ro.log->enabled())
-      inn_csv = &ro.log->stream("innovations", {"throw", "id", "camera", "t", "nis", "decision", "fused", "in_statistics"});
+    const std::shared_ptr<RunSeries> series = detail::newSeries(ro.series, kLabels);
+    io::CsvWriter* inn_csv =
+        detail::logStream(ro, "innovations", {"throw", "id", "camera", "t", "nis", "decision", "fused", "in_statistics"});
     std::size_t mismatch = 0, sample = 0;
     for (const scenarios::ThrowResult& tr : sum.results)
       readThrow(tr, *sinks[static_cast<std::size_t>(tr.index)], r, series.get(), inn_csv, mismatch, sample, ro);
@@ -99,17 +114,6 @@ public:
   }
 
 private:
-  std::shared_ptr<RunSeries> makeSeries() const {
-    auto s = std::make_shared<RunSeries>();
-    s->time_label = "time since release [s]";
-    s->error_label = "tracker position error |p_hat - p| [m]";
-    s->nis_x_label = "innovation number (in the run)";
-    s->nis_dof = 2.0;
-    s->traj_x_label = "world x (towards the box) [m]";
-    s->traj_y_label = "world y [m]";
-    return s;
-  }
-
   void readThrow(const scenarios::ThrowResult& tr, const runtime::MemorySink& sink, RunResult& r, RunSeries* series,
                  io::CsvWriter* inn_csv, std::size_t& mismatch, std::size_t& sample, const RunOptions& ro) const {
     using tracking::GateDecision;
@@ -127,7 +131,8 @@ private:
       if (e.channel == "ball") estimates.push_back(&e);
     const bool keep_err = series != nullptr && tr.index < 30;
     const bool keep_traj = series != nullptr && tr.index < 5;
-    Curve err{"throw " + std::to_string(tr.index), {}, {}}, tru{"truth", {}, {}}, est{"estimate", {}, {}};
+    detail::TrackCurves c;
+    c.error.name = "throw " + std::to_string(tr.index);
     int fused_count = 0, in_track = 0, used = 0, rejected = 0;
     std::optional<estimation::StateEstimate> half_state;  // the prediction drawn: from mid-flight on
     std::vector<double> est_t;
@@ -138,14 +143,7 @@ private:
       in_track += fused;
       used += fused;
       rejected += !fused;
-      if (counted) {
-        r.nis.add(inn.nis, 2.0);
-        if (series != nullptr) {
-          series->nis_t.push_back(static_cast<double>(sample));
-          series->nis.push_back(inn.nis);
-        }
-        ++sample;
-      }
+      if (counted) detail::addNis(r.nis, inn.nis, 2.0, static_cast<double>(sample++), series);
       if (inn_csv != nullptr)
         inn_csv->row({static_cast<double>(tr.index), static_cast<double>(inn.id), static_cast<double>(inn.source), inn.t,
                       inn.nis, static_cast<double>(static_cast<int>(inn.decision)), fused ? 1.0 : 0.0,
@@ -159,71 +157,54 @@ private:
       const double d = (s.x().head<3>() - xt.head<3>()).norm();
       if (ro.live) ro.live({s.t(), d, counted ? inn.nis : -1.0});
       if (keep_err) {
-        err.x.push_back(s.t());
-        err.y.push_back(d);
+        c.error.x.push_back(s.t());
+        c.error.y.push_back(d);
       }
       if (keep_traj) {
-        tru.x.push_back(xt(0));
-        tru.y.push_back(xt(1));
-        est.x.push_back(s.x()(0));
-        est.y.push_back(s.x()(1));
+        c.truth.x.push_back(xt(0));
+        c.truth.y.push_back(xt(1));
+        c.estimate.x.push_back(s.x()(0));
+        c.estimate.y.push_back(s.x()(1));
         est_t.push_back(s.t());
         if (!half_state && 2 * fused_count >= tr.fused) half_state = s;
       }
     }
     mismatch += static_cast<std::size_t>(std::abs(used - tr.fused) + std::abs(rejected - tr.gated));
     if (series == nullptr) return;
-    if (truth && !err.x.empty()) series->error.push_back(err);
-    if (truth && !tru.x.empty()) series->truth.push_back(tru);
-    if (!est.x.empty()) series->estimate.push_back(est);
+    if (!truth) {  // no true flight: the error and truth curves are not drawn
+      c.error = {};
+      c.truth = {};
+    }
     if (half_state && half_state->dim() == 6) {
       // The tracker's own (drag-free ballistic) model rolled forward from its mid-flight state.
-      Curve pre{"prediction from mid-flight", {}, {}};
+      c.prediction.name = "prediction from mid-flight";
       const tracking::Vector6 x0 = half_state->x();
       for (double t : est_t) {
         if (t < half_state->t()) continue;
         const tracking::Vector6 xp = cfg_.tracker.model.propagate(x0, t - half_state->t());
-        pre.x.push_back(xp(0));
-        pre.y.push_back(xp(1));
+        c.prediction.x.push_back(xp(0));
+        c.prediction.y.push_back(xp(1));
       }
-      if (!pre.x.empty()) series->prediction.push_back(pre);
     }
+    c.moveInto(*series);
   }
-
-  scenarios::BallCatchingConfig cfg_;
-  CatchOptions opt_;
 };
 
 }  // namespace
 
 void registerBallCatchingAdapter(AdapterRegistry& registry) {
-  detail::AdapterInfo info;
-  info.name = "ball_catching";
-  info.description = "ball catching of [L] VI.C (rendered free-running cameras, viewline tracker, catch planner, robot; "
-                     "config/ball_catching.yaml)";
-  info.app = "ball_catching";
-  info.app_arguments = "--throws 100 --headless --summary ball_catching_summary.json";
-  info.default_metric = "catch_rate_reachable";
-  info.minimize = false;
-  info.metrics = {"catch_rate_all", "catch_rate_reachable", "reachable_fraction", "prediction_error_mm_median",
-                  "prediction_error_mm_p95", "prediction_error_lead_mm_median", "decision_time_s_median",
-                  "miss_distance_mm_median_reachable", "gave_up_reachable_fraction", "detection_rate", "limit_violations",
-                  "replay_fate_mismatch", "nis_mean", "nees_mean"};
-  info.options = {{"throws", "10", {}, "throws per run (throw i from deriveSeed(seed, i), as ball_catching --throws)"},
-                  {"burn_in", "4", {}, "fused images of a track before its innovations count in NIS"},
-                  {"nees_fused", "8", {}, "the NEES sample of a throw is taken after this many fused images"}};
-  registry.add(detail::makeAdapter(std::move(info), [](const std::string& yaml, const std::string& name,
-                                                       const AdapterOptions& options) {
-    scenarios::BallCatchingConfig cfg = scenarios::loadBallCatchingConfig(detail::scenarioConfig(yaml, name));
-    CatchOptions o;
-    const double throws = optionNumber(options, "throws");
-    if (!(throws >= 1.0 && throws <= 1e5)) throw core::InvalidInput("adapter option 'throws': expected 1 to 1e5");
-    o.throws = static_cast<int>(throws);
-    o.burn_in = static_cast<int>(optionNumber(options, "burn_in"));
-    o.nees_fused = static_cast<int>(optionNumber(options, "nees_fused"));
-    if (o.burn_in < 1 || o.nees_fused < 1) throw core::InvalidInput("adapter options burn_in, nees_fused: expected >= 1");
-    return std::unique_ptr<ScenarioInstance>(std::make_unique<CatchInstance>(std::move(cfg), o));
-  }));
+  registry.add(detail::makeAdapter(
+      {"ball_catching",
+       "ball catching of [L] VI.C (rendered free-running cameras, viewline tracker, catch planner, robot; "
+       "config/ball_catching.yaml)",
+       "ball_catching", "--throws 100 --headless --summary ball_catching_summary.json", "catch_rate_reachable", false,
+       {"catch_rate_all", "catch_rate_reachable", "reachable_fraction", "prediction_error_mm_median",
+        "prediction_error_mm_p95", "prediction_error_lead_mm_median", "decision_time_s_median",
+        "miss_distance_mm_median_reachable", "gave_up_reachable_fraction", "detection_rate", "limit_violations",
+        "replay_fate_mismatch", "nis_mean", "nees_mean"}},
+      catchOptions(), [](const io::ConfigNode& config, const CatchOptions& o) {
+        return std::make_unique<CatchInstance>(scenarios::loadBallCatchingConfig(config), o);
+      }));
 }
 
 }  // namespace viewline::tuning

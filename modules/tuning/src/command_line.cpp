@@ -95,7 +95,8 @@ void TuneCommandLine::list(const AdapterRegistry& registry) {
     for (const auto& m : a.metricNames()) std::printf(" %s", m.c_str());
     std::printf("\n  options (sweep file 'adapter:' map or --option name=value):\n");
     for (const auto& o : a.options())
-      std::printf("    %-24s default %-14s %s\n", o.name.c_str(), o.default_value.c_str(), o.doc.c_str());
+      std::printf("    %-24s default %-14s %s (%s)\n", o.name.c_str(), o.default_value.c_str(), o.doc.c_str(),
+                  o.expected().c_str());
   }
 }
 

@@ -28,6 +28,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <map>
 #include <optional>
 
@@ -50,39 +51,53 @@ using scenarios::DartDetection;
 using scenarios::DartScenarioConfig;
 using tracking::ImageMeasurement;
 
+/// The adapter options (declared with their defaults and ranges in registerDartAdapter).
 struct DartOptions {
-  int flights = 50;
-  DartClockMode clock = DartClockMode::FreeRunning;
-  bool outliers = true;
-  double assumed_sigma = 0.0;  ///< <= 0: the config's pixel_noise_px
-  int burn_in = 4;
-  std::string log_experiment = "A_alternating";
+  int flights;            ///< throws per run
+  DartClockMode clock;
+  bool outliers;          ///< gross outliers at the config's outlier_rate
+  double assumed_sigma;   ///< px; <= 0: the config's pixel_noise_px
+  int burn_in;            ///< fused images of a track before its innovations count
+  std::string log_experiment;
 };
+
+/// The adapter options: type, range, default and help of each, bound to its field.
+detail::OptionTable<DartOptions> dartOptions() {
+  detail::OptionTable<DartOptions> options;
+  options.integer("flights", &DartOptions::flights, "50", 1, 1e6, "throws per run")
+      .choice<DartClockMode>("clock", &DartOptions::clock, "free_running",
+                             {{"free_running", DartClockMode::FreeRunning}, {"alternating", DartClockMode::Alternating}},
+                             "free-running unsynchronised cameras (the full scenario) or alternating 100 Hz steps ([L] VI.A)")
+      .choice<bool>("outliers", &DartOptions::outliers, "config", {{"config", true}, {"none", false}},
+                    "gross outliers at the config's outlier_rate, or none")
+      .number("assumed_pixel_noise_px", &DartOptions::assumed_sigma, "0", -detail::kUnbounded,
+              detail::kUnbounded, "> 0: pixel noise the tracker assumes (simulation keeps pixel_noise_px)")
+      .integer("burn_in", &DartOptions::burn_in, "4", 1, 1e6,
+               "fused images of a track before its innovations count in NIS / likelihood")
+      .choice<std::string>("log_experiment", &DartOptions::log_experiment, "A_alternating",
+                           {{"A_alternating", "A_alternating"}, {"D_scenario", "D_scenario"}},
+                           "which experiment of a dart_tracking --log folder the auto-tuner replays");
+  return options;
+}
+
+const detail::SeriesLabels kLabels{"time since the first detection [s]", "position error |p_hat - p| [m]",
+                                   "innovation number (in the run)", 2.0, "world x (towards the board) [m]", "world y [m]"};
 
 struct Flight {
   std::vector<DartDetection> dets;  ///< truth valid only when has_truth
   bool has_truth = true;
 };
 
-class DartReplayData : public ReplayData {
-public:
-  std::vector<Flight> flights;
-  std::string source;
-  std::size_t measurements() const override {
-    std::size_t n = 0;
-    for (const auto& f : flights) n += f.dets.size();
-    return n;
-  }
-  std::string describe() const override {
-    return std::to_string(flights.size()) + " dart flights, " + std::to_string(measurements()) + " detections (" + source + ")";
-  }
-};
+using DartReplayData = detail::Recording<Flight>;
 
-/// Everything one pass over flights accumulates.
-struct Accum {
-  double cost = 0.0;
-  std::size_t terms = 0;
-  Consistency nees, nis;
+std::size_t detections(const Flight& f) { return f.dets.size(); }
+
+std::unique_ptr<DartReplayData> newReplayData() {
+  return std::make_unique<DartReplayData>("dart flights", "detections", &detections);
+}
+
+/// Everything one pass over flights accumulates: the innovation tally and the scenario's metrics.
+struct Accum : detail::InnovationTally {
   double sq_err = 0.0;
   std::size_t err_n = 0;
   double final_err = 0.0, pred_err = 0.0;
@@ -92,10 +107,10 @@ struct Accum {
   std::size_t sample = 0;
 };
 
-class DartInstance final : public ScenarioInstance {
+class DartInstance final : public detail::ConfiguredInstance<DartScenarioConfig, DartOptions> {
 public:
   DartInstance(DartScenarioConfig cfg, DartOptions opt)
-      : cfg_(std::move(cfg)), opt_(std::move(opt)), cams_(scenarios::makeDartCameras(cfg_)) {}
+      : ConfiguredInstance(std::move(cfg), std::move(opt)), cams_(scenarios::makeDartCameras(cfg_)) {}
 
   double confidence() const override { return cfg_.confidence; }
   double sigma() const { return opt_.assumed_sigma > 0.0 ? opt_.assumed_sigma : cfg_.pixel_noise_px; }
@@ -103,12 +118,10 @@ public:
   RunResult run(std::uint64_t seed, const RunOptions& ro) const override {
     RunResult r;
     r.seed = seed;
-    std::shared_ptr<RunSeries> series;
-    if (ro.series) series = makeSeries();
-    io::CsvWriter* det_csv = nullptr;
+    const std::shared_ptr<RunSeries> series = detail::newSeries(ro.series, kLabels);
+    io::CsvWriter* det_csv = detail::logStream(ro, "detections", scenarios::dartLogColumns());  // as dart_tracking --log
     io::CsvWriter* inn_csv = nullptr;
-    if (ro.log != nullptr && ro.log->enabled()) {
-      det_csv = &ro.log->stream("detections", scenarios::dartLogColumns());  // as dart_tracking --log writes it
+    if (det_csv != nullptr) {
       inn_csv = &ro.log->stream("innovations", {"flight", "id", "camera", "t", "d0", "d1", "S00", "S01", "S11", "nis",
                                                 "fused", "in_statistics"});
     }
@@ -145,17 +158,17 @@ public:
   }
 
   std::unique_ptr<ReplayData> record(std::uint64_t seed, int runs) const override {
-    auto d = std::make_unique<DartReplayData>();
+    auto d = newReplayData();
     for (int run = 0; run < runs; ++run) {
       const std::uint64_t s = core::deriveSeed(seed, static_cast<std::uint64_t>(run));
       for (int f = 0; f < opt_.flights; ++f) {
         core::Rng rng = core::makeRng(core::deriveSeed(s, static_cast<std::uint64_t>(f)));
         Flight fl;
         fl.dets = simulate(rng);
-        d->flights.push_back(std::move(fl));
+        d->items.push_back(std::move(fl));
       }
     }
-    d->source = "live: " + std::to_string(runs) + " run(s) from seed " + std::to_string(seed);
+    d->source = detail::liveSource(runs, seed);
     return d;
   }
 
@@ -164,16 +177,16 @@ public:
     const detail::CsvTable csv = detail::CsvTable::read(path, "the detections.csv of dart_tracking --log");
     const std::size_t ce = csv.col("experiment"), cr = csv.col("run"), ci = csv.col("id"), cc = csv.col("camera"),
                       ct = csv.col("t"), cu = csv.col("u"), cv = csv.col("v");
-    auto d = std::make_unique<DartReplayData>();
+    auto d = newReplayData();
     std::map<std::string, std::size_t> index;
     for (std::size_t row = 0; row < csv.rows(); ++row) {
       if (!opt_.log_experiment.empty() && csv.text(row, ce) != opt_.log_experiment) continue;
       const std::string key = csv.text(row, ce) + "/" + csv.text(row, cr);
       auto it = index.find(key);
       if (it == index.end()) {
-        it = index.emplace(key, d->flights.size()).first;
-        d->flights.emplace_back();
-        d->flights.back().has_truth = false;
+        it = index.emplace(key, d->items.size()).first;
+        d->items.emplace_back();
+        d->items.back().has_truth = false;
       }
       DartDetection det;
       det.truth.setZero();
@@ -182,11 +195,11 @@ public:
       det.m.t = csv.number(row, ct);
       det.m.uv = Eigen::Vector2d(csv.number(row, cu), csv.number(row, cv));
       if (det.m.camera >= cams_.size()) throw core::InvalidInput(csv.where(row) + ": camera index beyond the config's cameras");
-      d->flights[it->second].dets.push_back(det);
+      d->items[it->second].dets.push_back(det);
     }
-    for (auto& fl : d->flights)
+    for (auto& fl : d->items)
       std::stable_sort(fl.dets.begin(), fl.dets.end(), [](const auto& x, const auto& y) { return x.m.t < y.m.t; });
-    if (d->flights.empty())
+    if (d->items.empty())
       throw core::InvalidInput(path + ": no rows of experiment '" + opt_.log_experiment + "' (adapter option log_experiment)");
     d->source = path + " (" + opt_.log_experiment + ")";
     return d;
@@ -194,16 +207,12 @@ public:
 
   ReplayResult replay(const ReplayData& data, const std::vector<double>& noise, double outlier_prior,
                       bool want_series) const override {
-    const DartReplayData& d = detail::replayInput<DartReplayData>(data, noise, 2, "dart");
-    Accum a;
-    std::shared_ptr<RunSeries> series;
-    if (want_series) series = makeSeries();
-    RunOptions ro;
-    tracking::ViewlineTracker tracker(cams_, trackerConfig(noise[0]));
-    for (std::size_t f = 0; f < d.flights.size(); ++f)
-      processFlight(tracker, d.flights[f], static_cast<int>(f), noise[1], outlier_prior, a, series.get(), nullptr,
-                    nullptr, ro);
-    return detail::replayResult(a.cost, a.terms, a.nis, series);
+    return detail::replayRecording<Flight, Accum>(
+        data, noise, 2, "dart", want_series, kLabels, [&](const DartReplayData& d, Accum& a, RunSeries* series) {
+          tracking::ViewlineTracker tracker(cams_, trackerConfig(noise[0]));
+          for (std::size_t f = 0; f < d.items.size(); ++f)
+            processFlight(tracker, d.items[f], static_cast<int>(f), noise[1], outlier_prior, a, series, nullptr, nullptr, {});
+        });
   }
 
   std::unique_ptr<ScenarioInstance> withNoise(const std::vector<double>& noise) const override {
@@ -216,17 +225,6 @@ public:
   }
 
 private:
-  std::shared_ptr<RunSeries> makeSeries() const {
-    auto s = std::make_shared<RunSeries>();
-    s->time_label = "time since the first detection [s]";
-    s->error_label = "position error |p_hat - p| [m]";
-    s->nis_x_label = "innovation number (in the run)";
-    s->nis_dof = 2.0;
-    s->traj_x_label = "world x (towards the board) [m]";
-    s->traj_y_label = "world y [m]";
-    return s;
-  }
-
   std::vector<DartDetection> simulate(core::Rng& rng) const {
     return scenarios::simulateDartFlight(cfg_, cams_, opt_.clock, opt_.outliers ? cfg_.outlier_rate : 0.0, rng, 1)
         .detections;
@@ -247,7 +245,8 @@ private:
     const bool keep = series != nullptr;
     const bool keep_traj = keep && f < 5;
     const bool keep_err = keep && f < 30;
-    Curve err{"flight " + std::to_string(f), {}, {}}, tru{"truth", {}, {}}, est{"estimate", {}, {}}, pre{"prediction", {}, {}};
+    detail::TrackCurves c;
+    c.error.name = "flight " + std::to_string(f);
     const double t0 = fl.dets.front().m.t;
     const std::size_t half = fl.dets.size() / 2;
     std::optional<estimation::StateEstimate> half_state;
@@ -269,16 +268,8 @@ private:
       const auto out = tracker.outcome(m.id);
       const bool fused = out && out->fate == tracking::Fate::Fused;
       if (have) {
-        a.cost += detail::innovationCost(nis, std::log(S.determinant()), 2, eps, inn.log_u);
-        ++a.terms;
-        if (fused && !out->seed) {
-          a.nis.add(nis, 2.0);
-          if (series != nullptr) {
-            series->nis_t.push_back(static_cast<double>(a.sample));
-            series->nis.push_back(nis);
-          }
-          ++a.sample;
-        }
+        a.addCost(nis, std::log(S.determinant()), 2, eps, inn.log_u);
+        if (fused && !out->seed) detail::addNis(a.nis, nis, 2.0, static_cast<double>(a.sample++), series);
       }
       if (inn_csv != nullptr) {
         inn_csv->row({static_cast<double>(f), static_cast<double>(m.id), static_cast<double>(m.camera), m.t,
@@ -297,18 +288,18 @@ private:
         }
         if (k == cfg_.nees_index) a.nees.add(estimation::nees(s, det.truth), 6.0);
         if (keep_err) {
-          err.x.push_back(m.t - t0);
-          err.y.push_back(e);
+          c.error.x.push_back(m.t - t0);
+          c.error.y.push_back(e);
         }
         if (keep_traj) {
-          tru.x.push_back(det.truth(0));
-          tru.y.push_back(det.truth(1));
+          c.truth.x.push_back(det.truth(0));
+          c.truth.y.push_back(det.truth(1));
         }
         if (ro.live) ro.live({static_cast<double>(a.sample), e, have && fused ? nis : -1.0});
       }
       if (keep_traj) {
-        est.x.push_back(s.x()(0));
-        est.y.push_back(s.x()(1));
+        c.estimate.x.push_back(s.x()(0));
+        c.estimate.y.push_back(s.x()(1));
       }
       if (k == half) half_state = s;
       if (det_csv != nullptr) {
@@ -350,64 +341,34 @@ private:
           if (keep_traj) {
             for (std::size_t k = half; k < fl.dets.size(); ++k) {
               const tracking::Vector6 xp = model.propagate(x0, std::max(0.0, fl.dets[k].m.t - th));
-              pre.x.push_back(xp(0));
-              pre.y.push_back(xp(1));
+              c.prediction.x.push_back(xp(0));
+              c.prediction.y.push_back(xp(1));
             }
           }
         }
       }
     }
     a.restarts += static_cast<std::size_t>(tracker.trackState().restarts);
-    if (series != nullptr) {
-      if (!err.x.empty()) series->error.push_back(err);
-      if (!tru.x.empty()) series->truth.push_back(tru);
-      if (!est.x.empty()) series->estimate.push_back(est);
-      if (!pre.x.empty()) series->prediction.push_back(pre);
-    }
+    if (series != nullptr) c.moveInto(*series);
   }
 
-  DartScenarioConfig cfg_;
-  DartOptions opt_;
   std::vector<core::Camera> cams_;
 };
 
 }  // namespace
 
 void registerDartAdapter(AdapterRegistry& registry) {
-  detail::AdapterInfo info;
-  info.name = "dart";
-  info.description = "dart flights of [L] VI seen by the viewline tracker (measurement level; config/dart_tracking.yaml)";
-  info.app = "dart_tracking";
-  info.app_arguments = "--runs 500 --summary dart_summary.json";
-  info.default_metric = "rmse_position_m";
-  info.metrics = {"rmse_position_m", "final_error_m", "prediction_error_m", "nees_mean", "nis_mean",
-                  "outlier_rejected_fraction", "inlier_rejected_fraction", "restarts_per_flight"};
-  info.options = {{"flights", "50", {}, "throws per run"},
-                  {"clock", "free_running", {"free_running", "alternating"},
-                   "free-running unsynchronised cameras (the full scenario) or alternating 100 Hz steps ([L] VI.A)"},
-                  {"outliers", "config", {"config", "none"}, "gross outliers at the config's outlier_rate, or none"},
-                  {"assumed_pixel_noise_px", "0", {}, "> 0: pixel noise the tracker assumes (simulation keeps pixel_noise_px)"},
-                  {"burn_in", "4", {}, "fused images of a track before its innovations count in NIS / likelihood"},
-                  {"log_experiment", "A_alternating", {"A_alternating", "D_scenario"},
-                   "which experiment of a dart_tracking --log folder the auto-tuner replays"}};
-  registry.add(detail::makeConfigAdapter(std::move(info), [](const io::ConfigNode& config,
-                                                             const AdapterOptions& options) {
-    const std::string& name = config.fileName();
-    DartScenarioConfig cfg = scenarios::dartScenarioFromNode(config);
-    DartOptions o;
-    const double flights = optionNumber(options, "flights");
-    if (!(flights >= 1.0 && flights <= 1e6)) throw core::InvalidInput("adapter option 'flights': expected 1 to 1e6");
-    o.flights = static_cast<int>(flights);
-    o.clock = optionText(options, "clock") == "alternating" ? DartClockMode::Alternating : DartClockMode::FreeRunning;
-    o.outliers = optionText(options, "outliers") == "config";
-    o.assumed_sigma = optionNumber(options, "assumed_pixel_noise_px");
-    o.burn_in = static_cast<int>(optionNumber(options, "burn_in"));
-    if (o.burn_in < 1) throw core::InvalidInput("adapter option 'burn_in': expected >= 1");
-    o.log_experiment = optionText(options, "log_experiment");
-    if (o.clock == DartClockMode::Alternating && cfg.cameras.size() < 2)
-      throw core::InvalidInput(name + ": adapter option clock: alternating needs two cameras");
-    return std::unique_ptr<ScenarioInstance>(std::make_unique<DartInstance>(std::move(cfg), std::move(o)));
-  }));
+  registry.add(detail::makeAdapter(
+      {"dart", "dart flights of [L] VI seen by the viewline tracker (measurement level; config/dart_tracking.yaml)",
+       "dart_tracking", "--runs 500 --summary dart_summary.json", "rmse_position_m", true,
+       {"rmse_position_m", "final_error_m", "prediction_error_m", "nees_mean", "nis_mean", "outlier_rejected_fraction",
+        "inlier_rejected_fraction", "restarts_per_flight"}},
+      dartOptions(), [](const io::ConfigNode& config, const DartOptions& o) {
+        DartScenarioConfig cfg = scenarios::dartScenarioFromNode(config);
+        if (o.clock == DartClockMode::Alternating && cfg.cameras.size() < 2)
+          throw core::InvalidInput(config.fileName() + ": adapter option clock: alternating needs two cameras");
+        return std::make_unique<DartInstance>(std::move(cfg), o);
+      }));
 }
 
 }  // namespace viewline::tuning

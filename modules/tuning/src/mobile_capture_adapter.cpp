@@ -17,6 +17,7 @@
 // control keys work, with NEES and NIS beside the metrics.
 
 #include <cmath>
+#include <limits>
 #include <map>
 #include <memory>
 
@@ -37,17 +38,33 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
+/// The adapter options (declared with their defaults and ranges in registerMobileCaptureAdapter).
 struct MobileOptions {
-  double max_time = 0.0;      ///< 0: the config's world.max_time
-  double nees_spacing = 1.0;  ///< s
-  double settle = 2.0;        ///< s of valid track before NEES samples
+  double max_time;      ///< s; 0: the config's world.max_time
+  double nees_spacing;  ///< s between NEES samples
+  double settle;        ///< s of valid track before NEES samples
 };
 
-class MobileInstance final : public ScenarioInstance {
+/// The adapter options: type, range, default and help of each, bound to its field.
+detail::OptionTable<MobileOptions> mobileOptions() {
+  detail::OptionTable<MobileOptions> options;
+  options.number("max_time", &MobileOptions::max_time, "0", 0.0, detail::kUnbounded,
+                 "s, time limit of a chase (0: the config's world.max_time)")
+      .number("nees_spacing_s", &MobileOptions::nees_spacing, "1", 1e-9, detail::kUnbounded,
+              "s between the 1-dof NEES samples (nearly independent)")
+      .number("settle_s", &MobileOptions::settle, "2", 0.0, detail::kUnbounded,
+              "s a track must have been valid before its NEES samples count");
+  return options;
+}
+
+const detail::SeriesLabels kLabels{"t [s]", "object position error |p_hat - p| [m]", "t [s]", 2.0, "floor x [m]",
+                                   "floor y [m] (black: object and robot paths)"};
+
+class MobileInstance final : public detail::ConfiguredInstance<scenarios::MobileCaptureConfig, MobileOptions> {
 public:
-  MobileInstance(scenarios::MobileCaptureConfig cfg, MobileOptions opt) : cfg_(std::move(cfg)), opt_(opt) {
+  /// `cfg` as its reader validated it; the options only set a positive time limit.
+  MobileInstance(scenarios::MobileCaptureConfig cfg, MobileOptions opt) : ConfiguredInstance(std::move(cfg), opt) {
     if (opt_.max_time > 0.0) cfg_.max_time = opt_.max_time;
-    cfg_.validate();
   }
 
   std::string autotuneUnsupported() const override {
@@ -67,8 +84,7 @@ public:
       }
     }
 #endif
-    std::shared_ptr<RunSeries> series;
-    if (ro.series) series = makeSeries();
+    const std::shared_ptr<RunSeries> series = detail::newSeries(ro.series, kLabels);
     Curve err{"position error", {}, {}}, obj{"object", {}, {}}, robot{"robot", {}, {}}, est{"estimate", {}, {}};
     double sq = 0.0;
     std::size_t n = 0;
@@ -145,15 +161,6 @@ public:
   }
 
 private:
-  std::shared_ptr<RunSeries> makeSeries() const {
-    auto s = std::make_shared<RunSeries>();
-    s->error_label = "object position error |p_hat - p| [m]";
-    s->nis_dof = 2.0;
-    s->traj_x_label = "floor x [m]";
-    s->traj_y_label = "floor y [m] (black: object and robot paths)";
-    return s;
-  }
-
   /// NEES: one 1-dof marginal sample every nees_spacing s, cycling over (x, y, θ, v, ω). NIS: the
   /// track's innovation records. Both once the track has been valid for settle s (a track is
   /// valid at the times it has an estimate record; a gap of more than a frame is a restart).
@@ -185,44 +192,23 @@ private:
     for (const auto& i : mem.innovationsOf(channel::kObject)) {
       const auto v = valid_since.find(i.t);
       if (!std::isfinite(i.nis) || v == valid_since.end() || i.t - v->second < opt_.settle) continue;
-      nis.add(i.nis, 2.0);
-      if (series) {
-        series->nis_t.push_back(i.t);
-        series->nis.push_back(i.nis);
-      }
+      detail::addNis(nis, i.nis, 2.0, i.t, series);
     }
   }
-
-  scenarios::MobileCaptureConfig cfg_;
-  MobileOptions opt_;
 };
 
 }  // namespace
 
 void registerMobileCaptureAdapter(AdapterRegistry& registry) {
-  detail::AdapterInfo info;
-  info.name = "mobile_capture";
-  info.description = "mobile capture of [K] (rendered head camera, curvilinear EKF, capture planner, grasp; "
-                     "config/mobile_capture.yaml)";
-  info.app = "mobile_capture";
-  info.app_arguments = "--headless --summary mobile_capture_summary.json";
-  info.default_metric = "capture_time_s";
-  info.metrics = {"captured", "capture_time_s", "oracle_captured", "capture_time_ratio_to_oracle", "grasp_attempts",
-                  "detection_rate", "longest_lost_s", "localization_rmse_mm", "estimate_rmse_mm", "nees_mean"};
-  info.options = {{"max_time", "0", {}, "s, time limit of a chase (0: the config's world.max_time)"},
-                  {"nees_spacing_s", "1", {}, "s between the 1-dof NEES samples (nearly independent)"},
-                  {"settle_s", "2", {}, "s a track must have been valid before its NEES samples count"}};
-  registry.add(detail::makeAdapter(std::move(info), [](const std::string& yaml, const std::string& name,
-                                                       const AdapterOptions& options) {
-    scenarios::MobileCaptureConfig cfg = scenarios::loadMobileCaptureConfig(detail::scenarioConfig(yaml, name));
-    MobileOptions o;
-    o.max_time = optionNumber(options, "max_time");
-    o.nees_spacing = optionNumber(options, "nees_spacing_s");
-    o.settle = optionNumber(options, "settle_s");
-    if (!(o.max_time >= 0.0) || !(o.nees_spacing > 0.0) || !(o.settle >= 0.0))
-      throw core::InvalidInput("mobile_capture adapter options: max_time >= 0, nees_spacing_s > 0, settle_s >= 0");
-    return std::unique_ptr<ScenarioInstance>(std::make_unique<MobileInstance>(std::move(cfg), o));
-  }));
+  registry.add(detail::makeAdapter(
+      {"mobile_capture",
+       "mobile capture of [K] (rendered head camera, curvilinear EKF, capture planner, grasp; config/mobile_capture.yaml)",
+       "mobile_capture", "--headless --summary mobile_capture_summary.json", "capture_time_s", true,
+       {"captured", "capture_time_s", "oracle_captured", "capture_time_ratio_to_oracle", "grasp_attempts", "detection_rate",
+        "longest_lost_s", "localization_rmse_mm", "estimate_rmse_mm", "nees_mean"}},
+      mobileOptions(), [](const io::ConfigNode& config, const MobileOptions& o) {
+        return std::make_unique<MobileInstance>(scenarios::loadMobileCaptureConfig(config), o);
+      }));
 }
 
 }  // namespace viewline::tuning

@@ -24,6 +24,7 @@
 #include <atomic>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <map>
 #include <optional>
 
@@ -55,20 +56,17 @@ struct Recorded {
   bool has_truth = true;
 };
 
-class PanTiltReplayData : public ReplayData {
-public:
-  std::vector<Recorded> runs;
-  std::string source;
-  std::size_t measurements() const override {
-    std::size_t n = 0;
-    for (const auto& r : runs)
-      for (const auto& f : r.frames) n += f.detected;
-    return n;
-  }
-  std::string describe() const override {
-    return std::to_string(runs.size()) + " pan-tilt run(s), " + std::to_string(measurements()) + " measurements (" + source + ")";
-  }
-};
+using PanTiltReplayData = detail::Recording<Recorded>;
+
+std::size_t detectedFrames(const Recorded& r) {
+  std::size_t n = 0;
+  for (const auto& f : r.frames) n += f.detected;
+  return n;
+}
+
+std::unique_ptr<PanTiltReplayData> newReplayData() {
+  return std::make_unique<PanTiltReplayData>("pan-tilt run(s)", "measurements", &detectedFrames);
+}
 
 std::vector<Frame> readFrames(const std::string& path) {
   const detail::CsvTable csv = detail::CsvTable::read(path, "predictive_frames.csv of pan_tilt_tracking --log");
@@ -87,18 +85,36 @@ std::vector<Frame> readFrames(const std::string& path) {
   return frames;
 }
 
+/// The adapter options (declared with their defaults and ranges in registerPanTiltAdapter).
 struct PanTiltOptions {
-  double duration = 0.0;      ///< 0: the config's
-  int burn_in = 5;
-  double nees_spacing = 2.0;  ///< s
-  std::uint64_t log_seed = 1;
+  double duration;       ///< s; 0: the config's
+  int burn_in;           ///< accepted measurements of a track before its innovations count
+  double nees_spacing;   ///< s between NEES samples
+  std::uint64_t log_seed;
 };
 
-struct Accum {
-  double cost = 0.0;
-  std::size_t terms = 0;
-  Consistency nis, nees;
-};
+/// The adapter options: type, range, default and help of each, bound to its field.
+detail::OptionTable<PanTiltOptions> panTiltOptions() {
+  detail::OptionTable<PanTiltOptions> options;
+  options.number("duration", &PanTiltOptions::duration, "0", 0.0, detail::kUnbounded, "s of each run (0: the config's run.duration)")
+      .integer("burn_in", &PanTiltOptions::burn_in, "5", 1, 1e6, "accepted measurements of a track before its innovations count")
+      .number("nees_spacing_s", &PanTiltOptions::nees_spacing, "2", 1e-9, detail::kUnbounded, "s between NEES samples (nearly independent)")
+      .integer("log_seed", &PanTiltOptions::log_seed, "1", 0, 1e15,
+               "seed of a pan_tilt_tracking --log run (its path amplitude gives R)");
+  return options;
+}
+
+using Accum = detail::InnovationTally;
+
+const detail::SeriesLabels kLabels{"t [s]", "image error |true target - image centre| [px]", "t [s]", 2.0,
+                                   "screen x (right) [m]", "screen y (down) [m]"};
+constexpr double kHorizon = 0.2;  // s, the prediction drawn in the trajectory plot
+
+detail::TrackCurves makeCurves() {
+  detail::TrackCurves c;
+  c.prediction.name = "prediction 0.2 s ahead";
+  return c;
+}
 
 /// The live error curve of a run (RunOptions::live), fed frame by frame.
 class LiveCurve : public scenarios::pan_tilt::FrameSink {
@@ -112,10 +128,10 @@ private:
   std::function<void(const LiveSample&)> live_;
 };
 
-class PanTiltInstance final : public ScenarioInstance {
+class PanTiltInstance final : public detail::ConfiguredInstance<scenarios::PanTiltScenarioConfig, PanTiltOptions> {
 public:
   PanTiltInstance(scenarios::PanTiltScenarioConfig cfg, PanTiltOptions opt, double r_scale)
-      : cfg_(std::move(cfg)), opt_(opt), r_scale_(r_scale) {
+      : ConfiguredInstance(std::move(cfg), opt), r_scale_(r_scale) {
     cfg_.run_baseline = false;
     if (opt_.duration > 0.0) cfg_.duration = opt_.duration;
   }
@@ -135,7 +151,7 @@ public:
     std::optional<scenarios::pan_tilt::FrameCsvSink> csv;
     scenarios::pan_tilt::FrameFanout frames;
     if (ro.live) frames.add(&live);
-    if (ro.log != nullptr && ro.log->enabled()) frames.add(&csv.emplace(*ro.log));
+    if (detail::logging(ro)) frames.add(&csv.emplace(*ro.log));
     scenarios::PanTiltRunIo io;
     io.telemetry = &sink;
     io.frames = frames.empty() ? nullptr : &frames;
@@ -172,12 +188,10 @@ public:
     const Recorded rec = recordOne(seed, ro, &m, sink);
     RunResult r;
     r.seed = seed;
-    std::shared_ptr<RunSeries> series;
-    if (ro.series) series = makeSeries();
+    const std::shared_ptr<RunSeries> series = detail::newSeries(ro.series, kLabels);
     Accum a;
-    io::CsvWriter* inn = nullptr;
-    if (ro.log != nullptr && ro.log->enabled())
-      inn = &ro.log->stream("innovations", {"t", "d0", "d1", "S00", "S01", "S11", "nis", "accepted", "in_statistics"});
+    io::CsvWriter* inn =
+        detail::logStream(ro, "innovations", {"t", "d0", "d1", "S00", "S01", "S11", "nis", "accepted", "in_statistics"});
     scoreRun(rec, sink, m.controller, a, series.get(), inn);
     r.nis = a.nis;
     r.nees = a.nees;
@@ -215,33 +229,31 @@ public:
   }
 
   std::unique_ptr<ReplayData> record(std::uint64_t seed, int runs) const override {
-    auto d = std::make_unique<PanTiltReplayData>();
+    auto d = newReplayData();
     for (int i = 0; i < runs; ++i) {
       runtime::MemorySink sink;
-      d->runs.push_back(recordOne(core::deriveSeed(seed, static_cast<std::uint64_t>(i)), {}, nullptr, sink));
+      d->items.push_back(recordOne(core::deriveSeed(seed, static_cast<std::uint64_t>(i)), {}, nullptr, sink));
     }
-    d->source = "live: " + std::to_string(runs) + " run(s) from seed " + std::to_string(seed);
+    d->source = detail::liveSource(runs, seed);
     return d;
   }
 
   std::unique_ptr<ReplayData> loadLog(const std::string& dir) const override {
-    auto d = std::make_unique<PanTiltReplayData>();
+    auto d = newReplayData();
     Recorded rec;
     rec.frames = readFrames((fs::path(dir) / "predictive_frames.csv").string());
     rec.R = trueR(opt_.log_seed);
-    d->runs.push_back(rec);
+    d->items.push_back(rec);
     d->source = dir + "/predictive_frames.csv (R from the config, seed option log_seed)";
     return d;
   }
 
   ReplayResult replay(const ReplayData& data, const std::vector<double>& noise, double outlier_prior,
                       bool want_series) const override {
-    const PanTiltReplayData& d = detail::replayInput<PanTiltReplayData>(data, noise, 2, "pan-tilt");
-    Accum a;
-    std::shared_ptr<RunSeries> series;
-    if (want_series) series = makeSeries();
-    for (const auto& rec : d.runs) replayRun(rec, noise[0], noise[1], outlier_prior, a, series.get(), nullptr, {});
-    return detail::replayResult(a.cost, a.terms, a.nis, series);
+    return detail::replayRecording<Recorded, Accum>(
+        data, noise, 2, "pan-tilt", want_series, kLabels, [&](const PanTiltReplayData& d, Accum& a, RunSeries* series) {
+          for (const auto& rec : d.items) replayRun(rec, noise[0], noise[1], outlier_prior, a, series, nullptr, {});
+        });
   }
 
   std::unique_ptr<ScenarioInstance> withNoise(const std::vector<double>& noise) const override {
@@ -251,31 +263,15 @@ public:
   }
 
 private:
-  std::shared_ptr<RunSeries> makeSeries() const {
-    auto s = std::make_shared<RunSeries>();
-    s->error_label = "image error |true target - image centre| [px]";
-    s->nis_dof = 2.0;
-    s->traj_x_label = "screen x (right) [m]";
-    s->traj_y_label = "screen y (down) [m]";
-    return s;
-  }
-
   /// NIS, NEES and the innovation cost of a live run, read from its telemetry: the controller's own
   /// gate decisions, innovations and estimates (nothing re-run).
   void scoreRun(const Recorded& rec, const runtime::MemorySink& sink, const std::string& name, Accum& a,
                 RunSeries* series, io::CsvWriter* inn) const {
     using tracking::GateDecision;
     const double u = 1.0 / (cfg_.screen_width * cfg_.screen_height);
-    const double horizon = 0.2;  // s, the prediction drawn in the trajectory plot
-    Curve err{"error", {}, {}}, tru{"truth", {}, {}}, est{"estimate", {}, {}}, pre{"prediction", {}, {}};
-    if (series != nullptr) {
-      for (const Frame& f : rec.frames) {
-        err.x.push_back(f.t);
-        err.y.push_back(f.error_px);
-        tru.x.push_back(f.truth.x());
-        tru.y.push_back(f.truth.y());
-      }
-    }
+    detail::TrackCurves c = makeCurves();
+    if (series != nullptr)
+      for (const Frame& f : rec.frames) addFrame(c, f);
     std::vector<const runtime::EstimateRecord*> estimates;
     for (const auto& e : sink.estimates)
       if (e.channel == name) estimates.push_back(&e);
@@ -303,15 +299,8 @@ private:
       const bool accepted = tracking::uses(d);
       if (accepted) ++accepted_in_track;
       if (have) {
-        a.cost += detail::innovationCost(nis, std::log(Eigen::Matrix2d(r.S).determinant()), 2, 0.0, std::log(u));
-        ++a.terms;
-        if (d == GateDecision::Accept) {
-          a.nis.add(nis, 2.0);
-          if (series != nullptr) {
-            series->nis_t.push_back(r.t);
-            series->nis.push_back(nis);
-          }
-        }
+        a.addCost(nis, std::log(Eigen::Matrix2d(r.S).determinant()), 2, 0.0, std::log(u));
+        if (d == GateDecision::Accept) detail::addNis(a.nis, nis, 2.0, r.t, series);
       }
       if (inn != nullptr) {
         const double nan = std::nan("");
@@ -327,20 +316,24 @@ private:
         a.nees.add(ex.dot(Eigen::Matrix2d(e.P).ldlt().solve(ex)), 2.0);
         next_nees = r.t + opt_.nees_spacing;
       }
-      if (series != nullptr) {
-        est.x.push_back(p.x());
-        est.y.push_back(p.y());
-        pre.x.push_back(p.x() + horizon * v.x());  // constant velocity from the published estimate
-        pre.y.push_back(p.y() + horizon * v.y());
-      }
+      if (series != nullptr)
+        addEstimate(c, p, p + kHorizon * v);  // constant velocity from the published estimate
     }
-    if (series != nullptr) {
-      series->error.push_back(err);
-      series->truth.push_back(tru);
-      series->estimate.push_back(est);
-      pre.name = "prediction 0.2 s ahead";
-      series->prediction.push_back(pre);
-    }
+    if (series != nullptr) c.moveInto(*series);
+  }
+
+  static void addFrame(detail::TrackCurves& c, const Frame& f) {
+    c.error.x.push_back(f.t);
+    c.error.y.push_back(f.error_px);
+    c.truth.x.push_back(f.truth.x());
+    c.truth.y.push_back(f.truth.y());
+  }
+
+  static void addEstimate(detail::TrackCurves& c, const Eigen::Vector2d& p, const Eigen::Vector2d& ahead) {
+    c.estimate.x.push_back(p.x());
+    c.estimate.y.push_back(p.y());
+    c.prediction.x.push_back(ahead.x());
+    c.prediction.y.push_back(ahead.y());
   }
 
   void replayRun(const Recorded& rec, double q, double r_scale, double eps, Accum& a, RunSeries* series,
@@ -350,17 +343,11 @@ private:
     tracking::PlanarTargetFilter filter(fc);
     const Eigen::Matrix2d R = r_scale * r_scale * rec.R;
     const double u = 1.0 / (cfg_.screen_width * cfg_.screen_height);
-    const double horizon = 0.2;  // s, the prediction drawn in the trajectory plot
-    Curve err{"error", {}, {}}, tru{"truth", {}, {}}, est{"estimate", {}, {}}, pre{"prediction", {}, {}};
+    detail::TrackCurves c = makeCurves();
     double last_accepted = -1e300, next_nees = cfg_.metrics_start;
     int accepted_in_track = 0;
     for (const Frame& f : rec.frames) {
-      if (series != nullptr) {
-        err.x.push_back(f.t);
-        err.y.push_back(f.error_px);
-        tru.x.push_back(f.truth.x());
-        tru.y.push_back(f.truth.y());
-      }
+      if (series != nullptr) addFrame(c, f);
       if (!f.detected) {
         if (ro.live) ro.live({f.t, f.error_px, -1.0});
         continue;
@@ -392,15 +379,8 @@ private:
         last_accepted = f.t;
       }
       if (have) {
-        a.cost += detail::innovationCost(nis, std::log(S.determinant()), 2, eps, std::log(u));
-        ++a.terms;
-        if (up.accepted && !up.reinitialized) {
-          a.nis.add(nis, 2.0);
-          if (series != nullptr) {
-            series->nis_t.push_back(f.t);
-            series->nis.push_back(nis);
-          }
-        }
+        a.addCost(nis, std::log(S.determinant()), 2, eps, std::log(u));
+        if (up.accepted && !up.reinitialized) detail::addNis(a.nis, nis, 2.0, f.t, series);
       }
       if (inn != nullptr)
         inn->row({f.t, have ? d(0) : std::nan(""), have ? d(1) : std::nan(""), have ? S(0, 0) : std::nan(""),
@@ -413,57 +393,30 @@ private:
         a.nees.add(e.dot(k.P_pos.ldlt().solve(e)), 2.0);
         next_nees = f.t + opt_.nees_spacing;
       }
-      if (series != nullptr && filter.initialized()) {
-        const auto k = filter.at(f.t);
-        est.x.push_back(k.p.x());
-        est.y.push_back(k.p.y());
-        const auto kp = filter.at(f.t + horizon);
-        pre.x.push_back(kp.p.x());
-        pre.y.push_back(kp.p.y());
-      }
+      if (series != nullptr && filter.initialized()) addEstimate(c, filter.at(f.t).p, filter.at(f.t + kHorizon).p);
     }
-    if (series != nullptr) {
-      series->error.push_back(err);
-      series->truth.push_back(tru);
-      series->estimate.push_back(est);
-      pre.name = "prediction 0.2 s ahead";
-      series->prediction.push_back(pre);
-    }
+    if (series != nullptr) c.moveInto(*series);
   }
 
-  scenarios::PanTiltScenarioConfig cfg_;
-  PanTiltOptions opt_;
   double r_scale_ = 1.0;
 };
 
 }  // namespace
 
 void registerPanTiltAdapter(AdapterRegistry& registry) {
-  detail::AdapterInfo info;
-  info.name = "pan_tilt";
-  info.description = "pan-tilt tracking of [T] (rendered screen target, predictive controller; config/pan_tilt_*.yaml)";
-  info.app = "pan_tilt_tracking";
-  info.app_arguments = "--headless --summary pan_tilt_summary.json";
-  info.default_metric = "image_error_rms_px";
-  info.metrics = {"image_error_rms_px", "image_error_max_px", "rmse_filtered_cm", "rmse_filtered_x_cm", "rmse_filtered_y_cm",
-                  "rmse_measured_cm", "reacquisition_delay_s", "nis_mean", "nees_mean"};
-  info.options = {{"duration", "0", {}, "s of each run (0: the config's run.duration)"},
-                  {"burn_in", "5", {}, "accepted measurements of a track before its innovations count"},
-                  {"nees_spacing_s", "2", {}, "s between NEES samples (nearly independent)"},
-                  {"log_seed", "1", {}, "seed of a pan_tilt_tracking --log run (its path amplitude gives R)"}};
-  registry.add(detail::makeAdapter(std::move(info), [](const std::string& yaml, const std::string& name,
-                                                       const AdapterOptions& options) {
-    scenarios::PanTiltScenarioConfig cfg = scenarios::loadPanTiltScenarioConfig(detail::scenarioConfig(yaml, name));
-    PanTiltOptions o;
-    o.duration = optionNumber(options, "duration");
-    if (!(o.duration >= 0.0)) throw core::InvalidInput("adapter option 'duration': expected >= 0");
-    o.burn_in = static_cast<int>(optionNumber(options, "burn_in"));
-    o.nees_spacing = optionNumber(options, "nees_spacing_s");
-    o.log_seed = static_cast<std::uint64_t>(optionNumber(options, "log_seed"));
-    if (o.burn_in < 1 || !(o.nees_spacing > 0.0)) throw core::InvalidInput("adapter options burn_in >= 1, nees_spacing_s > 0");
-    cfg.validate();
-    return std::unique_ptr<ScenarioInstance>(std::make_unique<PanTiltInstance>(std::move(cfg), o, 1.0));
-  }));
+  registry.add(detail::makeAdapter(
+      {"pan_tilt", "pan-tilt tracking of [T] (rendered screen target, predictive controller; config/pan_tilt_*.yaml)",
+       "pan_tilt_tracking", "--headless --summary pan_tilt_summary.json", "image_error_rms_px", true,
+       {"image_error_rms_px", "image_error_max_px", "rmse_filtered_cm", "rmse_filtered_x_cm", "rmse_filtered_y_cm",
+        "rmse_measured_cm", "reacquisition_delay_s", "nis_mean", "nees_mean"}},
+      panTiltOptions(), [](const io::ConfigNode& config, const PanTiltOptions& o) {
+        // The loader validated the config; the run length the option sets must still cover the
+        // metrics' start (run.metrics_start < run.duration, as validate() requires of the file).
+        scenarios::PanTiltScenarioConfig cfg = scenarios::loadPanTiltScenarioConfig(config);
+        if (o.duration > 0.0 && !(o.duration > cfg.metrics_start))
+          throw core::InvalidInput(config.fileName() + ": adapter option duration: expected > run.metrics_start");
+        return std::make_unique<PanTiltInstance>(std::move(cfg), o, 1.0);
+      }));
 }
 
 }  // namespace viewline::tuning

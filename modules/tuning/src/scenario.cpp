@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <sstream>
 
 #include "viewline/core/error.h"
 
@@ -97,19 +98,59 @@ std::vector<std::string> AdapterRegistry::names() const {
   return n;
 }
 
+namespace {
+std::string numberText(double v) {
+  std::ostringstream os;
+  os << v;
+  return os.str();
+}
+}  // namespace
+
+std::string AdapterOption::expected() const {
+  if (!choices.empty()) {
+    std::string list;
+    for (const auto& c : choices) list += (list.empty() ? "" : ", ") + c;
+    return "one of: " + list;
+  }
+  const std::string what = integer ? "an integer" : "a number";
+  const bool lo = std::isfinite(min), hi = std::isfinite(max);
+  if (lo && hi) return what + " in [" + numberText(min) + ", " + numberText(max) + "]";
+  if (lo) return what + " >= " + numberText(min);
+  if (hi) return what + " <= " + numberText(max);
+  return integer ? what : "a finite number";
+}
+
+bool AdapterOption::accepts(const std::string& text) const {
+  if (!choices.empty()) return std::find(choices.begin(), choices.end(), text) != choices.end();
+  char* end = nullptr;
+  const double v = std::strtod(text.c_str(), &end);
+  if (text.empty() || end == text.c_str() || *end != '\0' || !std::isfinite(v)) return false;
+  if (integer && v != std::floor(v)) return false;
+  return v >= min && v <= max;
+}
+
 AdapterOptions readAdapterOptions(const ScenarioAdapter& adapter, const io::ConfigNode* node) {
   AdapterOptions out;
   for (const AdapterOption& o : adapter.options()) {
     out[o.name] = o.default_value;
     if (node == nullptr || !node->has(o.name)) continue;
-    if (o.choices.empty()) {
-      const double v = node->get<double>(o.name);
-      if (!std::isfinite(v)) node->fail(o.name, "a finite number");
-      std::string text = node->get<std::string>(o.name);
-      out[o.name] = text;
-    } else {
-      out[o.name] = node->getChoice(o.name, o.choices);
-    }
+    const std::string text = node->get<std::string>(o.name);
+    if (!o.accepts(text)) node->fail(o.name, o.expected());
+    out[o.name] = text;
+  }
+  return out;
+}
+
+AdapterOptions checkedOptions(const std::vector<AdapterOption>& declared, const AdapterOptions& given,
+                              const std::string& adapter) {
+  AdapterOptions out;
+  for (const AdapterOption& o : declared) out[o.name] = o.default_value;
+  for (const auto& [name, text] : given) {
+    const auto it = std::find_if(declared.begin(), declared.end(), [&](const AdapterOption& o) { return o.name == name; });
+    if (it == declared.end()) throw core::InvalidInput(adapter + ": '" + name + "' is not an option of this adapter");
+    if (!it->accepts(text))
+      throw core::InvalidInput(adapter + " adapter option '" + name + "': expected " + it->expected() + ", got '" + text + "'");
+    out[name] = text;
   }
   return out;
 }

@@ -35,8 +35,9 @@ std::string fmt(double v, int prec = 4) {
   return b;
 }
 
-/// The scenario config of a session: its text (with the --set edits) parsed once. The adapter reads
-/// `node` (each key once, validated once); edits (sweep settings, relocated paths) start from `tree`.
+/// The scenario config of a session, read once: `text` (with the --set edits) for the configs the
+/// session writes, `node` for the adapter (each key read once, validated once), `tree` (the same
+/// parsed nodes) where sweep settings and relocated paths start from (editedTree keeps its marks).
 struct ScenarioFile {
   std::string path, text;
   io::ConfigNode node;
@@ -44,10 +45,18 @@ struct ScenarioFile {
 };
 
 ScenarioFile readScenarioFile(const std::string& path, const std::vector<std::string>& set) {
-  std::string text = io::configTextWithValues(path, set);
-  io::ConfigNode node = detail::scenarioConfig(text, path);
+  if (!set.empty()) {  // the --set values written into the text (rewriteYamlText), then parsed
+    std::string text = io::configTextWithValues(path, set);
+    io::ConfigNode node = detail::scenarioConfig(text, path);
+    YAML::Node tree = node.yaml();
+    return {path, std::move(text), std::move(node), std::move(tree)};
+  }
+  io::ConfigNode node = io::ConfigNode::loadFile(path);  // names the file and line of its own errors
+  std::ifstream in(path);
+  std::ostringstream text;
+  text << in.rdbuf();
   YAML::Node tree = node.yaml();
-  return {path, std::move(text), std::move(node), std::move(tree)};
+  return {path, text.str(), std::move(node), std::move(tree)};
 }
 
 // `kv` plus the config's relative paths (rig folders, ...) re-expressed for a copy of the config
@@ -273,6 +282,16 @@ AutotuneOutcome doAutotune(const ScenarioInstance& base, const ScenarioFile& fil
   return o;
 }
 
+/// Writes the report and the summary (naming the report and its plot count) into `out_dir`.
+nlohmann::json writeOutputs(const HtmlReport& rep, nlohmann::json j, const std::string& out_dir) {
+  const std::string report_path = (fs::path(out_dir) / "report.html").string();
+  j["report"] = report_path;
+  j["report_plots"] = rep.plotCount();
+  rep.write(report_path);
+  io::writeSummaryFile((fs::path(out_dir) / "summary.json").string(), j);
+  return j;
+}
+
 /// The adapter's options with the command line's `--option name=value` values.
 AdapterOptions withOptions(const ScenarioAdapter& adapter, const std::string& scenario, const AdapterOptions& given) {
   AdapterOptions ao = readAdapterOptions(adapter, nullptr);
@@ -320,7 +339,7 @@ nlohmann::json runSweepSession(const AdapterRegistry& registry, const std::strin
     if (!io::findKey(tree, p.key)) {
       // Not in the file: accept it only when the scenario's loader knows it.
       try {
-        adapter.load(io::withValue(tree, p.key, p.values.empty() ? YAML::Node("0") : p.values.front()), config_path,
+        adapter.load(editedTree(tree, {{p.key, p.values.empty() ? YAML::Node("0") : p.values.front()}}), config_path,
                      spec.adapter_options);
       } catch (const core::InvalidInput& e) {
         throw core::InvalidInput(p.location + ": parameter '" + p.key + "': not a key of the " + spec.scenario +
@@ -336,7 +355,7 @@ nlohmann::json runSweepSession(const AdapterRegistry& registry, const std::strin
       // Name the parameter whose value the scenario refuses (try them one at a time).
       for (std::size_t k = 0; k < spec.parameters.size(); ++k) {
         try {
-          adapter.load(io::withValue(tree, spec.parameters[k].key, s.values[k]), config_path, spec.adapter_options);
+          adapter.load(editedTree(tree, {{spec.parameters[k].key, s.values[k]}}), config_path, spec.adapter_options);
         } catch (const core::InvalidInput& e1) {
           throw core::InvalidInput(spec.parameters[k].location + ": parameter '" + spec.parameters[k].key +
                                    "': value '" + scalarText(s.values[k]) + "' refused by the " + spec.scenario +
@@ -431,8 +450,8 @@ nlohmann::json runSweepSession(const AdapterRegistry& registry, const std::strin
     const std::string best_text = io::rewriteYamlText(file.text, kv, header);
     io::writeTextFileAtomic(best_config, best_text);
     bool verified = true;
-    try {  // the file as written loads (the app will read it)
-      adapter.loadConfig(detail::scenarioConfig(best_text, best_config), spec.adapter_options);
+    try {  // its values, relative paths resolved from its folder, load (the app will read them)
+      adapter.load(editedTree(tree, kv), best_config, spec.adapter_options);
     } catch (const core::InvalidInput&) {
       verified = false;
     }
@@ -560,16 +579,11 @@ nlohmann::json runSweepSession(const AdapterRegistry& registry, const std::strin
   rep.preformatted("results (one JSON line per finished setting): " + jsonl + "\nsummary: " +
                    (fs::path(opt.out_dir) / "summary.json").string() + "\nplot data and gnuplot scripts: " +
                    (fs::path(opt.out_dir) / "plots").string());
-  const std::string report_path = (fs::path(opt.out_dir) / "report.html").string();
-  j["report"] = report_path;
-  j["report_plots"] = rep.plotCount();
   j["session_wall_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_session).count();
   nlohmann::json all = nlohmann::json::array();
   for (const auto& r : out.settings) all.push_back(r.toJson(spec));
   j["all_settings"] = all;
-  rep.write(report_path);
-  io::writeSummaryFile((fs::path(opt.out_dir) / "summary.json").string(), j);
-  return j;
+  return writeOutputs(rep, std::move(j), opt.out_dir);
 }
 
 nlohmann::json runSingleSession(const AdapterRegistry& registry, const SingleRunOptions& o) {
@@ -613,12 +627,7 @@ nlohmann::json runSingleSession(const AdapterRegistry& registry, const SingleRun
              {"NIS", fmt(r.nis.mean()), consistencyCell(r.nis, c), std::to_string(r.nis.count), r.nis.verdict(c)}});
   rep.paragraph("Run verdict: <b>" + htmlEscape(r.verdict) + "</b>");
   if (r.series) addRunPlots(rep, *r.series, "run", o.scenario + " seed " + std::to_string(o.seed), c);
-  const std::string report_path = (fs::path(o.out_dir) / "report.html").string();
-  j["report"] = report_path;
-  j["report_plots"] = rep.plotCount();
-  rep.write(report_path);
-  io::writeSummaryFile((fs::path(o.out_dir) / "summary.json").string(), j);
-  return j;
+  return writeOutputs(rep, std::move(j), o.out_dir);
 }
 
 nlohmann::json runAutotuneSession(const AdapterRegistry& registry, const AutotuneSessionOptions& o) {
@@ -657,12 +666,7 @@ nlohmann::json runAutotuneSession(const AdapterRegistry& registry, const Autotun
                 consistencyCell(at.live_after.nis, ao.confidence), at.live_after.verdict}});
   }
   autotunePlots(rep, at.result, ao.confidence);
-  const std::string report_path = (fs::path(o.out_dir) / "report.html").string();
-  j["report"] = report_path;
-  j["report_plots"] = rep.plotCount();
-  rep.write(report_path);
-  io::writeSummaryFile((fs::path(o.out_dir) / "summary.json").string(), j);
-  return j;
+  return writeOutputs(rep, std::move(j), o.out_dir);
 }
 
 }  // namespace viewline::tuning

@@ -245,7 +245,7 @@ std::string Setting::label() const {
 YAML::Node applySetting(const YAML::Node& scenario, const SweepSpec& spec, const Setting& s) {
   std::vector<std::pair<std::string, YAML::Node>> kv;
   for (std::size_t k = 0; k < spec.parameters.size(); ++k) kv.emplace_back(spec.parameters[k].key, s.values[k]);
-  return io::withValues(scenario, kv);
+  return editedTree(scenario, kv);
 }
 
 }  // namespace viewline::tuning

@@ -25,6 +25,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <optional>
 
 #include "adapter_util.h"
@@ -52,40 +53,76 @@ struct BallFrame {
   std::optional<Eigen::Vector2d> prediction;  ///< the loop observer's N-th predicted position
 };
 
-class TableBallReplayData : public ReplayData {
-public:
-  std::vector<std::vector<BallFrame>> runs;
-  std::string source;
-  std::size_t measurements() const override {
-    std::size_t n = 0;
-    for (const auto& r : runs)
-      for (const auto& f : r) n += f.y.has_value();
-    return n;
-  }
-  std::string describe() const override {
-    return std::to_string(runs.size()) + " table-ball run(s), " + std::to_string(measurements()) +
-           " ball measurements (" + source + ")";
-  }
-};
+using BallRun = std::vector<BallFrame>;
+using TableBallReplayData = detail::Recording<BallRun>;
 
+std::size_t ballMeasurements(const BallRun& run) {
+  std::size_t n = 0;
+  for (const auto& f : run) n += f.y.has_value();
+  return n;
+}
+
+std::unique_ptr<TableBallReplayData> newReplayData() {
+  return std::make_unique<TableBallReplayData>("table-ball run(s)", "ball measurements", &ballMeasurements);
+}
+
+/// The adapter options (declared with their defaults and ranges in registerTableBallAdapter).
 struct TableBallOptions {
-  double duration = 0.0;      ///< 0: the config's
-  int burn_in = 5;
-  double nees_spacing = 0.5;  ///< s
+  double duration;      ///< s; 0: the config's
+  int burn_in;          ///< ball measurements of the track before its innovations count
+  double nees_spacing;  ///< s between NEES samples
 };
 
-struct Accum {
-  double cost = 0.0;
-  std::size_t terms = 0;
-  Consistency nis, nees;
-};
+/// The adapter options: type, range, default and help of each, bound to its field.
+detail::OptionTable<TableBallOptions> tableBallOptions() {
+  detail::OptionTable<TableBallOptions> options;
+  options.number("duration", &TableBallOptions::duration, "0", 0.0, detail::kUnbounded, "s of each run (0: the config's duration)")
+      .integer("burn_in", &TableBallOptions::burn_in, "5", 1, 1e6, "ball measurements of the track before its innovations count")
+      .number("nees_spacing_s", &TableBallOptions::nees_spacing, "0.5", 1e-9, detail::kUnbounded,
+              "s between NEES samples (nearly independent)");
+  return options;
+}
 
-class TableBallInstance final : public ScenarioInstance {
+using Accum = detail::InnovationTally;
+
+/// The metrics that are a field of the scenario's result, by name (the rest are formed in run()).
+using ResultMetric = std::pair<const char*, double scenarios::TableBallResult::*>;
+const ResultMetric kResultMetrics[] = {
+    {"observer_rmse_mm", &scenarios::TableBallResult::observer_rmse_mm},
+    {"measurement_rmse_mm", &scenarios::TableBallResult::measurement_rmse_mm},
+    {"prediction_rmse_mm_10", &scenarios::TableBallResult::prediction_rmse_mm_10},
+    {"tilt_rmse_deg", &scenarios::TableBallResult::tilt_rmse_deg},
+    {"overshoot_pct", &scenarios::TableBallResult::overshoot_pct},
+    {"settling_time_s", &scenarios::TableBallResult::settling_time_s},
+    {"steady_state_error_mm", &scenarios::TableBallResult::steady_state_error_mm},
+    {"push_recovery_s", &scenarios::TableBallResult::push_recovery_s},
+    {"max_commanded_angle_deg", &scenarios::TableBallResult::max_commanded_angle_deg}};
+/// The observer's RMSE under the compared tunings (metrics.compare_tunings).
+const ResultMetric kComparedTunings[] = {
+    {"observer_rmse_mm_M_sw1_sv0005", &scenarios::TableBallResult::observer_rmse_mm_M_sw1_sv0005},
+    {"observer_rmse_mm_M_sw1_sv1", &scenarios::TableBallResult::observer_rmse_mm_M_sw1_sv1},
+    {"observer_rmse_mm_stationary", &scenarios::TableBallResult::observer_rmse_mm_stationary}};
+
+/// Every metric a run reports, in the order the tool lists them.
+std::vector<std::string> metricNames() {
+  std::vector<std::string> names;
+  for (const auto& m : kResultMetrics) names.emplace_back(m.first);
+  names.insert(names.end(), {"limits_respected", "ball_detection_rate"});
+  for (const auto& m : kComparedTunings) names.emplace_back(m.first);
+  names.insert(names.end(), {"nis_mean", "nees_mean"});
+  return names;
+}
+
+const detail::SeriesLabels kLabels{"t [s]", "ball position error |p_hat - p| [mm]", "t [s]", 2.0, "table x [m]",
+                                   "table y [m]"};
+
+class TableBallInstance final : public detail::ConfiguredInstance<scenarios::TableBallConfig, TableBallOptions> {
 public:
-  TableBallInstance(scenarios::TableBallConfig cfg, TableBallOptions opt) : cfg_(std::move(cfg)), opt_(opt) {
+  /// `cfg` as its reader validated it; the options only turn the wall-clock reference off and
+  /// set a positive duration (nothing validate() would refuse).
+  TableBallInstance(scenarios::TableBallConfig cfg, TableBallOptions opt) : ConfiguredInstance(std::move(cfg), opt) {
     cfg_.time_reference = false;
     if (opt_.duration > 0.0) cfg_.duration = opt_.duration;
-    cfg_.validate();
   }
 
   RunResult run(std::uint64_t seed, const RunOptions& ro) const override {
@@ -94,32 +131,18 @@ public:
     const scenarios::TableBallResult res = simulate(seed, ro, frames, &telemetry);
     RunResult r;
     r.seed = seed;
-    std::shared_ptr<RunSeries> series;
-    if (ro.series) series = makeSeries();
+    const std::shared_ptr<RunSeries> series = detail::newSeries(ro.series, kLabels);
     Accum a;
-    io::CsvWriter* inn = nullptr;
-    if (ro.log != nullptr && ro.log->enabled())
-      inn = &ro.log->stream("innovations", {"t", "d0", "d1", "S00", "S01", "S11", "nis", "in_statistics"});
+    io::CsvWriter* inn = detail::logStream(ro, "innovations", {"t", "d0", "d1", "S00", "S01", "S11", "nis", "in_statistics"});
     consistency(frames, telemetry, a, series.get(), inn);
     r.nis = a.nis;
     r.nees = a.nees;
     auto& m = r.metrics;
-    m["observer_rmse_mm"] = res.observer_rmse_mm;
-    m["measurement_rmse_mm"] = res.measurement_rmse_mm;
-    m["prediction_rmse_mm_10"] = res.prediction_rmse_mm_10;
-    m["tilt_rmse_deg"] = res.tilt_rmse_deg;
-    m["overshoot_pct"] = res.overshoot_pct;
-    m["settling_time_s"] = res.settling_time_s;
-    m["steady_state_error_mm"] = res.steady_state_error_mm;
-    m["push_recovery_s"] = res.push_recovery_s;
-    m["max_commanded_angle_deg"] = res.max_commanded_angle_deg;
+    for (const auto& [name, field] : kResultMetrics) m[name] = res.*field;
     m["limits_respected"] = res.limits_respected ? 1.0 : 0.0;
     m["ball_detection_rate"] = res.frames > 0 ? static_cast<double>(res.ball_detections) / res.frames : std::nan("");
-    if (cfg_.compare_tunings) {
-      m["observer_rmse_mm_M_sw1_sv0005"] = res.observer_rmse_mm_M_sw1_sv0005;
-      m["observer_rmse_mm_M_sw1_sv1"] = res.observer_rmse_mm_M_sw1_sv1;
-      m["observer_rmse_mm_stationary"] = res.observer_rmse_mm_stationary;
-    }
+    if (cfg_.compare_tunings)
+      for (const auto& [name, field] : kComparedTunings) m[name] = res.*field;
     m["nis_mean"] = a.nis.mean();
     m["nees_mean"] = a.nees.mean();
     r.verdict = combinedVerdict(r.nees, r.nis, confidence());
@@ -135,12 +158,12 @@ public:
   }
 
   std::unique_ptr<ReplayData> record(std::uint64_t seed, int runs) const override {
-    auto d = std::make_unique<TableBallReplayData>();
+    auto d = newReplayData();
     for (int i = 0; i < runs; ++i) {
-      d->runs.emplace_back();
-      simulate(core::deriveSeed(seed, static_cast<std::uint64_t>(i)), {}, d->runs.back(), nullptr);
+      d->items.emplace_back();
+      simulate(core::deriveSeed(seed, static_cast<std::uint64_t>(i)), {}, d->items.back(), nullptr);
     }
-    d->source = "live: " + std::to_string(runs) + " run(s) from seed " + std::to_string(seed);
+    d->source = detail::liveSource(runs, seed);
     return d;
   }
 
@@ -152,9 +175,9 @@ public:
     const detail::CsvTable balls = detail::CsvTable::read(balls_path, "the measurements_ball.csv of table_ball_balancing --log");
     const std::size_t it = inputs.col("t"), ax = inputs.col("z0"), ay = inputs.col("z1");
     const std::size_t bt = balls.col("t"), bx = balls.col("z0"), by = balls.col("z1");
-    auto d = std::make_unique<TableBallReplayData>();
-    d->runs.emplace_back();
-    auto& run = d->runs.back();
+    auto d = newReplayData();
+    d->items.emplace_back();
+    auto& run = d->items.back();
     std::size_t b = 0;  // every frame has an input row; a found ball has a row with the same t
     for (std::size_t row = 0; row < inputs.rows(); ++row) {
       BallFrame f;
@@ -177,12 +200,10 @@ public:
 
   ReplayResult replay(const ReplayData& data, const std::vector<double>& noise, double outlier_prior,
                       bool want_series) const override {
-    const TableBallReplayData& d = detail::replayInput<TableBallReplayData>(data, noise, 2, "table_ball");
-    Accum a;
-    std::shared_ptr<RunSeries> series;
-    if (want_series) series = makeSeries();
-    for (const auto& run : d.runs) replayRun(run, noise[0], noise[1], outlier_prior, a, series.get());
-    return detail::replayResult(a.cost, a.terms, a.nis, series);
+    return detail::replayRecording<BallRun, Accum>(
+        data, noise, 2, "table_ball", want_series, kLabels, [&](const TableBallReplayData& d, Accum& a, RunSeries* series) {
+          for (const auto& run : d.items) replayRun(run, noise[0], noise[1], outlier_prior, a, series);
+        });
   }
 
   std::unique_ptr<ScenarioInstance> withNoise(const std::vector<double>& noise) const override {
@@ -215,7 +236,7 @@ private:
     std::optional<runtime::CsvSink> csv;
     runtime::FanoutSink sinks;
     sinks.add(telemetry);
-    if (ro.log != nullptr && ro.log->enabled()) sinks.add(&csv.emplace(*ro.log));
+    if (detail::logging(ro)) sinks.add(&csv.emplace(*ro.log));
     scenarios::TableBallHooks hooks;
     hooks.telemetry = &sinks;
     hooks.on_frame = [&](const scenarios::TableBallFrameView& v) {
@@ -250,13 +271,8 @@ private:
                            u.S.rows() == 2 && u.S.cols() == 2 && std::isfinite(u.nis);
       const Eigen::Matrix2d S = counted ? Eigen::Matrix2d(u.S) : Eigen::Matrix2d::Constant(std::nan(""));
       if (counted) {
-        a.cost += detail::innovationCost(u.nis, std::log(S.determinant()), 2, 0.0, log_u);
-        ++a.terms;
-        a.nis.add(u.nis, 2.0);
-        if (series != nullptr) {
-          series->nis_t.push_back(u.t);
-          series->nis.push_back(u.nis);
-        }
+        a.addCost(u.nis, std::log(S.determinant()), 2, 0.0, log_u);
+        detail::addNis(a.nis, u.nis, 2.0, u.t, series);
       }
       if (inn != nullptr)
         inn->row({u.t, counted ? u.innovation[0] : std::nan(""), counted ? u.innovation[1] : std::nan(""), S(0, 0),
@@ -265,7 +281,7 @@ private:
     std::vector<const runtime::EstimateRecord*> estimates;
     for (const auto& e : telemetry.estimates)
       if (e.channel == "ball") estimates.push_back(&e);
-    Curve err{"error", {}, {}}, tru{"truth", {}, {}}, est{"estimate", {}, {}}, pre{"prediction", {}, {}};
+    detail::TrackCurves c = makeCurves();
     int measured = 0;
     double next_nees = cfg_.warmup;
     std::size_t e = 0;
@@ -276,46 +292,42 @@ private:
       const Eigen::VectorXd& x = estimates[e]->x;
       const Eigen::MatrixXd& P = estimates[e]->P;
       const Eigen::Vector2d p(x[0], x[2]);
-      if (f.has_truth && f.t >= next_nees && measured >= opt_.burn_in) {
-        Eigen::Matrix2d Pp;
-        Pp << P(0, 0), P(0, 2), P(2, 0), P(2, 2);
-        const Eigen::Vector2d d = p - f.truth;
-        a.nees.add(d.dot(Pp.ldlt().solve(d)), 2.0);
-        next_nees = f.t + opt_.nees_spacing;
-      }
-      if (series != nullptr) {
-        if (f.has_truth) {
-          err.x.push_back(f.t);
-          err.y.push_back(1e3 * (p - f.truth).norm());
-          tru.x.push_back(f.truth.x());
-          tru.y.push_back(f.truth.y());
-        }
-        est.x.push_back(p.x());
-        est.y.push_back(p.y());
-        if (f.prediction) {
-          pre.x.push_back(f.prediction->x());
-          pre.y.push_back(f.prediction->y());
-        }
-      }
+      Eigen::Matrix2d Pp;
+      Pp << P(0, 0), P(0, 2), P(2, 0), P(2, 2);
+      sample(f, p, Pp, f.prediction, measured, next_nees, a, series != nullptr ? &c : nullptr);
     }
-    if (series != nullptr) finishSeries(*series, err, tru, est, pre);
+    if (series != nullptr) c.moveInto(*series);
   }
 
-  void finishSeries(RunSeries& series, Curve& err, Curve& tru, Curve& est, Curve& pre) const {
-    if (!err.x.empty()) series.error.push_back(err);
-    if (!tru.x.empty()) series.truth.push_back(tru);
-    series.estimate.push_back(est);
-    pre.name = "prediction " + std::to_string(cfg_.observer.tracker.model.prediction_steps) + " frames ahead";
-    series.prediction.push_back(pre);
+  detail::TrackCurves makeCurves() const {
+    detail::TrackCurves c;
+    c.prediction.name = "prediction " + std::to_string(cfg_.observer.tracker.model.prediction_steps) + " frames ahead";
+    return c;
   }
 
-  std::shared_ptr<RunSeries> makeSeries() const {
-    auto s = std::make_shared<RunSeries>();
-    s->error_label = "ball position error |p_hat - p| [mm]";
-    s->nis_dof = 2.0;
-    s->traj_x_label = "table x [m]";
-    s->traj_y_label = "table y [m]";
-    return s;
+  /// The NEES sample (one every nees_spacing s once the track has burn_in measurements) and the
+  /// curves of one frame's estimate: ball position `p` on the table, its covariance `Pp`.
+  void sample(const BallFrame& f, const Eigen::Vector2d& p, const Eigen::Matrix2d& Pp,
+              const std::optional<Eigen::Vector2d>& prediction, int measured, double& next_nees, Accum& a,
+              detail::TrackCurves* c) const {
+    if (f.has_truth && f.t >= next_nees && measured >= opt_.burn_in) {
+      const Eigen::Vector2d d = p - f.truth;
+      a.nees.add(d.dot(Pp.ldlt().solve(d)), 2.0);
+      next_nees = f.t + opt_.nees_spacing;
+    }
+    if (c == nullptr) return;
+    if (f.has_truth) {
+      c->error.x.push_back(f.t);
+      c->error.y.push_back(1e3 * (p - f.truth).norm());
+      c->truth.x.push_back(f.truth.x());
+      c->truth.y.push_back(f.truth.y());
+    }
+    c->estimate.x.push_back(p.x());
+    c->estimate.y.push_back(p.y());
+    if (prediction) {
+      c->prediction.x.push_back(prediction->x());
+      c->prediction.y.push_back(prediction->y());
+    }
   }
 
   /// Replays logged measurements through the observer's filter with (σw, σv).
@@ -325,7 +337,7 @@ private:
     tracking::RollingBallTracker trk(tc);
     const double side = tc.model.table_side - 2.0 * tc.model.ball_radius;
     const double log_u = -std::log(side * side);
-    Curve err{"error", {}, {}}, tru{"truth", {}, {}}, est{"estimate", {}, {}}, pre{"prediction", {}, {}};
+    detail::TrackCurves c = makeCurves();
     int measured = 0;
     double next_nees = cfg_.warmup;
     for (const BallFrame& f : frames) {
@@ -337,72 +349,30 @@ private:
       const auto& u = trk.lastUpdate();
       if (counted_track && u && u->decision == tracking::GateDecision::Accept && std::isfinite(u->report.nis)) {
         const double nis = u->report.nis;
-        a.cost += detail::innovationCost(nis, std::log(Eigen::Matrix2d(u->report.S).determinant()), 2, eps, log_u);
-        ++a.terms;
-        a.nis.add(nis, 2.0);
-        if (series != nullptr) {
-          series->nis_t.push_back(f.t);
-          series->nis.push_back(nis);
-        }
+        a.addCost(nis, std::log(Eigen::Matrix2d(u->report.S).determinant()), 2, eps, log_u);
+        detail::addNis(a.nis, nis, 2.0, f.t, series);
       }
       if (!trk.initialized()) continue;
-      if (f.has_truth && f.t >= next_nees && measured >= opt_.burn_in) {
-        const Eigen::MatrixXd P = trk.P();
-        Eigen::Matrix2d Pp;
-        Pp << P(0, 0), P(0, 2), P(2, 0), P(2, 2);
-        const Eigen::Vector2d e = trk.position() - f.truth;
-        a.nees.add(e.dot(Pp.ldlt().solve(e)), 2.0);
-        next_nees = f.t + opt_.nees_spacing;
-      }
-      if (series != nullptr) {
-        if (f.has_truth) {
-          err.x.push_back(f.t);
-          err.y.push_back(1e3 * (trk.position() - f.truth).norm());
-          tru.x.push_back(f.truth.x());
-          tru.y.push_back(f.truth.y());
-        }
-        est.x.push_back(trk.position().x());
-        est.y.push_back(trk.position().y());
-        if (!trk.predictions().empty()) {
-          pre.x.push_back(trk.predictions().back().x());
-          pre.y.push_back(trk.predictions().back().y());
-        }
-      }
+      const Eigen::MatrixXd P = trk.P();
+      Eigen::Matrix2d Pp;
+      Pp << P(0, 0), P(0, 2), P(2, 0), P(2, 2);
+      const std::optional<Eigen::Vector2d> prediction =
+          trk.predictions().empty() ? std::nullopt : std::optional<Eigen::Vector2d>(trk.predictions().back());
+      sample(f, trk.position(), Pp, prediction, measured, next_nees, a, series != nullptr ? &c : nullptr);
     }
-    if (series != nullptr) finishSeries(*series, err, tru, est, pre);
+    if (series != nullptr) c.moveInto(*series);
   }
-
-  scenarios::TableBallConfig cfg_;
-  TableBallOptions opt_;
 };
 
 }  // namespace
 
 void registerTableBallAdapter(AdapterRegistry& registry) {
-  detail::AdapterInfo info;
-  info.name = "table_ball";
-  info.description = "table-ball balancing of [M] (rendered table and ball, rolling-ball observer, LQR; config/table_ball.yaml)";
-  info.app = "table_ball_balancing";
-  info.app_arguments = "--headless --summary table_ball_summary.json";
-  info.default_metric = "observer_rmse_mm";
-  info.metrics = {"observer_rmse_mm", "measurement_rmse_mm", "prediction_rmse_mm_10", "tilt_rmse_deg", "overshoot_pct",
-                  "settling_time_s", "steady_state_error_mm", "push_recovery_s", "max_commanded_angle_deg",
-                  "limits_respected", "ball_detection_rate", "observer_rmse_mm_M_sw1_sv0005", "observer_rmse_mm_M_sw1_sv1",
-                  "observer_rmse_mm_stationary", "nis_mean", "nees_mean"};
-  info.options = {{"duration", "0", {}, "s of each run (0: the config's duration)"},
-                  {"burn_in", "5", {}, "ball measurements of the track before its innovations count"},
-                  {"nees_spacing_s", "0.5", {}, "s between NEES samples (nearly independent)"}};
-  registry.add(detail::makeAdapter(std::move(info), [](const std::string& yaml, const std::string& name,
-                                                       const AdapterOptions& options) {
-    scenarios::TableBallConfig cfg = scenarios::tableBallConfigFromYaml(detail::scenarioConfig(yaml, name));
-    TableBallOptions o;
-    o.duration = optionNumber(options, "duration");
-    o.burn_in = static_cast<int>(optionNumber(options, "burn_in"));
-    o.nees_spacing = optionNumber(options, "nees_spacing_s");
-    if (!(o.duration >= 0.0) || o.burn_in < 1 || !(o.nees_spacing > 0.0))
-      throw core::InvalidInput("table_ball adapter options: duration >= 0, burn_in >= 1, nees_spacing_s > 0");
-    return std::unique_ptr<ScenarioInstance>(std::make_unique<TableBallInstance>(std::move(cfg), o));
-  }));
+  registry.add(detail::makeAdapter(
+      {"table_ball", "table-ball balancing of [M] (rendered table and ball, rolling-ball observer, LQR; config/table_ball.yaml)",
+       "table_ball_balancing", "--headless --summary table_ball_summary.json", "observer_rmse_mm", true, metricNames()},
+      tableBallOptions(), [](const io::ConfigNode& config, const TableBallOptions& o) {
+        return std::make_unique<TableBallInstance>(scenarios::tableBallConfigFromYaml(config), o);
+      }));
 }
 
 }  // namespace viewline::tuning

@@ -153,3 +153,32 @@ TEST(YamlEdit, SetValuesReachTheRunsTheSummaryAndTheBestConfig) {
   }
   fs::remove_all(root);
 }
+
+// A setting's tree is read as it is (no text round trip): a value the scenario refuses is named in
+// the file, and keys the setting did not touch keep their lines; the parsed tree is not changed.
+TEST(SweepSpec, EditedTreeKeepsTheFileLines) {
+  const YAML::Node file = YAML::Load("steps: 400\nfilter:\n  q: 0.01\n  r: 1.0\n  rr: 2\n");
+  const YAML::Node edited = editedTree(file, {{"filter.q", YAML::Node("-1")}, {"extra.k", YAML::Node("3")}});
+  EXPECT_EQ(edited["filter"]["q"].as<std::string>(), "-1");
+  EXPECT_EQ(edited["extra"]["k"].as<int>(), 3);
+  EXPECT_EQ(edited["filter"]["r"].Mark().line, 3);  // the file's node, shared
+  EXPECT_EQ(file["filter"]["q"].as<std::string>(), "0.01");
+  EXPECT_FALSE(file["extra"].IsDefined());
+  std::string error;
+  try {
+    toy::registry().get("toy").load(editedTree(file, {{"filter.q", YAML::Node("0.5")}}), "toy.yaml", {});
+  } catch (const core::InvalidInput& e) {
+    error = e.what();
+  }
+  EXPECT_NE(error.find("toy.yaml:5:3: unknown key 'filter.rr'"), std::string::npos) << error;
+  try {
+    toy::registry().get("toy").load(editedTree(YAML::Load("steps: 4\n"), {{"filter.q", YAML::Node("-1")}}), "toy.yaml",
+                                    {});
+    error.clear();
+  } catch (const core::InvalidInput& e) {
+    error = e.what();
+  }
+  EXPECT_EQ(error.rfind("toy.yaml: key 'filter.q': expected a positive number", 0), 0u) << error;  // no made-up line
+  EXPECT_THROW(editedTree(file, {{"steps.x", YAML::Node("1")}}), core::InvalidInput);  // under a scalar
+  EXPECT_THROW(editedTree(file, {{"filter[2]", YAML::Node("1")}}), core::InvalidInput);  // not a list
+}

@@ -118,7 +118,7 @@ public:
   std::vector<AdapterOption> options() const override { return {{"scale", "1", {}, "unused"}}; }
   std::unique_ptr<ScenarioInstance> load(const YAML::Node& n, const std::string& name,
                                          const AdapterOptions&) const override {
-    const io::ConfigNode root = io::ConfigNode::fromString(io::emitYaml(n), name);
+    const io::ConfigNode root = io::ConfigNode::fromTree(n, name);  // the tree as edited, read once
     Config c;
     c.q_true = root.getOr<double>("q_true", c.q_true);
     c.r_true = root.getOr<double>("r_true", c.r_true);

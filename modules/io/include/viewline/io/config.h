@@ -43,6 +43,13 @@ public:
   /// the file's folder.
   static ConfigNode fromString(const std::string& text, const std::string& name = "<string>",
                                const std::string& base_dir = "");
+  /// Reads a tree already parsed (and perhaps edited, e.g. a sweep setting) without a text round
+  /// trip: `name` names the file in messages, relative paths (getPath) resolve against `base_dir`.
+  /// Nodes keep the line/column marks the parser gave them, so errors name `name:line:col` where
+  /// the node came from the file; nodes built in code carry no mark and their errors name the file
+  /// alone. The tree is shared, not copied: the caller must not change it while the node is read.
+  /// A null root is an empty map; any other non-map root, a non-scalar or duplicate key is refused.
+  static ConfigNode fromTree(const YAML::Node& root, const std::string& name, const std::string& base_dir = "");
 
   /// True when the map has this key (does not mark it as read).
   bool has(const std::string& key) const;

@@ -41,30 +41,36 @@
 
 namespace viewline::tuning {
 
+/// How the noise search runs (see the file comment).
 struct AutotuneOptions {
-  double outlier_prior = 0.05;
-  double span_decades = 2.5;
-  int grid_points = 11;
-  int workers = 0;          ///< 0: all cores
-  double confidence = 0.99;
-  int max_simplex_evaluations = 200;
-  std::function<void(const std::string&)> progress;
+  double outlier_prior = 0.05;  ///< ε, prior probability that a measurement is a gross outlier (0: Gaussian)
+  double span_decades = 2.5;    ///< the grid spans start ± this many decades per parameter
+  int grid_points = 11;         ///< grid points per parameter
+  int workers = 0;              ///< threads of the grid stage; 0: all cores
+  double confidence = 0.99;     ///< of the NIS chi-square bands
+  int max_simplex_evaluations = 200;  ///< Nelder-Mead stops after this many cost evaluations
+  std::function<void(const std::string&)> progress;  ///< progress lines (optional)
 };
 
+/// One cost evaluation of the search.
 struct AutotuneEvaluation {
-  std::vector<double> values;
-  double cost = 0.0;
-  double nis_mean = 0.0;
+  std::vector<double> values;  ///< noise values (noiseParameters() order, their units)
+  double cost = 0.0;           ///< −2 log L of the replayed innovations
+  double nis_mean = 0.0;       ///< NIS mean of the replay
 };
 
+/// What the noise search found.
 struct AutotuneResult {
-  std::vector<NoiseParameter> parameters;
-  std::vector<double> start, tuned;
-  ReplayResult before, after;          ///< replays at start and tuned values (with series)
-  std::vector<AutotuneEvaluation> grid;  ///< the grid stage (for the cost plot)
-  std::size_t evaluations = 0;
-  std::string data_description;
-  double wall_s = 0.0;
+  std::vector<NoiseParameter> parameters;  ///< the tuned noise parameters
+  std::vector<double> start;               ///< start values (parameter units)
+  std::vector<double> tuned;               ///< values of least cost (parameter units)
+  ReplayResult before;                     ///< replay at the start values (with series)
+  ReplayResult after;                      ///< replay at the tuned values (with series)
+  std::vector<AutotuneEvaluation> grid;    ///< the grid stage (for the cost plot)
+  std::size_t evaluations = 0;             ///< cost evaluations in all
+  std::string data_description;            ///< what was replayed (ReplayData::describe())
+  double wall_s = 0.0;                     ///< s of wall-clock time of the search
+  /// The result as JSON (the session summary's "autotune" object), bands at `confidence`.
   nlohmann::json toJson(double confidence) const;
 };
 

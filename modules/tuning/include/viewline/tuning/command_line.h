@@ -22,6 +22,7 @@
 
 namespace viewline::tuning {
 
+/// The viewline_tune subcommands on a CLI11 app, and running the parsed one.
 class TuneCommandLine {
 public:
   /// Adds the subcommands sweep, run, autotune and list to `app` (exactly one is required).

@@ -11,24 +11,31 @@
 
 namespace viewline::tuning {
 
+/// One HTML report built section by section, with its plots embedded.
 class HtmlReport {
 public:
-  /// Plots go to `dir/plots`.
+  /// A report titled `title`; plots go to the folder plots under `dir`.
   HtmlReport(std::string title, std::string dir);
 
+  /// A heading of this level (h2 by default); `text` is escaped.
   void heading(const std::string& text, int level = 2);
+  /// A paragraph of HTML (the caller escapes its text).
   void paragraph(const std::string& html);
+  /// A preformatted block of plain text (escaped).
   void preformatted(const std::string& text);
+  /// A table of text cells (escaped); `row_classes` (optional, one per row) colour rows by CSS class.
   void table(const std::vector<std::string>& header, const std::vector<std::vector<std::string>>& rows,
              const std::vector<std::string>& row_classes = {});
-  /// Writes `data` to `plots/name.dat` and `script` (gnuplot, may refer to `'name.dat'` and other
-  /// files written with dataFile()) to `plots/name.gp`, runs gnuplot, embeds `plots/name.png`.
+  /// Writes `script` (gnuplot; it may refer to the files written with dataFile()) to plots/NAME.gp
+  /// (NAME = `name`), runs gnuplot and embeds plots/NAME.png with `caption`.
   /// Returns false (and notes it in the report) when gnuplot failed.
   bool plot(const std::string& name, const std::string& script, const std::string& caption);
-  /// Writes a data file `plots/file`; returns its file name (relative to plots/).
+  /// Writes `content` to the data file `file` in plots/; returns its file name (relative to plots/).
   std::string dataFile(const std::string& file, const std::string& content);
 
+  /// Plots embedded so far.
   std::size_t plotCount() const { return plots_; }
+  /// The whole HTML document.
   std::string html() const;
   /// Writes the HTML atomically.
   void write(const std::string& path) const;

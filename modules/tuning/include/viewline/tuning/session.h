@@ -21,8 +21,9 @@
 
 namespace viewline::tuning {
 
+/// What a sweep session runs and where its outputs go.
 struct SessionOptions {
-  std::string out_dir = "tune_out";
+  std::string out_dir = "tune_out";   ///< folder of every output (created)
   std::string config_override;        ///< scenario config instead of the sweep file's `config`
   /// "key=value" edits of the scenario config (the command line's --set): applied to its text before
   /// anything is loaded (io::configTextWithValues, comments kept where the keys are plain scalars), so
@@ -32,9 +33,9 @@ struct SessionOptions {
   int workers = 0;                    ///< 0: all cores
   int seeds_override = 0;             ///< > 0: seeds per setting instead of the file's
   bool measure_speedup = false;       ///< also run the sweep with one worker: parallel_speedup
-  bool skip_autotune = false;
-  const std::atomic<bool>* stop = nullptr;
-  bool quiet = false;
+  bool skip_autotune = false;         ///< leave out the sweep file's autotune section
+  const std::atomic<bool>* stop = nullptr;  ///< when it becomes true, no new run starts (optional)
+  bool quiet = false;                 ///< no progress lines on stderr
 };
 
 /// Sweep (+ optional auto-tune) session; returns the summary (also written to summary.json).
@@ -47,37 +48,41 @@ nlohmann::json runSweepSession(const AdapterRegistry& registry, const std::strin
 using LiveViewFactory =
     std::function<std::function<void(const LiveSample&)>(const std::string& title, double confidence)>;
 
+/// What a single seeded run session runs and where its outputs go.
 struct SingleRunOptions {
   std::string scenario;      ///< adapter name
   std::string config;        ///< scenario YAML
-  std::uint64_t seed = 1;
-  std::string out_dir = "tune_run";
+  std::uint64_t seed = 1;    ///< seed of the run
+  std::string out_dir = "tune_run";  ///< folder of the summary and report (created)
   std::string log_dir;       ///< scenario logs (CSV) of the run, "" = none
   bool display = false;      ///< live curves (live_view) + the scenario's view
-  LiveViewFactory live_view;
+  LiveViewFactory live_view; ///< the live curves' window (from the app; empty: none)
   std::vector<std::string> set;  ///< --set edits of the config (see SessionOptions::set)
-  AdapterOptions adapter_options;
-  bool quiet = false;
+  AdapterOptions adapter_options;  ///< --option values (checked against the adapter's declarations)
+  bool quiet = false;        ///< no progress on stderr
 };
+/// One seeded run with its metrics, consistency and plots; returns the summary (also summary.json).
 nlohmann::json runSingleSession(const AdapterRegistry& registry, const SingleRunOptions& options);
 
+/// What a noise auto-tuning session tunes, from which data, and where its outputs go.
 struct AutotuneSessionOptions {
-  std::string scenario;
-  std::string config;
+  std::string scenario;       ///< adapter name
+  std::string config;         ///< scenario YAML
   std::string log_dir;        ///< the scenario app's --log folder; "" = record a live run
-  std::uint64_t record_seed = 1000;
-  int record_runs = 1;
+  std::uint64_t record_seed = 1000;  ///< seed of the live recording
+  int record_runs = 1;        ///< runs of the live recording
   double start_scale = 1.0;   ///< start from the config's noise values times this
-  double outlier_prior = 0.05;
-  double span_decades = 2.5;
-  int grid_points = 11;
+  double outlier_prior = 0.05;  ///< AutotuneOptions::outlier_prior
+  double span_decades = 2.5;  ///< AutotuneOptions::span_decades
+  int grid_points = 11;       ///< AutotuneOptions::grid_points
   int verify_runs = 0;        ///< > 0: live runs of the tuned config for NEES/NIS (seeds 1..n)
-  int workers = 0;
-  std::string out_dir = "tune_autotune";
+  int workers = 0;            ///< threads; 0: all cores
+  std::string out_dir = "tune_autotune";  ///< folder of every output (created)
   std::vector<std::string> set;  ///< --set edits of the config (see SessionOptions::set)
-  AdapterOptions adapter_options;
-  bool quiet = false;
+  AdapterOptions adapter_options;  ///< --option values (checked against the adapter's declarations)
+  bool quiet = false;         ///< no progress lines on stderr
 };
+/// Noise auto-tuning with its report and tuned config; returns the summary (also summary.json).
 nlohmann::json runAutotuneSession(const AdapterRegistry& registry, const AutotuneSessionOptions& options);
 
 /// "1.23 0.98 0.50" (the 1, 5, 15 minute load averages) or "" when unavailable.

@@ -24,51 +24,62 @@
 
 namespace viewline::tuning {
 
+/// One metric of a setting over its seeds (finite values only).
 struct MetricStats {
-  double mean = 0.0;
+  double mean = 0.0;  ///< mean over seeds
   double std = 0.0;   ///< sample standard deviation over seeds (0 for one seed)
-  double min = 0.0, max = 0.0;
-  std::size_t n = 0;
+  double min = 0.0;   ///< smallest value
+  double max = 0.0;   ///< largest value
+  std::size_t n = 0;  ///< finite values
 };
 
+/// A setting's runs and their aggregate.
 struct SettingResult {
-  Setting setting;
+  Setting setting;               ///< the parameter values
   std::vector<RunResult> runs;   ///< in seed order
-  bool complete = false;
+  bool complete = false;         ///< every run finished without error
   std::string error;             ///< first run error, if any
-  std::map<std::string, MetricStats> metrics;
-  Consistency nees, nis;         ///< pooled over the runs
-  std::string verdict;
+  std::map<std::string, MetricStats> metrics;  ///< by metric name
+  Consistency nees;              ///< NEES pooled over the runs
+  Consistency nis;               ///< NIS pooled over the runs
+  std::string verdict;           ///< combinedVerdict of the pooled NEES and NIS
+  /// The setting as one JSON object (a results.jsonl line), parameters named as in `spec`.
   nlohmann::json toJson(const SweepSpec& spec) const;
 };
 
 /// Aggregates the runs of a setting (means, spreads, pooled consistency, verdict).
 void aggregate(SettingResult& r, double confidence);
 
+/// How far a sweep is.
 struct SweepProgress {
-  std::size_t done = 0, total = 0;
-  double elapsed_s = 0.0, eta_s = 0.0;
+  std::size_t done = 0;    ///< runs finished
+  std::size_t total = 0;   ///< runs in all
+  double elapsed_s = 0.0;  ///< s since the sweep started
+  double eta_s = 0.0;      ///< s still expected
 };
 
 /// "[37/100] 12.3 s elapsed, ETA 20 s".
 std::string formatProgress(const SweepProgress& p);
 
+/// How a sweep runs.
 struct SweepOptions {
   int workers = 0;                         ///< 0: std::thread::hardware_concurrency()
-  const std::atomic<bool>* stop = nullptr;
+  const std::atomic<bool>* stop = nullptr; ///< when it becomes true, no new run starts (optional)
   std::string results_jsonl;               ///< "" = no incremental file
-  std::function<void(const SweepProgress&)> progress;
+  std::function<void(const SweepProgress&)> progress;  ///< progress reports (optional)
   double progress_interval_s = 0.5;        ///< minimum time between progress calls (the last one always comes)
   bool series_for_first_seed = false;      ///< keep the time series of every setting's first run
 };
 
+/// What a sweep ran and found.
 struct SweepOutcome {
   std::vector<SettingResult> settings;     ///< every setting, by index (complete or not)
-  std::size_t jobs_done = 0, jobs_total = 0;
-  bool interrupted = false;
-  double wall_s = 0.0;
+  std::size_t jobs_done = 0;               ///< runs finished
+  std::size_t jobs_total = 0;              ///< runs in all
+  bool interrupted = false;                ///< stopped before every run finished
+  double wall_s = 0.0;                     ///< s of wall-clock time
   double cpu_s = 0.0;                      ///< process CPU time during the sweep
-  int workers = 1;
+  int workers = 1;                         ///< threads used
   std::optional<std::size_t> best;         ///< index into settings (complete settings only)
 };
 

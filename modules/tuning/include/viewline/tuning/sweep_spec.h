@@ -45,53 +45,63 @@
 
 namespace viewline::tuning {
 
-enum class SweepMode { Grid, Random };
+/// How the settings of a sweep are made.
+enum class SweepMode {
+  Grid,    ///< the cartesian product of every parameter's values
+  Random   ///< `samples` seeded draws
+};
 
+/// One swept scenario key (an entry of `parameters:`).
 struct SweepParameter {
-  std::string key;
+  std::string key;                   ///< dotted scenario key
   std::string location;              ///< "<file>:<line>:<col>" of the entry (for later errors)
   std::vector<YAML::Node> values;    ///< explicit values (grid points are generated into it)
-  bool has_range = false;
-  double lo = 0.0, hi = 0.0;
-  bool log_scale = false;
-  bool integer = false;
-  int count = 0;
+  bool has_range = false;            ///< given as `range: [lo, hi]`
+  double lo = 0.0;                   ///< low end of the range (the key's units)
+  double hi = 0.0;                   ///< high end of the range (the key's units)
+  bool log_scale = false;            ///< range points spaced in log
+  bool integer = false;              ///< range values are integers (`type: int`)
+  int count = 0;                     ///< grid points of the range
 };
 
+/// The `autotune:` section of a sweep file (see AutotuneOptions).
 struct AutotuneSpec {
-  bool enabled = false;
-  double start_scale = 1.0;
-  std::uint64_t record_seed = 1000;
-  int record_runs = 1;
-  double outlier_prior = 0.05;
-  double span_decades = 2.5;
-  int grid_points = 11;
+  bool enabled = false;              ///< the section is present
+  double start_scale = 1.0;          ///< start from the config's noise values times this
+  std::uint64_t record_seed = 1000;  ///< seed of the live recording
+  int record_runs = 1;               ///< runs of the live recording
+  double outlier_prior = 0.05;       ///< AutotuneOptions::outlier_prior
+  double span_decades = 2.5;         ///< AutotuneOptions::span_decades
+  int grid_points = 11;              ///< AutotuneOptions::grid_points
 };
 
+/// A sweep file as read (keys documented in the file comment).
 struct SweepSpec {
-  std::string file;
-  std::string scenario;
+  std::string file;                  ///< the sweep file's path
+  std::string scenario;              ///< adapter name
   std::string config_path;           ///< resolved against the sweep file's folder ("" when absent)
-  int seeds = 3;
-  std::uint64_t base_seed = 1;
-  std::string metric;
-  bool minimize = true;
-  SweepMode mode = SweepMode::Grid;
-  int samples = 0;
-  std::uint64_t sample_seed = 7;
-  double confidence = 0.99;
-  std::vector<SweepParameter> parameters;
-  AdapterOptions adapter_options;
-  AutotuneSpec autotune;
+  int seeds = 3;                     ///< runs per setting
+  std::uint64_t base_seed = 1;       ///< run j uses deriveSeed(base_seed, j)
+  std::string metric;                ///< the metric optimised
+  bool minimize = true;              ///< direction of `metric`
+  SweepMode mode = SweepMode::Grid;  ///< grid or random settings
+  int samples = 0;                   ///< settings drawn in random mode
+  std::uint64_t sample_seed = 7;     ///< seed of the random draws
+  double confidence = 0.99;          ///< of the NEES/NIS bands
+  std::vector<SweepParameter> parameters;  ///< the swept keys
+  AdapterOptions adapter_options;    ///< the `adapter:` map, checked, with defaults
+  AutotuneSpec autotune;             ///< the `autotune:` section
 };
 
 /// Parses a sweep file (strict keys; adapter options checked against the named adapter).
 SweepSpec loadSweepSpec(const std::string& path, const AdapterRegistry& registry);
+/// The same from YAML text; `name` names the file in messages, `config:` resolves against `base_dir`.
 SweepSpec sweepSpecFromString(const std::string& yaml, const std::string& name, const AdapterRegistry& registry,
                               const std::string& base_dir = ".");
 
+/// One setting of a sweep: a value per parameter.
 struct Setting {
-  std::size_t index = 0;
+  std::size_t index = 0;           ///< position in the sweep's settings
   std::vector<YAML::Node> values;  ///< one per parameter
   std::vector<double> numeric;     ///< numeric value per parameter (NaN for text values)
   std::string label() const;       ///< "tracker.accel_psd=0.5 gate=none" style (needs keys)
@@ -103,7 +113,7 @@ std::vector<Setting> generateSettings(const SweepSpec& spec);
 /// "k1=v1, k2=v2".
 std::string settingLabel(const SweepSpec& spec, const Setting& s);
 
-/// Applies a setting to a scenario tree.
+/// The scenario tree with the setting's values (editedTree: the untouched nodes keep the file's marks).
 YAML::Node applySetting(const YAML::Node& scenario, const SweepSpec& spec, const Setting& s);
 
 }  // namespace viewline::tuning
