@@ -1,10 +1,11 @@
 #pragma once
 // Fixed-size path of the linear square-root Kalman filter (kalman_filter.h) for small states
 // whose sizes are known at compile time (e.g. the 6-state ballistic filter with the 2 viewline
-// rows of one image): the same equations, the same array algorithm, the same validation, on
-// Eigen fixed-size matrices, so nothing is allocated and the loops have compile-time bounds.
+// rows of one image): the same equations and the same validation on Eigen fixed-size matrices,
+// so nothing is allocated and the loops have compile-time bounds.
 //
-//   Time update ([L] eqs 1-10, square-root form):   [Φ L  Gq] Θ = [L⁺ 0],  x ← Φ x + Γ u
+//   Time update ([L] eqs 1-10):  L⁺ = chol((Φ L)(Φ L)ᵀ + Q)  (or [Φ L  Gq] Θ = [L⁺ 0] when that
+//                                is only semi-definite),  x ← Φ x + Γ u
 //   Measurement update (filter form):
 //       [ C L   Ge ] Θ = [ S^½  0  ]     S^½ S^½ᵀ = R + C P Cᵀ,  w = S^-½ (y − C x),
 //       [ L     0  ]     [ K̄    L⁺ ]     x ← x + K̄ w,  NIS = |w|²
@@ -17,8 +18,8 @@
 // one validated by the previous call of this thread (per size) is reused. The dynamic path's
 // messages are used (core::InvalidInput naming the quantity).
 //
-// Results equal the dynamic path's to rounding (the same operations; the fixed-size products may
-// sum in another order): the tests compare them to 1e-12 relative.
+// Results equal the dynamic path's to rounding (the time update factors P⁺ by Cholesky instead
+// of QR; the fixed-size products may sum in another order): the tests compare them to 1e-12 relative.
 
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
@@ -180,13 +181,28 @@ void predict(FixedEstimate<N>& s, const FixedTransition<N, P>& tr) {
   }
   Eigen::Matrix<double, N, 1> x = tr.Phi * s.x;
   if constexpr (P > 0) x.noalias() += tr.Gamma * tr.u;
-  Eigen::Matrix<double, N, 2 * N, Eigen::RowMajor> pre;
-  pre.template leftCols<N>().noalias() = tr.Phi * s.L.template triangularView<Eigen::Lower>();
-  pre.template rightCols<N>() = Gq;
-  fixed_detail::lowerTriangularize(pre);
-  if (!x.allFinite() || !pre.template leftCols<N>().allFinite()) fixed_detail::throwNonFiniteResult("predict");
+  // Plain (lazy, unrolled) products: Eigen's triangular and rank-update kernels are blocked for
+  // large matrices and cost more than they save at these sizes.
+  const Eigen::Matrix<double, N, N> phiL = (tr.Phi * s.L).eval();
+  // P⁺ = (Φ L)(Φ L)ᵀ + Q is a sum of positive semi-definite terms (no cancellation, unlike the
+  // measurement update), so its Cholesky factor is as accurate as the QR of [Φ L  Gq] and costs
+  // a third. When P⁺ is only semi-definite the array algorithm gives the factor.
+  Eigen::Matrix<double, N, N> Pplus = tr.Q;
+  Pplus.noalias() += (phiL * phiL.transpose()).eval();
+  Eigen::LLT<Eigen::Matrix<double, N, N>> llt(Pplus);
+  Eigen::Matrix<double, N, N> L;
+  if (llt.info() == Eigen::Success) {
+    L = llt.matrixL();
+  } else {
+    Eigen::Matrix<double, N, 2 * N, Eigen::RowMajor> pre;
+    pre.template leftCols<N>() = phiL;
+    pre.template rightCols<N>() = Gq;
+    fixed_detail::lowerTriangularize(pre);
+    L = pre.template leftCols<N>();
+  }
+  if (!x.allFinite() || !L.allFinite()) fixed_detail::throwNonFiniteResult("predict");
   s.x = x;
-  s.L = pre.template leftCols<N>();
+  s.L = L;
   s.t += tr.dt;
 }
 
@@ -197,7 +213,7 @@ FixedUpdateReport<M> update(FixedEstimate<N>& s, const FixedMeasurement<N, M>& m
   if (!m.y.allFinite()) fixed_detail::throwNotFinite("measurement y");
   const auto& Ge = fixed_detail::validatedFactor<M, 1>(m.R, "measurement noise R (R2)", true);
   Eigen::Matrix<double, M + N, N + M, Eigen::RowMajor> pre;
-  pre.template topLeftCorner<M, N>().noalias() = m.C * s.L.template triangularView<Eigen::Lower>();
+  pre.template topLeftCorner<M, N>() = (m.C * s.L).eval();
   pre.template topRightCorner<M, M>() = Ge;
   pre.template bottomLeftCorner<N, N>() = s.L;
   pre.template bottomRightCorner<N, M>().setZero();
