@@ -3,6 +3,8 @@
 // latency budget of docs/results.md ("Latency"): exit status 1 when a measured p99 is more than
 // 20 % over its budget (run before a release; not in CI, whose timings are noisy).
 //
+// Table ball (320x240, config/table_ball.yaml): the first 6 s of frames of the scenario, replayed
+// through the observer (table and ball detection, rolling-ball filter) and the controller.
 // Ball catching (656x480, the default config's two cameras): the frames of real throws are
 // recorded from the scenario (catch_pipeline.h) and replayed through detector, tracker and
 // planner, pass after pass (the tracker and planner restart at each pass), until --frames frames
@@ -30,8 +32,11 @@
 
 #include "catch_pipeline.h"
 #include "latency_stats.h"
+#include "viewline/control/table_balancer.h"
 #include "viewline/core/frames.h"
 #include "viewline/core/random.h"
+#include "viewline/scenarios/table_ball.h"
+#include "viewline/scenarios/table_ball/world.h"
 
 #ifndef VIEWLINE_SOURCE_DIR
 #error "VIEWLINE_SOURCE_DIR must name the source tree (for the default config)"
@@ -93,6 +98,64 @@ CatchFigures ballCatching(const std::string& config, std::size_t frames_wanted) 
   out.track_window = latency::summarise(tw);
   out.plan_window = latency::summarise(pw);
   return out;
+}
+
+// ---- table ball ------------------------------------------------------------------------------
+
+struct TableFrame {
+  double t = 0.0;
+  cv::Mat image;
+  core::Camera camera;  ///< the observer's camera at capture
+  Eigen::Vector2d tilt = Eigen::Vector2d::Zero();
+  Eigen::Vector2d setpoint = Eigen::Vector2d::Zero();
+};
+
+// Frames of the default table-ball run (first `seconds`), replayed through the observer (table
+// and ball detection, rolling-ball filter) and the controller, as the loop calls them
+// (scenarios/table_ball/loop.cpp): c_R_w from the capture pose, the nominal table pose from the
+// arm's kinematics at the true tilt.
+latency::Stats tableBall(const std::string& config, double seconds, std::size_t frames_wanted, std::size_t& recorded) {
+  scenarios::TableBallConfig cfg = scenarios::tableBallConfigFromYaml(io::loadConfigWithValues(config, {}));
+  cfg.duration = seconds;
+  cfg.time_reference = false;
+  std::vector<TableFrame> frames;
+  scenarios::TableBallHooks hooks;
+  hooks.on_frame = [&](const scenarios::TableBallFrameView& v) {
+    if (v.image && v.camera && v.observer)
+      frames.push_back({v.observer->t, v.image->clone(), *v.camera, v.tilt, v.setpoint});
+    return true;
+  };
+  scenarios::runTableBall(cfg, 1, hooks);
+  if (frames.empty()) throw core::Error("table ball: the run produced no frames");
+  recorded = frames.size();
+  scenarios::TableBallWorld world(cfg, 1);  // kinematics (table pose), observer config, wrist
+  std::vector<double> times;
+  std::size_t timed = 0;
+  bool warm = false;
+  while (timed < frames_wanted) {
+    scenarios::TableBallObserver observer(world.observerCamera(), world.observerConfig());
+    control::TableBalancer controller(cfg.controllerConfig(world.wrist()));
+    double sink = 0.0;
+    for (const auto& f : frames) {
+      const Eigen::Matrix3d c_R_w = f.camera.c_M_w.rotation();
+      const Eigen::Isometry3d c_M_t_nominal = f.camera.c_M_w * world.tablePose(f.tilt);
+      const double t0 = latency::threadCpuNow();
+      const scenarios::ObserverFrame& of = observer.process(f.image, f.t, c_R_w, c_M_t_nominal);
+      if (of.estimate_valid) {
+        const control::TiltRamp r = controller.update(f.t, Eigen::Vector2d(of.x[0], of.x[2]),
+                                                      Eigen::Vector2d(of.x[1], of.x[3]), f.setpoint);
+        sink += r.rate.x();
+      }
+      const double dt = latency::threadCpuNow() - t0;
+      if (warm) {
+        times.push_back(dt);
+        ++timed;
+      }
+    }
+    warm = true;  // the first pass warms buffers and caches
+    if (!std::isfinite(sink)) throw core::Error("table ball: non-finite controller output");
+  }
+  return latency::summarise(times);
 }
 
 // ---- scaling ---------------------------------------------------------------------------------
@@ -191,6 +254,14 @@ int main(int argc, char** argv) {
     printStats("tracking: full-frame searches", bc.full_in_tracking);
     printStats("acquisition: every frame searched whole", bc.acquisition);
 
+    std::size_t table_recorded = 0;
+    const latency::Stats tb =
+        tableBall(std::string(VIEWLINE_SOURCE_DIR) + "/config/table_ball.yaml", 6.0, frames, table_recorded);
+    std::printf("\n## Table ball, 320x240, observer (table + ball detection, filter) + controller (%zu recorded frames replayed)\n\n",
+                table_recorded);
+    std::printf("| sample | frames | median (us) | p99 (us) | mean (us) |\n|---|---|---|---|---|\n");
+    printStats("every frame", tb);
+
     std::printf("\n## Scaling: K cameras at 100 Hz into one tracker (%.1f s of data each)\n\n", scaling_seconds);
     std::printf("| cameras | images | fused | share of one core (%%) |\n|---|---|---|---|\n");
     std::vector<ScalingPoint> pts;
@@ -218,6 +289,7 @@ int main(int argc, char** argv) {
     const std::vector<Budget> budgets{
         {"ball catching, tracking (window) p99", 0.5e-3, bc.window.p99},
         {"ball catching, acquisition (full frame) p99", 1.5e-3, bc.acquisition.p99},
+        {"table ball, per frame p99", 0.3e-3, tb.p99},
         {"64 cameras at 100 Hz, share of one core", 0.10, pts.back().core_fraction},
     };
     std::printf("\n## Budget check (fails above 1.2 x budget)\n\n| figure | budget | measured | ratio | verdict |\n|---|---|---|---|---|\n");
