@@ -5,6 +5,8 @@
 //
 // Table ball (320x240, config/table_ball.yaml): the first 6 s of frames of the scenario, replayed
 // through the observer (table and ball detection, rolling-ball filter) and the controller.
+// Pan-tilt (640x480, config/pan_tilt_rectangle.yaml): the first 6 s of the predictive
+// controller's frames, replayed through detection, back-projection, target filter and law.
 // Ball catching (656x480, the default config's two cameras): the frames of real throws are
 // recorded from the scenario (catch_pipeline.h) and replayed through detector, tracker and
 // planner, pass after pass (the tracker and planner restart at each pass), until --frames frames
@@ -35,6 +37,10 @@
 #include "viewline/control/table_balancer.h"
 #include "viewline/core/frames.h"
 #include "viewline/core/random.h"
+#include "viewline/scenarios/pan_tilt/loop.h"
+#include "viewline/scenarios/pan_tilt/telemetry.h"
+#include "viewline/scenarios/pan_tilt/world.h"
+#include "viewline/scenarios/pan_tilt_scenario.h"
 #include "viewline/scenarios/table_ball.h"
 #include "viewline/scenarios/table_ball/world.h"
 
@@ -158,6 +164,107 @@ latency::Stats tableBall(const std::string& config, double seconds, std::size_t 
   return latency::summarise(times);
 }
 
+// ---- pan-tilt ---------------------------------------------------------------------------------
+
+struct PanTiltFrame {
+  double t = 0.0;  ///< capture time
+  cv::Mat image;
+  Eigen::Vector2d q = Eigen::Vector2d::Zero(), qdot = Eigen::Vector2d::Zero();  ///< joints at the command
+};
+
+// Keeps the images and joint readings of the predictive controller's run.
+class PanTiltRecorder final : public scenarios::pan_tilt::FrameSink {
+public:
+  explicit PanTiltRecorder(std::size_t max_frames) : max_(max_frames) {}
+  void frame(const scenarios::pan_tilt::FrameRecord& r) override {
+    if (r.image && frames.size() < max_) frames.push_back({r.t, r.image->clone(), r.q, r.qdot});
+  }
+  std::vector<PanTiltFrame> frames;
+
+private:
+  std::size_t max_;
+};
+
+// Frames of the default pan-tilt run (rectangle path), replayed through what the loop does per
+// frame (scenarios/pan_tilt/loop.cpp): [T]'s screen-target detector, the back-projection onto
+// the screen through the camera at the joint reading, the predictive controller's observe()
+// (the constant-speed-leg target filter) and command(). The [T] measurement noise is left out
+// (a draw), the rest is the same work.
+struct PanTiltFigures {
+  latency::Stats total, detect, filter, law;
+};
+
+PanTiltFigures panTilt(const std::string& config, double seconds, std::size_t frames_wanted, std::size_t& recorded) {
+  scenarios::PanTiltScenarioConfig cfg = scenarios::loadPanTiltScenarioConfig(io::loadConfigWithValues(config, {}));
+  cfg.duration = seconds;
+  cfg.run_baseline = false;
+  PanTiltRecorder rec(200);
+  scenarios::PanTiltRunIo io;
+  io.frames = &rec;
+  scenarios::runPanTilt(cfg, 1, scenarios::PanTiltControllerKind::Predictive, io);
+  if (rec.frames.empty()) throw core::Error("pan-tilt: the run produced no frames");
+  recorded = rec.frames.size();
+  scenarios::pan_tilt::World world(cfg, 1);
+  const double latency = world.unit().commandLatency();
+  const double period = 1.0 / cfg.fps;
+  const auto& kin = world.modelKinematics();
+  core::Camera model_cam = scenarios::panTiltModelCamera(cfg);
+  const Eigen::Isometry3d screen_M_f = world.f_M_screen().inverse();
+  std::vector<double> times, t_detect, t_filter, t_law;
+  std::size_t timed = 0;
+  bool warm = false;
+  while (timed < frames_wanted) {
+    vision::ScreenTargetDetector detector(cfg.detector);
+    control::PredictiveConfig pc = cfg.control;
+    pc.filter.particle_seed = core::deriveSeed(1, 78);
+    control::PredictivePanTiltController ctrl(pc, cfg.unit.limits, latency, world.f_M_screen(), kin);
+    std::vector<robots::IssuedCommand> recent;
+    double sink = 0.0;
+    for (const auto& f : rec.frames) {
+      const double t0 = latency::threadCpuNow();
+      control::TargetObservation obs;
+      obs.stamp = f.t;
+      const auto det = detector.detect(f.image, f.t);
+      model_cam.c_M_w = kin.c_M_f(f.q);
+      if (det.ok()) {
+        const Eigen::Vector3d o_s = screen_M_f * model_cam.center_w();
+        const Eigen::Vector3d d_s = screen_M_f.linear() * model_cam.rayThroughPixel_w(det.value().pixel);
+        if (d_s.z() > 1e-9) {
+          const Eigen::Vector3d hit = o_s + (-o_s.z() / d_s.z()) * d_s;
+          const Eigen::Vector3d meas_c = model_cam.toCamera(world.f_M_screen() * Eigen::Vector3d(hit.x(), hit.y(), 0.0));
+          obs.detected = meas_c.z() > 0.0;
+          obs.plane = hit.head<2>();
+          obs.plane_cov = world.R();
+          obs.feature = Eigen::Vector2d(meas_c.x() / meas_c.z(), meas_c.y() / meas_c.z());
+        }
+      }
+      const double t1 = latency::threadCpuNow();
+      ctrl.observe(obs);
+      const double t2 = latency::threadCpuNow();
+      control::ControlInput in;
+      in.t = f.t + cfg.processing_delay;
+      in.joints = {in.t, f.q, f.qdot};
+      in.recent = recent;
+      in.period = period;
+      const control::ControlOutput out = ctrl.command(in);
+      recent.push_back({in.t, out.qdot});
+      if (recent.size() > 4) recent.erase(recent.begin());
+      sink += out.qdot.x();
+      const double t3 = latency::threadCpuNow();
+      if (warm) {
+        times.push_back(t3 - t0);
+        t_detect.push_back(t1 - t0);
+        t_filter.push_back(t2 - t1);
+        t_law.push_back(t3 - t2);
+        ++timed;
+      }
+    }
+    warm = true;
+    if (!std::isfinite(sink)) throw core::Error("pan-tilt: non-finite command");
+  }
+  return {latency::summarise(times), latency::summarise(t_detect), latency::summarise(t_filter), latency::summarise(t_law)};
+}
+
 // ---- scaling ---------------------------------------------------------------------------------
 
 struct ScalingPoint {
@@ -262,6 +369,17 @@ int main(int argc, char** argv) {
     std::printf("| sample | frames | median (us) | p99 (us) | mean (us) |\n|---|---|---|---|---|\n");
     printStats("every frame", tb);
 
+    std::size_t pan_recorded = 0;
+    const PanTiltFigures pt_frames =
+        panTilt(std::string(VIEWLINE_SOURCE_DIR) + "/config/pan_tilt_rectangle.yaml", 6.0, frames, pan_recorded);
+    std::printf("\n## Pan-tilt, 640x480, detection + back-projection + target filter + control law (%zu recorded frames replayed)\n\n",
+                pan_recorded);
+    std::printf("| sample | frames | median (us) | p99 (us) | mean (us) |\n|---|---|---|---|---|\n");
+    printStats("every frame", pt_frames.total);
+    printStats("  of which detection + back-projection", pt_frames.detect);
+    printStats("  of which target filter (observe)", pt_frames.filter);
+    printStats("  of which control law (command)", pt_frames.law);
+
     std::printf("\n## Scaling: K cameras at 100 Hz into one tracker (%.1f s of data each)\n\n", scaling_seconds);
     std::printf("| cameras | images | fused | share of one core (%%) |\n|---|---|---|---|\n");
     std::vector<ScalingPoint> pts;
@@ -290,6 +408,7 @@ int main(int argc, char** argv) {
         {"ball catching, tracking (window) p99", 0.5e-3, bc.window.p99},
         {"ball catching, acquisition (full frame) p99", 1.5e-3, bc.acquisition.p99},
         {"table ball, per frame p99", 0.3e-3, tb.p99},
+        {"pan-tilt, per frame p99 (with the target filter)", 0.5e-3, pt_frames.total.p99},
         {"64 cameras at 100 Hz, share of one core", 0.10, pts.back().core_fraction},
     };
     std::printf("\n## Budget check (fails above 1.2 x budget)\n\n| figure | budget | measured | ratio | verdict |\n|---|---|---|---|---|\n");
