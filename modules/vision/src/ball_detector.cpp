@@ -66,8 +66,9 @@ BallDetector::BallDetector(BallDetectorConfig config, std::optional<core::Camera
 
 Result<BallMeasurement> BallDetector::detect(const cv::Mat& bgr, core::Timestamp stamp,
                                              const std::optional<Eigen::Vector2d>& predicted) {
-  requireBgrImage(bgr, "BallDetector::detect");
-  core::requireFinite(stamp, "BallDetector::detect: stamp");
+  // Test first, name the failure after (the checks take std::string: a heap allocation per frame).
+  if (bgr.empty() || bgr.type() != CV_8UC3) requireBgrImage(bgr, "BallDetector::detect");
+  if (!std::isfinite(stamp)) core::requireFinite(stamp, "BallDetector::detect: stamp");
   const cv::Rect full(0, 0, bgr.cols, bgr.rows);
   bool cut = false;
   if (predicted && std::isfinite(predicted->x()) && std::isfinite(predicted->y())) {
