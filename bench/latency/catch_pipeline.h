@@ -80,7 +80,8 @@ public:
     double plan = 0.0;    ///< planner update (when fused) + set point
   };
 
-  /// One frame (a frame of another throw than the last restarts tracker and planner); `acquisition`: no predicted pixel (the detector searches the full frame).
+  /// One frame (a frame of another throw than the last restarts tracker and planner);
+  /// `acquisition`: no predicted pixel (the detector searches the full frame).
   /// Returns whether the detector found the ball in the window around the prediction. With
   /// `clock` (a function returning seconds) the stages are timed into `stages`.
   bool process(const CatchRecordedFrame& f, bool acquisition, double (*clock)() = nullptr,

@@ -3,10 +3,11 @@
 // latency budget of docs/results.md ("Latency"): exit status 1 when a measured p99 is more than
 // 20 % over its budget (run before a release; not in CI, whose timings are noisy).
 //
-// Table ball (320x240, config/table_ball.yaml): the first 6 s of frames of the scenario, replayed
-// through the observer (table and ball detection, rolling-ball filter) and the controller.
-// Pan-tilt (640x480, config/pan_tilt_rectangle.yaml): the first 6 s of the predictive
-// controller's frames, replayed through detection, back-projection, target filter and law.
+// Table ball (320x240, config/table_ball.yaml): the frames of the first --record-seconds (6 s)
+// of the scenario, replayed through the observer (table and ball detection, rolling-ball filter)
+// and the controller.
+// Pan-tilt (640x480, config/pan_tilt_rectangle.yaml): the predictive controller's frames of the
+// first --record-seconds (6 s), replayed through detection, back-projection, target filter and law.
 // Ball catching (656x480, the default config's two cameras): the frames of real throws are
 // recorded from the scenario (catch_pipeline.h) and replayed through detector, tracker and
 // planner, pass after pass (the tracker and planner restart at each pass), until --frames frames
@@ -20,8 +21,8 @@
 // time per second of data is the fraction of one core; a least-squares line over K = 1..64 gives
 // the cost per camera and the residual.
 //
-//   nice -n 10 build/bench/latency_frames [--frames 10000] [--scaling-seconds 2] [--check]
-//       [--config config/ball_catching.yaml]
+//   nice -n 10 build/bench/latency_frames [--frames 10000] [--scaling-seconds 2] [--throws 2]
+//       [--record-seconds 6] [--config config/ball_catching.yaml] [--check]
 
 #include <Eigen/Geometry>
 #include <opencv2/core/utility.hpp>
@@ -64,9 +65,9 @@ struct CatchFigures {
   std::size_t recorded = 0;
 };
 
-CatchFigures ballCatching(const std::string& config, std::size_t frames_wanted) {
+CatchFigures ballCatching(const std::string& config, int throws, std::size_t frames_wanted) {
   const scenarios::BallCatchingConfig cfg = latency::catchConfig(config);
-  const auto frames = latency::recordCatchFrames(cfg, 2, 1, 400);
+  const auto frames = latency::recordCatchFrames(cfg, throws, 1, 400);
   if (frames.empty()) throw core::Error("ball catching: the throws produced no frames");
   CatchFigures out;
   out.recorded = frames.size();
@@ -331,7 +332,8 @@ void printStats(const char* what, const latency::Stats& s) {
 int main(int argc, char** argv) {
   cv::setNumThreads(1);
   std::size_t frames = 10000;
-  double scaling_seconds = 2.0;
+  double scaling_seconds = 2.0, record_seconds = 6.0;
+  int throws = 2;
   bool check = false;
   std::string config = std::string(VIEWLINE_SOURCE_DIR) + "/config/ball_catching.yaml";
   for (int i = 1; i < argc; ++i) {
@@ -339,19 +341,24 @@ int main(int argc, char** argv) {
     if (i + 1 < argc && a == "--frames") frames = static_cast<std::size_t>(std::atol(argv[++i]));
     else if (i + 1 < argc && a == "--scaling-seconds") scaling_seconds = std::atof(argv[++i]);
     else if (i + 1 < argc && a == "--config") config = argv[++i];
+    else if (i + 1 < argc && a == "--throws") throws = std::atoi(argv[++i]);
+    else if (i + 1 < argc && a == "--record-seconds") record_seconds = std::atof(argv[++i]);
     else if (a == "--check") check = true;
     else {
-      std::fprintf(stderr, "usage: %s [--frames N>=1] [--scaling-seconds S>0] [--config FILE] [--check]\n", argv[0]);
+      std::fprintf(stderr,
+                   "usage: %s [--frames N>=1] [--scaling-seconds S>0] [--throws N>=1] [--record-seconds S>=1] "
+                   "[--config FILE] [--check]\n",
+                   argv[0]);
       return 2;
     }
   }
-  if (frames < 1 || !(scaling_seconds > 0.0)) {
-    std::fprintf(stderr, "%s: --frames must be >= 1 and --scaling-seconds > 0\n", argv[0]);
+  if (frames < 1 || !(scaling_seconds > 0.0) || throws < 1 || !(record_seconds >= 1.0)) {
+    std::fprintf(stderr, "%s: --frames and --throws must be >= 1, --scaling-seconds > 0, --record-seconds >= 1\n", argv[0]);
     return 2;
   }
   try {
     std::printf("# Per-frame processing (thread CPU time, one core); load %s\n\n", latency::loadAverage().c_str());
-    const CatchFigures bc = ballCatching(config, frames);
+    const CatchFigures bc = ballCatching(config, throws, frames);
     std::printf("## Ball catching, 656x480, detect + track + plan (%zu recorded frames replayed)\n\n", bc.recorded);
     std::printf("| sample | frames | median (us) | p99 (us) | mean (us) |\n|---|---|---|---|---|\n");
     printStats("tracking: ball found in the window", bc.window);
@@ -363,7 +370,7 @@ int main(int argc, char** argv) {
 
     std::size_t table_recorded = 0;
     const latency::Stats tb =
-        tableBall(std::string(VIEWLINE_SOURCE_DIR) + "/config/table_ball.yaml", 6.0, frames, table_recorded);
+        tableBall(std::string(VIEWLINE_SOURCE_DIR) + "/config/table_ball.yaml", record_seconds, frames, table_recorded);
     std::printf("\n## Table ball, 320x240, observer (table + ball detection, filter) + controller (%zu recorded frames replayed)\n\n",
                 table_recorded);
     std::printf("| sample | frames | median (us) | p99 (us) | mean (us) |\n|---|---|---|---|---|\n");
@@ -371,7 +378,7 @@ int main(int argc, char** argv) {
 
     std::size_t pan_recorded = 0;
     const PanTiltFigures pt_frames =
-        panTilt(std::string(VIEWLINE_SOURCE_DIR) + "/config/pan_tilt_rectangle.yaml", 6.0, frames, pan_recorded);
+        panTilt(std::string(VIEWLINE_SOURCE_DIR) + "/config/pan_tilt_rectangle.yaml", record_seconds, frames, pan_recorded);
     std::printf("\n## Pan-tilt, 640x480, detection + back-projection + target filter + control law (%zu recorded frames replayed)\n\n",
                 pan_recorded);
     std::printf("| sample | frames | median (us) | p99 (us) | mean (us) |\n|---|---|---|---|---|\n");
