@@ -27,6 +27,7 @@
 #include <Eigen/Geometry>
 #include <opencv2/core/utility.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -198,6 +199,7 @@ struct PanTiltFigures {
 PanTiltFigures panTilt(const std::string& config, double seconds, std::size_t frames_wanted, std::size_t& recorded) {
   scenarios::PanTiltScenarioConfig cfg = scenarios::loadPanTiltScenarioConfig(io::loadConfigWithValues(config, {}));
   cfg.duration = seconds;
+  cfg.metrics_start = std::min(cfg.metrics_start, 0.5 * seconds);  // scoring only; short recordings
   cfg.run_baseline = false;
   PanTiltRecorder rec(200);
   scenarios::PanTiltRunIo io;
