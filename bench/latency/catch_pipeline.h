@@ -58,6 +58,7 @@ inline std::vector<CatchRecordedFrame> recordCatchFrames(const scenarios::BallCa
 /// Detector per camera, tracker and planner of one throw, as ThrowLoop wires them.
 class CatchPipeline {
 public:
+  /// The parts of one throw for `cfg` (which must outlive the pipeline).
   explicit CatchPipeline(const scenarios::BallCatchingConfig& cfg)
       : cfg_(cfg), robot_(cfg.robot), planner_(cfg.plannerConfig(), robot_), tracker_(cameras(cfg), cfg.tracker) {
     for (const auto& c : tracker_.cameras()) detectors_.emplace_back(cfg.detector, c);
@@ -123,6 +124,7 @@ public:
     return in_window;
   }
 
+  /// The tracker (initialised() tells whether a track is held).
   const tracking::ViewlineTracker& tracker() const { return tracker_; }
   /// Planner updates that predicted a crossing (keeps the work observable).
   std::size_t crossings() const { return crossings_; }

@@ -82,12 +82,17 @@ struct FixedUpdateReport {
 
 namespace fixed_detail {
 
-/// Throw core::InvalidInput with the dynamic path's message for `what` (kalman_filter.cpp).
+/// Throws core::InvalidInput: matrix `what` has NaN or Inf (the dynamic path's message).
 [[noreturn]] void throwNotFinite(const char* what);
+/// Throws core::InvalidInput: scalar `what` is NaN or Inf.
 [[noreturn]] void throwNotFiniteScalar(const char* what);
+/// Throws core::InvalidInput: covariance `what` is not symmetric positive (semi-)definite.
 [[noreturn]] void throwBadCovariance(const Eigen::MatrixXd& M, const char* what, bool definite);
+/// Throws core::InvalidInput: transition dt < 0.
 [[noreturn]] void throwNegativeDt();
+/// Throws core::NumericalError: `step` (predict or update) produced NaN or Inf.
 [[noreturn]] void throwNonFiniteResult(const char* step);
+/// Throws core::NumericalError: the innovation covariance factor has a zero pivot.
 [[noreturn]] void throwSingularInnovation();
 
 /// Factor of a positive semi-definite (not definite) matrix, as psdSqrt (square_root.h).
@@ -111,9 +116,9 @@ bool finiteAndSymmetric(const Mat& m) {
 /// A validated covariance and its factor, per thread, size and role (0: Q, 1: R).
 template <int K, int Role>
 struct FactorCache {
-  Eigen::Matrix<double, K, K> M;
-  Eigen::Matrix<double, K, K> G;
-  bool valid = false;
+  Eigen::Matrix<double, K, K> M;  ///< the covariance validated last
+  Eigen::Matrix<double, K, K> G;  ///< its factor, G Gᵀ = M
+  bool valid = false;             ///< M and G hold a validated pair
 };
 
 /// Square-root factor G (G Gᵀ = M) of a validated covariance (see the file comment).
