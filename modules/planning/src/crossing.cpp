@@ -84,13 +84,13 @@ std::optional<MeanCrossing> meanCrossing(const Vector6& x0, const CrossingPlane&
   double h = h0;
   while (tau < m.max_horizon) {
     const double dt = std::min(m.step, m.max_horizon - tau);
-    const Vector6 xn = d.propagate(x, dt);
+    const Vector6 xn = d.propagateFixed(x, dt);
     const double hn = n.dot(xn.head<3>() - pl.point);
     if (hn <= 0.0) {
       // Newton from the bracketing state x (at tau, h > 0).
       double s = dt * h / (h - hn);  // secant start
       for (int it = 0; it < 20; ++it) {
-        const Vector6 xs = s > 0.0 ? Vector6(d.propagate(x, s)) : x;
+        const Vector6 xs = s > 0.0 ? d.propagateFixed(x, s) : x;
         const double hs = n.dot(xs.head<3>() - pl.point);
         const double vs = n.dot(xs.tail<3>());
         if (!(vs < 0.0)) break;
@@ -98,7 +98,7 @@ std::optional<MeanCrossing> meanCrossing(const Vector6& x0, const CrossingPlane&
         s = std::clamp(s + ds, 0.0, dt);
         if (std::abs(ds) < 1e-12) break;
       }
-      const Vector6 xc = s > 0.0 ? Vector6(d.propagate(x, s)) : x;
+      const Vector6 xc = s > 0.0 ? d.propagateFixed(x, s) : x;
       if (!(n.dot(xc.tail<3>()) < 0.0)) return std::nullopt;
       return MeanCrossing{tau + s, xc};
     }
@@ -151,10 +151,13 @@ std::optional<Crossing> predictCrossing(const estimation::StateEstimate& est, co
   } else {
     estimation::DragBallisticModel d = dragModel(model);
     d.substeps = std::max(2, static_cast<int>(std::ceil(tau / 0.02)));
-    F = d.jacobian(x0, tau);
+    F = d.jacobianFixed(x0, tau);
     if (model.accel_psd > 0.0) Q = d.processNoise(x0, tau);
   }
-  const Matrix6 P = est.P();
+  // est.P() without its temporary: the same product, evaluated into a per-thread buffer.
+  thread_local Eigen::MatrixXd P_buffer(6, 6);
+  P_buffer.noalias() = est.sqrtP() * est.sqrtP().transpose();
+  const Matrix6 P = P_buffer;
   const Matrix6 Pt = F * P * F.transpose() + Q;
   const Eigen::Matrix3d Ppp = 0.5 * (Pt.topLeftCorner<3, 3>() + Pt.topLeftCorner<3, 3>().transpose());
   const Eigen::Vector3d& n = plane.normal;

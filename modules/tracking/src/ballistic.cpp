@@ -1,5 +1,7 @@
 #include "viewline/tracking/ballistic.h"
 
+#include <cmath>
+
 #include "viewline/core/checks.h"
 
 namespace viewline::tracking {
@@ -13,10 +15,10 @@ Matrix6 BallisticModel::processNoise(double dt) const {
 }
 
 estimation::LinearTransition BallisticModel::transition(double dt) const {
-  core::requireFinite(dt, "ballistic transition dt");
+  if (!std::isfinite(dt)) core::requireFinite(dt, "ballistic transition dt");
   if (dt < 0.0) throw core::InvalidInput("ballistic transition dt is negative (expected >= 0)");
   if (!(accel_psd >= 0.0)) throw core::InvalidInput("ballistic model accel_psd must be >= 0");
-  core::requireFinite(gravity_w, "ballistic model gravity_w");
+  if (!gravity_w.allFinite()) core::requireFinite(gravity_w, "ballistic model gravity_w");
   const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
   estimation::LinearTransition tr;
   tr.Phi = Eigen::MatrixXd::Identity(6, 6);

@@ -50,8 +50,8 @@ double chi2Threshold(Eigen::Index m, double alpha) {
 }  // namespace
 
 GateReport evaluateGate(const Eigen::VectorXd& d, const Eigen::MatrixXd& R, const GateConfig& cfg) {
-  core::requireSize(R, d.size(), d.size(), "gate: innovation covariance");
-  core::requireFinite(d, "gate: innovation");
+  if (R.rows() != d.size() || R.cols() != d.size()) core::requireSize(R, d.size(), d.size(), "gate: innovation covariance");
+  if (!d.allFinite()) core::requireFinite(d, "gate: innovation");
   if (!(cfg.directional_p > 0.0)) throw core::InvalidInput("gate: directional_p must be > 0");
   if (!(cfg.mahalanobis_alpha > 0.0 && cfg.mahalanobis_alpha < 1.0))
     throw core::InvalidInput("gate: mahalanobis_alpha must be in (0, 1)");

@@ -277,7 +277,7 @@ Refusal ViewlineTracker::submit(const ImageMeasurement& m) {
 
 estimation::StateEstimate ViewlineTracker::predictAt(core::Timestamp t) const {
   if (!initialised()) throw core::InvalidInput("tracker: predictAt before any measurement");
-  core::requireFinite(t, "tracker: predictAt time");
+  if (!std::isfinite(t)) core::requireFinite(t, "tracker: predictAt time");
   if (t < state_.est.t()) throw core::InvalidInput("tracker: predictAt time is before the estimate's time");
   estimation::StateEstimate s = state_.est;
   if (t > s.t()) {

@@ -16,7 +16,7 @@ ViewlinePlanes viewlinePlanes(const core::Camera& camera, const Eigen::Vector2d&
   core::requireFinite(uv, "viewline: pixel");
   ViewlinePlanes out;
   out.xy = camera.pixelToNormalized(uv);
-  core::requireFinite(out.xy, "viewline: undistorted pixel");
+  if (!out.xy.allFinite()) core::requireFinite(out.xy, "viewline: undistorted pixel");
   const Eigen::Matrix<double, 3, 4> Pc = camera.normalizedProjection();
   const Eigen::Vector3d lx(-1.0, 0.0, out.xy.x());
   const Eigen::Vector3d ly(0.0, -1.0, out.xy.y());
@@ -39,7 +39,7 @@ Eigen::Matrix2d undistortionJacobian(const core::Camera& camera, const Eigen::Ve
 }
 
 Eigen::Vector2d exactPixelOf(const core::Camera& camera, const Eigen::Vector2d& xy) {
-  core::requireFinite(xy, "exactPixelOf: normalised point");
+  if (!xy.allFinite()) core::requireFinite(xy, "exactPixelOf: normalised point");
   Eigen::Vector2d uv = camera.normalizedToPixel(xy);
   for (int it = 0; it < 20; ++it) {
     const Eigen::Vector2d r = camera.pixelToNormalized(uv) - xy;
@@ -51,8 +51,8 @@ Eigen::Vector2d exactPixelOf(const core::Camera& camera, const Eigen::Vector2d& 
 
 Eigen::Matrix2d viewlineRowNoise(const core::Camera& camera, const Eigen::Vector2d& uv,
                                  const ViewlinePlanes& planes, double sigma_px, double depth_sq) {
-  core::requirePositive(sigma_px, "viewline: pixel noise sigma_px");
-  core::requirePositive(depth_sq, "viewline: expected squared depth");
+  if (!(std::isfinite(sigma_px) && sigma_px > 0.0)) core::requirePositive(sigma_px, "viewline: pixel noise sigma_px");
+  if (!(std::isfinite(depth_sq) && depth_sq > 0.0)) core::requirePositive(depth_sq, "viewline: expected squared depth");
   const Eigen::Matrix2d J = undistortionJacobian(camera, uv);
   Eigen::Matrix2d D = Eigen::Matrix2d::Zero();
   D(0, 0) = 1.0 / std::sqrt(1.0 + planes.xy.x() * planes.xy.x());
@@ -79,7 +79,7 @@ double expectedSquaredDepth(const core::Camera& camera, const Vector6& x, const 
 
 ViewlineRows viewlineRowsWithDepth(const core::Camera& camera, const Eigen::Vector2d& uv, double sigma_px,
                                    double dt_offset, const BallisticModel& model, double depth_sq) {
-  core::requireFinite(dt_offset, "viewline: capture-time offset dt");
+  if (!std::isfinite(dt_offset)) core::requireFinite(dt_offset, "viewline: capture-time offset dt");
   const ViewlinePlanes planes = viewlinePlanes(camera, uv);
   ViewlineRows rows;
   const Eigen::Vector4d* pis[2] = {&planes.pi_x, &planes.pi_y};
@@ -101,7 +101,7 @@ ViewlineRows viewlineRowsWithDepth(const core::Camera& camera, const Eigen::Vect
 ViewlineRows viewlineRows(const core::Camera& camera, const Eigen::Vector2d& uv, double sigma_px,
                           const Vector6& predicted, const Matrix6& P, double dt_offset,
                           const BallisticModel& model, double min_depth, bool depth_variance_in_noise) {
-  core::requireFinite(dt_offset, "viewline: capture-time offset dt");
+  if (!std::isfinite(dt_offset)) core::requireFinite(dt_offset, "viewline: capture-time offset dt");
   const double depth_sq =
       expectedSquaredDepth(camera, predicted, P, dt_offset, model, min_depth, depth_variance_in_noise);
   return viewlineRowsWithDepth(camera, uv, sigma_px, dt_offset, model, depth_sq);

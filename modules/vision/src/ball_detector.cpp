@@ -66,8 +66,9 @@ BallDetector::BallDetector(BallDetectorConfig config, std::optional<core::Camera
 
 Result<BallMeasurement> BallDetector::detect(const cv::Mat& bgr, core::Timestamp stamp,
                                              const std::optional<Eigen::Vector2d>& predicted) {
-  requireBgrImage(bgr, "BallDetector::detect");
-  core::requireFinite(stamp, "BallDetector::detect: stamp");
+  // Test first, name the failure after (the checks take std::string: a heap allocation per frame).
+  if (bgr.empty() || bgr.type() != CV_8UC3) requireBgrImage(bgr, "BallDetector::detect");
+  if (!std::isfinite(stamp)) core::requireFinite(stamp, "BallDetector::detect: stamp");
   const cv::Rect full(0, 0, bgr.cols, bgr.rows);
   bool cut = false;
   if (predicted && std::isfinite(predicted->x()) && std::isfinite(predicted->y())) {
@@ -94,7 +95,10 @@ Result<BallMeasurement> BallDetector::detectIn(const cv::Mat& bgr, const cv::Rec
   if (!close_kernel_.empty()) cv::morphologyEx(mask_, mask_, cv::MORPH_CLOSE, close_kernel_);
   cv::findContours(mask_, contours_, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_NONE, roi.tl());
 
-  std::vector<Candidate> candidates;
+  // Reused between calls (per thread: the detector itself is used by one thread at a time), so
+  // the steady-state path does not allocate.
+  thread_local std::vector<Candidate> candidates;
+  candidates.clear();
   double largest_tiny = 0.0;
   for (std::size_t i = 0; i < contours_.size(); ++i) {
     const auto& c = contours_[i];
@@ -124,16 +128,20 @@ Result<BallMeasurement> BallDetector::detectIn(const cv::Mat& bgr, const cv::Rec
     candidates.push_back(cand);
   }
 
-  std::ostringstream where;
-  where << (is_full ? "full frame" : "window") << " [" << roi.x << "," << roi.y << " " << roi.width
-        << "x" << roi.height << "]";
+  // Where the search ran, for the failure messages only (built on failure: no allocation otherwise).
+  const auto where = [&] {
+    std::ostringstream w;
+    w << (is_full ? "full frame" : "window") << " [" << roi.x << "," << roi.y << " " << roi.width << "x"
+      << roi.height << "]";
+    return w;
+  };
   if (candidates.empty()) {
     if (largest_tiny > 0.0)
       return Result<BallMeasurement>::fail(
           FailureReason::TooSmall, "largest ball-coloured blob has " + std::to_string(largest_tiny) +
-                                       " px < min_area_px in " + where.str());
+                                       " px < min_area_px in " + where().str());
     return Result<BallMeasurement>::fail(FailureReason::NotFound,
-                                         "no round ball-coloured blob in " + where.str());
+                                         "no round ball-coloured blob in " + where().str());
   }
   std::sort(candidates.begin(), candidates.end(),
             [](const Candidate& a, const Candidate& b) { return a.score > b.score; });
@@ -149,7 +157,7 @@ Result<BallMeasurement> BallDetector::detectIn(const cv::Mat& bgr, const cv::Rec
   if (candidates.size() > 1 && candidates[1].score >= config_.ambiguity_ratio * best.score)
     return Result<BallMeasurement>::fail(
         FailureReason::Ambiguous, std::to_string(candidates.size()) +
-                                      " ball-like blobs score alike in " + where.str());
+                                      " ball-like blobs score alike in " + where().str());
 
   const cv::Moments m = cv::moments(contours_[best.index]);
   if (!(m.m00 > 0.0))

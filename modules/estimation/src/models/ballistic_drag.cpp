@@ -1,5 +1,6 @@
 #include "viewline/estimation/models/ballistic_drag.h"
 
+#include <cmath>
 #include <sstream>
 
 #include "model_checks.h"
@@ -27,6 +28,10 @@ double DragBallisticModel::dragConstant(double rho, double cd, double area, doub
 }
 
 void DragBallisticModel::validate() const {
+  // The common case first: the checks below build their messages (std::string, heap) even when
+  // they pass, and the planner validates the model on every propagation step.
+  const auto fine = [](double v) { return std::isfinite(v) && v >= 0.0; };
+  if (up.allFinite() && up.norm() > 0.0 && fine(g) && fine(k) && fine(q) && substeps >= 1) return;
   core::requireFinite(up, "DragBallisticModel.up");
   if (!(up.norm() > 0.0)) throw core::InvalidInput("DragBallisticModel.up is the zero vector (expected a direction)");
   detail::requireNonNegative(g, "DragBallisticModel.g");
@@ -61,10 +66,27 @@ Mat6 DragBallisticModel::derivativeJacobian(const Vec6& x) const {
   return J;
 }
 
+namespace {
+
+// The checks of propagate/jacobian without building a message unless one fails (a std::string
+// per call would be a heap allocation in the planner's hot path).
+void checkStep(const DragBallisticModel& m, const Vec6& x, double dt) {
+  m.validate();
+  if (!(std::isfinite(dt) && dt > 0.0)) detail::requireDt(dt, "DragBallisticModel");
+  if (!x.allFinite()) core::requireFinite(x, "DragBallisticModel: state x");
+}
+
+}  // namespace
+
 Eigen::VectorXd DragBallisticModel::propagate(const Eigen::VectorXd& x0, double dt) const {
   validate();
   detail::requireDt(dt, "DragBallisticModel");
-  Vec6 x = toVec6(x0, "DragBallisticModel: state x");
+  return propagateFixed(toVec6(x0, "DragBallisticModel: state x"), dt);
+}
+
+Vec6 DragBallisticModel::propagateFixed(const Vec6& x0, double dt) const {
+  checkStep(*this, x0, dt);
+  Vec6 x = x0;
   const double h = dt / substeps;
   for (int i = 0; i < substeps; ++i) {
     const Vec6 k1 = derivative(x);
@@ -79,7 +101,12 @@ Eigen::VectorXd DragBallisticModel::propagate(const Eigen::VectorXd& x0, double 
 Eigen::MatrixXd DragBallisticModel::jacobian(const Eigen::VectorXd& x0, double dt) const {
   validate();
   detail::requireDt(dt, "DragBallisticModel");
-  Vec6 x = toVec6(x0, "DragBallisticModel: state x");
+  return jacobianFixed(toVec6(x0, "DragBallisticModel: state x"), dt);
+}
+
+Mat6 DragBallisticModel::jacobianFixed(const Vec6& x0, double dt) const {
+  checkStep(*this, x0, dt);
+  Vec6 x = x0;
   // RK4 on (x, S) with Ṡ = J(x) S: each stage's S-part is the derivative of the x-stage.
   Mat6 S = Mat6::Identity();
   const double h = dt / substeps;

@@ -53,6 +53,11 @@ struct DragBallisticModel {
   Eigen::MatrixXd jacobian(const Eigen::VectorXd& x, double dt) const;
   /// Process noise of a step of dt linearised at x.
   Eigen::MatrixXd processNoise(const Eigen::VectorXd& x, double dt) const;
+  /// propagate() on a fixed-size state: the same arithmetic and checks, no heap allocation (the
+  /// planner's crossing search calls it a hundred times per update).
+  Eigen::Matrix<double, 6, 1> propagateFixed(const Eigen::Matrix<double, 6, 1>& x, double dt) const;
+  /// jacobian() on a fixed-size state: the same arithmetic and checks, no heap allocation.
+  Eigen::Matrix<double, 6, 6> jacobianFixed(const Eigen::Matrix<double, 6, 1>& x, double dt) const;
   /// f, F and Q (Q linearised at x_lin, normally the current estimate) for dt > 0.
   NonlinearTransition transition(double dt, const Eigen::VectorXd& x_lin) const;
   /// Throws core::InvalidInput naming the field (up, g, k, q, substeps).
