@@ -27,8 +27,10 @@ int main(int argc, char** argv) {
   app.add_option("--output", output, "YAML to write (e_M_c or r_M_c, residuals)");
   std::string rig_output, intrinsics, camera_name = "camera";
   std::size_t rig_pose = 0;
-  app.add_option("--rig-output", rig_output, "one-camera rig file to write (world = robot base frame)");
-  app.add_option("--intrinsics", intrinsics, "with --rig-output: ViSP camera XML (calibrate-camera's)")->check(CLI::ExistingFile);
+  auto* rig_output_opt = app.add_option("--rig-output", rig_output, "one-camera rig file to write (world = robot base frame)");
+  auto* intrinsics_opt =
+      app.add_option("--intrinsics", intrinsics, "with --rig-output: ViSP camera XML (calibrate-camera's)")->check(CLI::ExistingFile);
+  rig_output_opt->needs(intrinsics_opt);  // a usage error (exit 2) before any file is read
   app.add_option("--camera-name", camera_name, "with --rig-output: camera name in the XML and in the rig");
   app.add_option("--rig-pose", rig_pose, "with --rig-output, eye-in-hand: index of the robot pose the rig is written at");
   if (const auto code = viewline::calib::tools::parseCommandLine(app, argc, argv)) return *code;

@@ -39,7 +39,8 @@ SCENARIO_APPS = {
     # name: (config, extra args of a short valid run, the flag whose value gets the wrong type, long-run args)
     "dart_tracking": ("config/dart_tracking.yaml", ["--runs", "1"], "--runs", ["--runs", "100000"]),
     "ball_catching": ("config/ball_catching.yaml", ["--throws", "1"], "--throws", ["--throws", "100000"]),
-    "pan_tilt_tracking": ("config/pan_tilt_circle.yaml", ["--duration", "1"], "--seed", ["--duration", "100000"]),
+    "pan_tilt_tracking": ("config/pan_tilt_circle.yaml", ["--duration", "1", "--set", "run.metrics_start=0.5"], "--seed",
+                          ["--duration", "100000"]),
     "table_ball_balancing": ("config/table_ball.yaml", ["--duration", "0.5"], "--duration", ["--duration", "100000"]),
     "mobile_capture": ("config/mobile_capture.yaml", ["--runs", "1"], "--runs", ["--runs", "100000"]),
 }
@@ -55,10 +56,11 @@ def table():
             outputs=["--summary", "{out}/summary.json", "--log", "{out}/log"],
             wrong_type=[typed, "abc", "--config", cfg],
             contradictory=["--config", cfg, "--headless", "--display"],
+            valid=["--config", cfg] + short,
         )
     t["pan_tilt_tracking"]["contradictory"] = ["--config", "config/pan_tilt_circle.yaml", "--replay", "config/pan_tilt_circle.yaml",
                                                "--oracle-corners", "--particles"]
-    t["viewline_demo"] = dict(file=None, outputs=[], wrong_type=["--runs", "abc"], contradictory=None)
+    t["viewline_demo"] = dict(file=None, outputs=[], wrong_type=["--runs", "abc"], contradictory=None, valid=["--runs", "1"])
     # viewline_tune documents bad input in a file (a sweep's key, a scenario's value) as a usage error: exit 2.
     t["viewline_tune"] = dict(
         file=("--config", ["run", "--scenario", "dart", "--quiet"]),
@@ -66,35 +68,43 @@ def table():
         wrong_type=["run", "--scenario", "dart", "--config", "config/dart_tracking.yaml", "--seed", "abc"],
         contradictory=["run", "--scenario", "dart", "--config", "config/dart_tracking.yaml", "--headless", "--display"],
         status={"empty_file": 2, "binary_file": 2},
+        valid=["run", "--scenario", "dart", "--config", "config/dart_tracking.yaml"],
     )
     board = "calib/boards/opencv_chessboard_9x6.yaml"
     xml = "calib/rigs/pan_tilt/intrinsics/ptu_camera.xml"
     image = "docs/pictures/pan_tilt_display.png"
     t["calibrate-camera"] = dict(file=("--board", [image]), outputs=["--output-xml", "{out}/c.xml", "--report", "{out}/r.json"],
                                  wrong_type=["--board", board, "--min-views", "abc", image],
-                                 contradictory=None)
+                                 contradictory=None, valid=["--board", board, image])
     t["compute-board-poses"] = dict(file=("--board", ["--intrinsics", xml, "--camera-name", "ptu_camera", image]),
-                                    outputs=["--output", "{out}/poses.yaml"], wrong_type=None, contradictory=None)
-    t["calibrate-rig"] = dict(file=("--config", []), outputs=["--output", "{out}/rig.yaml"], wrong_type=None, contradictory=None)
+                                    outputs=["--output", "{out}/poses.yaml"], wrong_type=None, contradictory=None,
+                                    valid=["--board", board, "--intrinsics", xml, image])
+    t["calibrate-rig"] = dict(file=("--config", []), outputs=["--output", "{out}/rig.yaml"], wrong_type=None, contradictory=None,
+                              valid=["--config", board])
     t["calibrate-hand-eye"] = dict(file=("--robot-poses", ["--camera-poses", "calib/rigs/pan_tilt/e_M_c.yaml"]),
                                    outputs=["--output", "{out}/he.yaml"],
                                    wrong_type=["--robot-poses", board, "--camera-poses", board, "--rig-pose", "abc"],
-                                   contradictory=["--robot-poses", board, "--camera-poses", board, "--rig-output", "{out}/rig.yaml"])
+                                   contradictory=["--robot-poses", board, "--camera-poses", board, "--rig-output", "{out}/rig.yaml"],
+                                   valid=["--robot-poses", board, "--camera-poses", board])
     t["camera-to-ground"] = dict(file=("--board", ["--intrinsics", xml, image]), outputs=["--output", "{out}/g.yaml"],
                                  wrong_type=["--board", board, "--intrinsics", xml, "--tag-id", "abc", image],
-                                 contradictory=None)
+                                 contradictory=None, valid=["--board", board, "--intrinsics", xml, image])
     t["render-board-views"] = dict(file=("--truth", ["--board", board]), outputs=["--output-dir", "{out}/views"],
                                    wrong_type=["--truth", "calib/rigs/pan_tilt/truth.yaml", "--board", board, "--views", "abc"],
-                                   contradictory=None)
+                                   contradictory=None, valid=["--truth", "calib/rigs/pan_tilt/truth.yaml", "--board", board])
     t["check-rig-calibration"] = dict(file=("--truth", ["--rig", "calib/rigs/pan_tilt/rig.yaml"]), outputs=[],
                                       wrong_type=["--truth", "calib/rigs/pan_tilt/truth.yaml", "--rig", "calib/rigs/pan_tilt/rig.yaml",
                                                   "--max-ray-px", "abc"],
-                                      contradictory=None)
+                                      contradictory=None,
+                                      valid=["--truth", "calib/rigs/pan_tilt/truth.yaml", "--rig", "calib/rigs/pan_tilt/rig.yaml"])
     t["print-board"] = dict(file=("--board", []), outputs=["--output", "{out}/b.png", "--pdf", "{out}/b.pdf"],
-                            wrong_type=["--board", board, "--dpi", "abc"], contradictory=None)
-    t["load_rig"] = dict(file=(None, []), outputs=[], wrong_type=None, contradictory=None)
+                            wrong_type=["--board", board, "--dpi", "abc"], contradictory=None, valid=["--board", board])
+    # load_rig, a tutorial's 40-line program, takes the rig file as its argument and reports every
+    # problem with it (missing, a directory, unreadable) as a runtime error.
+    t["load_rig"] = dict(file=(None, []), outputs=[], wrong_type=None, contradictory=None, valid=[],
+                         status={"missing_file": 1, "directory": 1})
     t["tutorial-picture"] = dict(file=("--input", []), outputs=["--output", "{out}/p.png"],
-                                 wrong_type=["--input", image, "--width", "abc"], contradictory=None)
+                                 wrong_type=["--input", image, "--width", "abc"], contradictory=None, valid=["--input", image])
     return t
 
 
@@ -158,11 +168,11 @@ def run_case(exe, cls, binary, work):
         named = [a for a in args if a.startswith("--") and a not in ("--config", "--scenario", "--board", "--robot-poses",
                                                                       "--camera-poses")]
     else:
-        args = ["--no-such-flag"]
+        args = ["--no-such-flag"] + fmt(spec["valid"], out)
         named = ["--no-such-flag"]
     args = fmt(args + spec["outputs"], out)
     if exe == "load_rig" and cls == "unknown_flag":
-        args = ["--no-such-flag"]
+        args = ["--no-such-flag", "calib/rigs/dart/rig.yaml"]
     cmd = [binary] + args
     try:
         p = subprocess.run(cmd, capture_output=True, text=True, errors="replace", timeout=TIMEOUT_S)
@@ -191,6 +201,12 @@ def run_interrupt(app, sig, binary, work):
     cmd = [binary, "--config", cfg, "--quiet", "--summary", summary, "--log", os.path.join(work, "log")] + long_args
     print("$ " + " ".join(cmd))
     p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, errors="replace")
+    # The signal handler exists once main() runs (loading ViSP and OpenCV can take seconds on a busy
+    # machine): wait until the run has made its log folder (after the config is read), then 1 s more.
+    log_dir = os.path.join(work, "log")
+    t_wait = time.monotonic()
+    while not os.path.isdir(log_dir) and p.poll() is None and time.monotonic() - t_wait < TIMEOUT_S:
+        time.sleep(0.05)
     time.sleep(1.0)
     if p.poll() is not None:
         fail(f"ended before the signal (exit {p.returncode}): {p.stderr.read()[-2000:]}")
