@@ -5,7 +5,8 @@
 // without the truth leaving the room). Every step, a noisy 3-D position measurement updates the
 // estimation module's square-root Kalman filter (predict + update, input validation on: the code
 // every tracker is built on); every updates/frames steps, one of two cameras renders the room and
-// the ball (sim::Renderer, 320x240) and vision::BallDetector finds it. Checked over the session:
+// the ball (sim::Renderer, 160x120) and vision::BallDetector finds it (in a window around its last
+// detection, as a tracking loop does). Checked over the session:
 //
 //   * the covariance stays positive definite: the square-root factor L (P = L Lᵀ) has a finite,
 //     positive diagonal after every update, and every 1000 updates P's Cholesky succeeds;
@@ -29,6 +30,7 @@
 #include <cstdio>
 #include <fstream>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -54,7 +56,7 @@ constexpr double kZeta = 0.3;              // damping ratio
 constexpr double kQc = 0.5;                // m²/s³, spectral density of the acceleration noise
 constexpr double kSigma = 0.005;           // m, measurement noise per axis
 constexpr int kNeesEvery = 250;            // updates between NEES samples
-constexpr double kBallRadius = 0.05;       // m
+constexpr double kBallRadius = 0.1;        // m (a 3-4 px radius at 3-5 m in the 160x120 images)
 
 /// VmRSS of this process in kB (0 when /proc is not there).
 long residentKb() {
@@ -84,12 +86,12 @@ estimation::ContinuousLinearModel springDamper() {
   return m;
 }
 
-core::Camera camera320(const std::string& name, const Eigen::Vector3d& eye) {
+core::Camera camera160(const std::string& name, const Eigen::Vector3d& eye) {
   core::Camera c;
   c.name = name;
-  c.width = 320;
-  c.height = 240;
-  c.intrinsics = vpCameraParameters(300.0, 300.0, 160.0, 120.0);
+  c.width = 160;
+  c.height = 120;
+  c.intrinsics = vpCameraParameters(150.0, 150.0, 80.0, 60.0);
   c.c_M_w = core::lookAt(eye, {0.0, 0.0, 1.5}, Eigen::Vector3d::UnitZ());
   return c;
 }
@@ -148,12 +150,14 @@ int main(int argc, char** argv) {
     const sim::SceneWorld world(sim::makeRoom(room, room_rng), [&ball_w](double, std::vector<sim::Primitive>& out) {
       out.push_back(sim::makeSphere("ball", ball_w, kBallRadius, Eigen::Vector3d(0.08, 0.45, 0.95)));
     });
-    const std::vector<core::Camera> cams{camera320("left", {-2.5, -3.0, 1.8}), camera320("right", {2.5, -3.0, 1.8})};
+    const std::vector<core::Camera> cams{camera160("left", {-2.5, -3.0, 1.8}), camera160("right", {2.5, -3.0, 1.8})};
     sim::Renderer renderer;
     vision::BallDetectorConfig dcfg;
     dcfg.hsv = {5, 22, 120, 255, 40, 255};  // orange, as config/ball_catching.yaml
+    dcfg.roi_half_size_px = 24.0;           // tracking mode: a window around the camera's last detection
     std::vector<vision::BallDetector> detectors;
     for (const auto& c : cams) detectors.emplace_back(dcfg, c);
+    std::vector<std::optional<Eigen::Vector2d>> last_px(cams.size());
 
     const long frame_every = updates / frames;
     const long samples_per_window = samples_total / windows;
@@ -207,8 +211,10 @@ int main(int argc, char** argv) {
         const auto truth_px = cams[ci].project(ball_w);
         const bool visible = truth_px && cams[ci].inImage(*truth_px, 3.0);
         if (visible) ++in_view;
-        const auto r = detectors[ci].detect(img, t);
+        const auto r = detectors[ci].detect(img, t, last_px[ci]);
+        last_px[ci].reset();
         if (r.ok()) {
+          last_px[ci] = r.value().pixel;
           ++detected;
           if (visible) {
             const double err = (r.value().pixel - *truth_px).norm();
