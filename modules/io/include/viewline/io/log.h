@@ -28,7 +28,9 @@ public:
   /// Closes the file, renaming the temporary onto `path` if flush() never did (errors are printed
   /// to stderr, not thrown: call close() to see them).
   ~CsvWriter();
+  /// Not copyable: one writer owns its file.
   CsvWriter(const CsvWriter&) = delete;
+  /// Not copyable: one writer owns its file.
   CsvWriter& operator=(const CsvWriter&) = delete;
 
   /// Whether rows are written (false for the disabled writer).
