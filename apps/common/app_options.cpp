@@ -1,10 +1,13 @@
 #include "app_options.h"
 
+#include <csignal>
 #include <cstdlib>
+#include <cstring>
 #include <exception>
 #include <iostream>
 
 #include "viewline/core/error.h"
+#include "viewline/core/interrupt.h"
 #include "viewline/core/version.h"
 #include "viewline/io/config_edit.h"
 
@@ -60,9 +63,32 @@ std::optional<int> parseCommandLine(CLI::App& cli, int argc, char** argv) {
   return std::nullopt;
 }
 
-int runGuarded(const std::string& app_name, const std::function<int()>& body) {
+namespace {
+extern "C" void onStopSignal(int sig) { core::noteInterrupt(sig); }  // async-signal-safe: one atomic store
+}  // namespace
+
+void installStopHandlers() {
+  struct sigaction sa;
+  std::memset(&sa, 0, sizeof sa);
+  sa.sa_handler = onStopSignal;
+  sigemptyset(&sa.sa_mask);
+  // SA_RESTART: blocking reads and writes go on after the handler; SA_RESETHAND: a second Ctrl-C
+  // takes the default action and ends a run that does not stop by itself.
+  sa.sa_flags = SA_RESTART | SA_RESETHAND;
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+}
+
+int runGuarded(const std::string& app_name, const std::function<int()>& body, OnSignal on_signal) {
+  if (on_signal == OnSignal::EndTheRun) installStopHandlers();
   try {
-    return body();
+    const int status = body();
+    if (const int sig = core::interruptSignal()) {
+      std::cerr << app_name << ": interrupted by " << (sig == SIGINT ? "SIGINT" : sig == SIGTERM ? "SIGTERM" : "a signal")
+                << "; the outputs hold the part of the run that was done\n";
+      return 128 + sig;  // the shell's convention for "ended by signal sig"
+    }
+    return status;
   } catch (const core::Error& e) {
     std::cerr << app_name << ": " << e.what() << "\n";
     return 1;

@@ -11,7 +11,8 @@
 //     return apps::runGuarded("ball_catching", [&] { ...; return 0; });
 //   }
 //
-// Exit status: 0 done, 1 runtime error (message names the file/key), 2 usage error.
+// Exit status: 0 done, 1 runtime error (message names the file/key), 2 usage error,
+// 130 / 143 ended by SIGINT (Ctrl-C) / SIGTERM with its partial summary written.
 
 #include <CLI/CLI.hpp>
 #include <cstdint>
@@ -50,8 +51,23 @@ void addCommonOptions(CLI::App& cli, CommonOptions& opt);
 /// (CLI11_PARSE would return CLI11's own codes, e.g. 105/108, instead of 2.)
 std::optional<int> parseCommandLine(CLI::App& cli, int argc, char** argv);
 
+/// What SIGINT (Ctrl-C) and SIGTERM do while runGuarded() runs its body.
+enum class OnSignal {
+  /// The first signal is recorded (core::noteInterrupt): schedulers stop, the run ends with what it
+  /// has, its summary says "interrupted": true, and the exit status is 128 + signal (130 / 143).
+  /// A second signal ends the process at once (the default action).
+  EndTheRun,
+  /// The default action: the process ends at once (outputs are written atomically, so no file is
+  /// left half-written). For tools whose loops do not poll core::interruptRequested().
+  Terminate,
+};
+
 /// Runs `body` and maps exceptions to exit codes: viewline::core::InvalidInput and other
 /// core::Error → 1 with "<app>: <message>" on stderr; anything else → 1 with its what().
-int runGuarded(const std::string& app_name, const std::function<int()>& body);
+/// A run ended by a signal (OnSignal::EndTheRun) returns 128 + the signal number.
+int runGuarded(const std::string& app_name, const std::function<int()>& body, OnSignal on_signal = OnSignal::EndTheRun);
+
+/// Installs the OnSignal::EndTheRun handlers for SIGINT and SIGTERM (runGuarded() does it).
+void installStopHandlers();
 
 }  // namespace viewline::apps

@@ -27,7 +27,11 @@ int main(int argc, char** argv) {
   int runs = 200;
   app.add_option("--seed", seed, "random seed");
   app.add_option("--runs", runs, "Monte-Carlo runs")->check(CLI::Range(1, 100000));
-  CLI11_PARSE(app, argc, argv);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : 2;  // usage error: 2, as in every viewline tool (CLI11_PARSE: CLI11's codes)
+  }
 
   const double g = 9.81, q = 0.05, sigma = 0.01;
   estimation::ContinuousLinearModel model;

@@ -16,15 +16,15 @@ int main(int argc, char** argv) {
   std::vector<std::string> images;
   int min_views = 3;
   double max_view_rms = 3.0;
-  app.add_option("--board", board_file, "board description (YAML)")->required();
+  app.add_option("--board", board_file, "board description (YAML)")->required()->check(CLI::ExistingFile);
   app.add_option("--name", name, "camera name in the XML file");
   app.add_option("--output-xml", xml, "ViSP camera XML to write");
   app.add_option("--output-yaml", yaml, "OpenCV YAML to write");
   app.add_option("--report", report, "JSON report to write (parameters, std devs, per-view errors)");
   app.add_option("--min-views", min_views, "fewest usable views accepted");
   app.add_option("--max-view-rms", max_view_rms, "views with a larger RMS error (px) are rejected");
-  app.add_option("images", images, "image files")->required();
-  CLI11_PARSE(app, argc, argv);
+  app.add_option("images", images, "image files")->required()->check(CLI::ExistingFile);
+  if (const auto code = viewline::calib::tools::parseCommandLine(app, argc, argv)) return *code;
   return viewline::calib::tools::runTool("calibrate-camera", [&] {
     using namespace viewline;
     if (xml.empty() && yaml.empty()) throw core::InvalidInput("give --output-xml and/or --output-yaml");

@@ -22,16 +22,18 @@ int main(int argc, char** argv) {
   std::string setup = "eye-in-hand", robot_file, camera_file, output;
   app.add_option("--setup", setup, "eye-in-hand (camera on the end effector) | eye-to-hand (camera fixed)")
       ->check(CLI::IsMember({"eye-in-hand", "eye-to-hand"}));
-  app.add_option("--robot-poses", robot_file, "YAML list of r_M_e (end effector in robot base)")->required();
-  app.add_option("--camera-poses", camera_file, "compute-board-poses output (c_M_o per image)")->required();
+  app.add_option("--robot-poses", robot_file, "YAML list of r_M_e (end effector in robot base)")->required()->check(CLI::ExistingFile);
+  app.add_option("--camera-poses", camera_file, "compute-board-poses output (c_M_o per image)")->required()->check(CLI::ExistingFile);
   app.add_option("--output", output, "YAML to write (e_M_c or r_M_c, residuals)");
   std::string rig_output, intrinsics, camera_name = "camera";
   std::size_t rig_pose = 0;
-  app.add_option("--rig-output", rig_output, "one-camera rig file to write (world = robot base frame)");
-  app.add_option("--intrinsics", intrinsics, "with --rig-output: ViSP camera XML (calibrate-camera's)");
+  auto* rig_output_opt = app.add_option("--rig-output", rig_output, "one-camera rig file to write (world = robot base frame)");
+  auto* intrinsics_opt =
+      app.add_option("--intrinsics", intrinsics, "with --rig-output: ViSP camera XML (calibrate-camera's)")->check(CLI::ExistingFile);
+  rig_output_opt->needs(intrinsics_opt);  // a usage error (exit 2) before any file is read
   app.add_option("--camera-name", camera_name, "with --rig-output: camera name in the XML and in the rig");
   app.add_option("--rig-pose", rig_pose, "with --rig-output, eye-in-hand: index of the robot pose the rig is written at");
-  CLI11_PARSE(app, argc, argv);
+  if (const auto code = viewline::calib::tools::parseCommandLine(app, argc, argv)) return *code;
   return viewline::calib::tools::runTool("calibrate-hand-eye", [&] {
     using namespace viewline;
     const auto robot = io::ConfigNode::loadFile(robot_file);

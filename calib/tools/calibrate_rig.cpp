@@ -35,9 +35,9 @@ int main(int argc, char** argv) {
   CLI::App app{"Rig extrinsics: every camera's pose in one world frame from shared board views."};
   app.set_version_flag("--version", std::string("viewline ") + viewline::core::kVersion);
   std::string config, output;
-  app.add_option("--config", config, "rig calibration config (YAML)")->required();
+  app.add_option("--config", config, "rig calibration config (YAML)")->required()->check(CLI::ExistingFile);
   app.add_option("--output", output, "rig file to write (with one <camera>.xml per camera next to it)")->required();
-  CLI11_PARSE(app, argc, argv);
+  if (const auto code = viewline::calib::tools::parseCommandLine(app, argc, argv)) return *code;
   return viewline::calib::tools::runTool("calibrate-rig", [&] {
     using namespace viewline;
     const auto cfg = io::ConfigNode::loadFile(config);

@@ -20,8 +20,8 @@ int main(int argc, char** argv) {
   std::string board_file, intrinsics, camera_name = "camera", projection = "with_distortion", output;
   std::vector<std::string> images;
   int tag_id = -1;
-  app.add_option("--board", board_file, "board description (YAML)")->required();
-  app.add_option("--intrinsics", intrinsics, "ViSP camera XML or OpenCV YAML")->required();
+  app.add_option("--board", board_file, "board description (YAML)")->required()->check(CLI::ExistingFile);
+  app.add_option("--intrinsics", intrinsics, "ViSP camera XML or OpenCV YAML")->required()->check(CLI::ExistingFile);
   app.add_option("--camera-name", camera_name, "camera name in the XML");
   app.add_option("--projection", projection, "XML model: with_distortion | without_distortion");
   app.add_option("--tag-id", tag_id, "board type apriltag: the tag on the floor (default: the only one seen)");
@@ -36,8 +36,8 @@ int main(int argc, char** argv) {
   app.add_option("--board-x-hint", x_hint, "chessboard: direction of the board's x axis in the image (right|left|up|down); "
                  "the corners are renumbered from the other end when the detection runs the other way (180° symmetry)")
       ->check(CLI::IsMember({"right", "left", "up", "down"}));
-  app.add_option("images", images, "image files (camera still, board still)")->required();
-  CLI11_PARSE(app, argc, argv);
+  app.add_option("images", images, "image files (camera still, board still)")->required()->check(CLI::ExistingFile);
+  if (const auto code = viewline::calib::tools::parseCommandLine(app, argc, argv)) return *code;
   return viewline::calib::tools::runTool("camera-to-ground", [&] {
     using namespace viewline;
     std::vector<double> ground_origin;

@@ -21,13 +21,13 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string("viewline ") + viewline::core::kVersion);
   std::string truth_file, rig_file, emc_file;
   double max_ray = -1, max_pos = -1, max_rot_deg = -1;
-  app.add_option("--truth", truth_file, "truth file")->required();
-  app.add_option("--rig", rig_file, "calibrated rig file (io::loadRig)")->required();
-  app.add_option("--e-M-c", emc_file, "calibrate-hand-eye output to compare with the truth's hand_eye.e_M_c");
+  app.add_option("--truth", truth_file, "truth file")->required()->check(CLI::ExistingFile);
+  app.add_option("--rig", rig_file, "calibrated rig file (io::loadRig)")->required()->check(CLI::ExistingFile);
+  app.add_option("--e-M-c", emc_file, "calibrate-hand-eye output to compare with the truth's hand_eye.e_M_c")->check(CLI::ExistingFile);
   app.add_option("--max-ray-px", max_ray, "fail (exit 3) when a camera's RMS world-ray error exceeds this (px)");
   app.add_option("--max-position", max_pos, "fail when a camera centre is off by more than this (m)");
   app.add_option("--max-rotation", max_rot_deg, "fail when a camera rotation is off by more than this (deg)");
-  CLI11_PARSE(app, argc, argv);
+  if (const auto code = viewline::calib::tools::parseCommandLine(app, argc, argv)) return *code;
   return viewline::calib::tools::runTool("check-rig-calibration", [&] {
     using namespace viewline;
     const calib::RigTruth truth = calib::loadRigTruth(truth_file);

@@ -15,13 +15,13 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string("viewline ") + viewline::core::kVersion);
   std::string board_file, intrinsics, camera_name = "camera", projection = "with_distortion", output;
   std::vector<std::string> images;
-  app.add_option("--board", board_file, "board description (YAML)")->required();
-  app.add_option("--intrinsics", intrinsics, "ViSP camera XML or OpenCV YAML")->required();
+  app.add_option("--board", board_file, "board description (YAML)")->required()->check(CLI::ExistingFile);
+  app.add_option("--intrinsics", intrinsics, "ViSP camera XML or OpenCV YAML")->required()->check(CLI::ExistingFile);
   app.add_option("--camera-name", camera_name, "camera name in the XML");
   app.add_option("--projection", projection, "XML model: with_distortion | without_distortion");
   app.add_option("--output", output, "poses file (YAML) to write");
-  app.add_option("images", images, "image files")->required();
-  CLI11_PARSE(app, argc, argv);
+  app.add_option("images", images, "image files")->required()->check(CLI::ExistingFile);
+  if (const auto code = viewline::calib::tools::parseCommandLine(app, argc, argv)) return *code;
   return viewline::calib::tools::runTool("compute-board-poses", [&] {
     using namespace viewline;
     using calib::tools::poseYaml;

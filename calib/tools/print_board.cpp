@@ -106,13 +106,13 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string("viewline ") + viewline::core::kVersion);
   std::string board_file, output, pdf;
   double dpi = 300.0, margin_mm = 15.0;
-  app.add_option("--board", board_file, "board description (calib/boards/*.yaml)")->required();
+  app.add_option("--board", board_file, "board description (calib/boards/*.yaml)")->required()->check(CLI::ExistingFile);
   app.add_option("--output", output, "PNG file to write")->required();
   app.add_option("--pdf", pdf, "also write this one-page PDF");
   app.add_option("--dpi", dpi, "printer resolution, dots per inch")->check(CLI::Range(50.0, 1200.0));
   app.add_option("--margin", margin_mm, "white margin around the board, mm (the caption goes in the bottom one)")
       ->check(CLI::Range(8.0, 100.0));
-  CLI11_PARSE(app, argc, argv);
+  if (const auto code = viewline::calib::tools::parseCommandLine(app, argc, argv)) return *code;
   return viewline::calib::tools::runTool("print-board", [&] {
     using namespace viewline;
     const calib::BoardSpec board = calib::loadBoard(board_file);

@@ -44,8 +44,8 @@ int main(int argc, char** argv) {
   std::uint64_t seed = 1;
   std::vector<double> target, floor_origin{0.0, 0.0}, board_in_front{0.75, 0.0765, 0.068};
   double radius = 0.4, max_obliquity_deg = 65.0, pan_range_deg = 20.0, tilt_range_deg = 15.0;
-  app.add_option("--truth", truth_file, "truth file (calib/rigs/<rig>/truth.yaml)")->required();
-  app.add_option("--board", board_file, "board description (YAML)")->required();
+  app.add_option("--truth", truth_file, "truth file (calib/rigs/<rig>/truth.yaml)")->required()->check(CLI::ExistingFile);
+  app.add_option("--board", board_file, "board description (YAML)")->required()->check(CLI::ExistingFile);
   app.add_option("--mode", mode, "intrinsics | rig | ground | hand-eye")
       ->check(CLI::IsMember({"intrinsics", "rig", "ground", "hand-eye"}));
   app.add_option("--camera", camera, "camera of the truth file (intrinsics: default every camera; ground, hand-eye: default the first)");
@@ -66,7 +66,7 @@ int main(int argc, char** argv) {
       ->expected(3);
   app.add_option("--pan-range", pan_range_deg, "hand-eye: pan angles within +-this, deg");
   app.add_option("--tilt-range", tilt_range_deg, "hand-eye: tilt angles within +-this, deg");
-  CLI11_PARSE(app, argc, argv);
+  if (const auto code = viewline::calib::tools::parseCommandLine(app, argc, argv)) return *code;
   return viewline::calib::tools::runTool("render-board-views", [&] {
     using namespace viewline;
     const calib::RigTruth truth = calib::loadRigTruth(truth_file);

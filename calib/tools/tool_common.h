@@ -2,9 +2,11 @@
 // Shared bits of the calibration tools: loading intrinsics for pose estimation, pose YAML output,
 // and the error handling of main().
 
+#include <CLI/CLI.hpp>
 #include <Eigen/Geometry>
 #include <exception>
 #include <iostream>
+#include <optional>
 #include <sstream>
 #include <string>
 
@@ -20,17 +22,27 @@ PoseCamera loadPoseCamera(const std::string& path, const std::string& camera_nam
 /// "translation: [..]\n rotation: [[..],[..],[..]]" at the given indentation (YAML block map).
 std::string poseYaml(const Eigen::Isometry3d& T, int indent);
 
-/// Runs f; prints "<tool>: error: <message>" and returns 1 on viewline errors, 2 on others.
+/// Parses the command line. nullopt: go on; otherwise the exit status to return at once: 0 after
+/// --help/--version, 2 for a usage error (CLI11's message; CLI11_PARSE would return CLI11's own codes).
+inline std::optional<int> parseCommandLine(CLI::App& app, int argc, char** argv) {
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? 0 : 2;
+  }
+  return std::nullopt;
+}
+
+/// Runs f; prints "<tool>: error: <message>" and returns 1 (a runtime error: the command line was
+/// well formed, a file or a computation was not) on any exception.
 template <class F>
 int runTool(const char* tool, F&& f) {
   try {
     return f();
-  } catch (const core::Error& e) {
-    std::cerr << tool << ": error: " << e.what() << "\n";
-    return 1;
   } catch (const std::exception& e) {
     std::cerr << tool << ": error: " << e.what() << "\n";
-    return 2;
+    return 1;
   }
 }
 

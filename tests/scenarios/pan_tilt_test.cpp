@@ -416,3 +416,40 @@ TEST(PanTiltScenario, TheParticleFilterRunsInTheLoopAndItsReplayReproducesIt) {
                    "config/pan_tilt_random.yaml", {"filter.model=waypoint_particles", "filter.region.size=[0, 0]"})),
                core::InvalidInput);
 }
+
+TEST(PanTiltScenario, ReplayRefusesAFieldThatIsNotANumberOrATimeThatIsNotFinite) {
+  // predictive_frames.csv is read back by --replay: a field "abc" or a missing/infinite time stamp is
+  // refused with the file, row and column, never read as 0 or handed to the filter as NaN.
+  auto cfg = shipped("circle");
+  cfg.duration = 1.0;
+  cfg.metrics_start = 0.5;
+  cfg.occlusion_start = -1.0;
+  const LoggedRun logged = loggedRun(cfg, 3, "bad_fields");
+  std::vector<std::string> lines;
+  {
+    std::ifstream in(logged.dir / "predictive_frames.csv");
+    for (std::string l; std::getline(in, l);) lines.push_back(l);
+  }
+  ASSERT_GT(lines.size(), 5u);
+  const auto withRow3 = [&](const std::string& first_field, const std::string& name) {
+    std::string row = lines[3];
+    row = first_field + row.substr(row.find(','));
+    const auto path = (logged.dir / name).string();
+    std::ofstream out(path);
+    for (std::size_t i = 0; i < lines.size(); ++i) out << (i == 3 ? row : lines[i]) << "\n";
+    return path;
+  };
+  for (const auto& [field, what] : std::vector<std::pair<std::string, std::string>>{
+           {"abc", "expected a number"}, {"", "expected a finite time"}, {"inf", "expected a finite time"}}) {
+    const std::string path = withRow3(field, "bad_t.csv");
+    try {
+      scenarios::replayPanTiltFilter(cfg, 3, path, scenarios::PanTiltReplayEstimator::Filter, nullptr);
+      ADD_FAILURE() << "t = '" << field << "' was accepted";
+    } catch (const core::InvalidInput& e) {
+      const std::string msg = e.what();
+      EXPECT_NE(msg.find(path + ":4:"), std::string::npos) << msg;
+      EXPECT_NE(msg.find(what), std::string::npos) << msg;
+    }
+  }
+  std::filesystem::remove_all(logged.dir);
+}

@@ -30,6 +30,7 @@ int main(int argc, char** argv) {
     return 0;
   }
   if ((argc != 2 && argc != 3) || argv[1][0] == '-') {
+    if (argc >= 2 && argv[1][0] == '-') std::cerr << "load_rig: unknown option " << argv[1] << "\n";
     std::cerr << kUsage;
     return 2;
   }

@@ -50,11 +50,15 @@ int main(int argc, char** argv) {
   std::vector<std::string> inputs;
   std::string board_file, output;
   int width = 320;
-  app.add_option("--input", inputs, "image (any format OpenCV reads); repeat for side by side")->required();
-  app.add_option("--board", board_file, "board description: draw its detection");
+  app.add_option("--input", inputs, "image (any format OpenCV reads); repeat for side by side")->required()->check(CLI::ExistingFile);
+  app.add_option("--board", board_file, "board description: draw its detection")->check(CLI::ExistingFile);
   app.add_option("--width", width, "width of the picture, px")->check(CLI::Range(32, 2000));
   app.add_option("--output", output, "PNG to write")->required();
-  CLI11_PARSE(app, argc, argv);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : 2;  // usage error: 2, as in every viewline tool (CLI11_PARSE: CLI11's codes)
+  }
   try {
     using namespace viewline;
     std::optional<calib::BoardSpec> board;

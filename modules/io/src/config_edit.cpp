@@ -183,6 +183,9 @@ std::string rewriteYamlText(const std::string& original_text,
 std::string configTextWithValues(const std::string& path, const std::vector<std::string>& key_values) {
   std::vector<std::pair<std::string, YAML::Node>> kv;
   for (const std::string& s : key_values) kv.push_back(parseKeyValue(s));
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec))  // else yaml-cpp's read fails with "basic_filebuf::underflow", unnamed
+    throw core::InvalidInput(path + ": is a directory (expected a YAML config file)");
   ConfigNode::loadFile(path);  // the file's own errors (missing, syntax, duplicate keys) with its own line numbers
   std::ifstream in(path);
   std::ostringstream text;

@@ -1,26 +1,24 @@
 #include "viewline/io/files.h"
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <atomic>
+#include <cerrno>
+#include <csignal>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
-#include <unistd.h>
 
 #include "viewline/core/error.h"
+#include "viewline/core/interrupt.h"
 #include "viewline/core/version.h"
 
 namespace fs = std::filesystem;
 
 namespace viewline::io {
 namespace {
-
-std::string tmpPathFor(const std::string& path) {
-  static std::atomic<unsigned> counter{0};
-  const fs::path p(path);
-  const std::string name = "." + p.filename().string() + ".tmp" + std::to_string(::getpid()) + "_" +
-                           std::to_string(counter++);
-  return (p.parent_path() / name).string();
-}
 
 void makeParent(const std::string& path) {
   const fs::path parent = fs::path(path).parent_path();
@@ -30,23 +28,70 @@ void makeParent(const std::string& path) {
   if (ec) throw core::InvalidInput(path + ": cannot create directory " + parent.string() + ": " + ec.message());
 }
 
+std::string errnoText(int err) {
+  std::string s = std::strerror(err);
+  if (err == ENOSPC || err == EDQUOT) s += " (the disk is full)";
+  if (err == EFBIG) s += " (over the file size limit)";
+  return s;
+}
+
+const char* signalName(int sig) {
+  switch (sig) {
+    case SIGINT: return "SIGINT";
+    case SIGTERM: return "SIGTERM";
+    default: return "signal";
+  }
+}
+
 }  // namespace
+
+std::string temporaryPathFor(const std::string& path) {
+  static std::atomic<unsigned> counter{0};
+  const fs::path p(path);
+  const std::string name = "." + p.filename().string() + ".tmp" + std::to_string(::getpid()) + "_" +
+                           std::to_string(counter++);
+  return (p.parent_path() / name).string();
+}
+
+void writeAllOrThrow(int fd, const char* data, std::size_t size, const std::string& path) {
+  while (size > 0) {
+    const ssize_t n = ::write(fd, data, size);
+    if (n < 0) {
+      if (errno == EINTR) continue;  // a signal arrived mid-write: the write itself goes on
+      throw core::InvalidInput(path + ": cannot write: " + errnoText(errno));
+    }
+    data += n;
+    size -= static_cast<std::size_t>(n);
+  }
+}
 
 void writeTextFileAtomic(const std::string& path, const std::string& content) {
   StagedFiles out;
   const std::string tmp = out.stage(path);
-  {
-    std::ofstream f(tmp, std::ios::binary);
-    if (!f) throw core::InvalidInput(path + ": cannot open for writing");
-    f << content;
-    f.flush();
-    if (!f) throw core::InvalidInput(path + ": write failed");
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+  if (fd < 0) throw core::InvalidInput(path + ": cannot open for writing: " + errnoText(errno));
+  try {
+    writeAllOrThrow(fd, content.data(), content.size(), path);
+    // fsync before the rename: after a power cut the target holds the old or the new content,
+    // never a renamed but empty file (ext4's delayed allocation).
+    if (::fsync(fd) != 0 && errno != EINVAL) throw core::InvalidInput(path + ": cannot write: " + errnoText(errno));
+  } catch (...) {
+    ::close(fd);
+    throw;  // `out` removes the temporary; the target is untouched
   }
+  if (::close(fd) != 0) throw core::InvalidInput(path + ": cannot write: " + errnoText(errno));
   out.commit();
 }
 
 void writeSummaryFile(const std::string& path, nlohmann::json j) {
-  if (j.is_object()) j["viewline_version"] = core::kVersion;
+  if (j.is_object()) {
+    j["viewline_version"] = core::kVersion;
+    // A run cut short by Ctrl-C / SIGTERM still writes its summary; it says so.
+    if (const int sig = core::interruptSignal()) {
+      j["interrupted"] = true;
+      j["interrupt_signal"] = signalName(sig);
+    }
+  }
   writeJsonFile(path, j);
 }
 
@@ -73,7 +118,7 @@ std::string StagedFiles::stage(const std::string& path) {
   for (const auto& f : files_)
     if (f.second == path) throw core::InvalidInput(path + ": output file named twice");
   makeParent(path);
-  const std::string tmp = tmpPathFor(path);
+  const std::string tmp = temporaryPathFor(path);
   std::error_code ec;
   fs::remove(tmp, ec);
   files_.emplace_back(tmp, path);

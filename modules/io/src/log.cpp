@@ -1,10 +1,17 @@
 #include "viewline/io/log.h"
 
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
+#include <iostream>
 
 #include "viewline/core/error.h"
+#include "viewline/io/files.h"
 
 namespace viewline::io {
 namespace {
@@ -28,11 +35,51 @@ CsvWriter::CsvWriter(const std::string& path, std::vector<std::string> header, i
     std::error_code ec;
     std::filesystem::create_directories(parent, ec);
   }
-  out_.open(path, std::ios::trunc);
-  if (!out_) throw core::InvalidInput(path + ": cannot open the CSV log for writing");
+  tmp_ = temporaryPathFor(path);
+  fd_ = ::open(tmp_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd_ < 0)
+    throw core::InvalidInput(path + ": cannot open the CSV log for writing: " + std::strerror(errno));
   std::string line;
   for (std::size_t i = 0; i < header_.size(); ++i) line += (i ? "," : "") + quote(header_[i]);
-  out_ << line << '\n';
+  append(line);
+}
+
+CsvWriter::~CsvWriter() {
+  try {
+    close();
+  } catch (const std::exception& e) {
+    std::cerr << e.what() << "\n";  // a destructor must not throw; the message still names the file
+  }
+  if (fd_ >= 0) ::close(fd_);
+  if (!tmp_.empty()) {
+    std::error_code ec;
+    std::filesystem::remove(tmp_, ec);  // never published (the write failed): no stray temporary
+  }
+}
+
+void CsvWriter::append(const std::string& line) {
+  buffer_ += line;
+  buffer_ += '\n';
+  if (buffer_.size() >= (1u << 16)) writeBuffer();  // whole lines in 64 KB writes
+}
+
+void CsvWriter::writeBuffer() {
+  const std::string data = std::move(buffer_);
+  buffer_.clear();
+  try {
+    writeAllOrThrow(fd_, data.data(), data.size(), path_);
+  } catch (...) {
+    // A failed write (disk full) ends the log: the writer is disabled and an unpublished temporary
+    // removed, so no truncated file appears under the log's name.
+    ::close(fd_);
+    fd_ = -1;
+    if (!tmp_.empty()) {
+      std::error_code ec;
+      std::filesystem::remove(tmp_, ec);
+      tmp_.clear();
+    }
+    throw;
+  }
 }
 
 void CsvWriter::checkCount(std::size_t n) const {
@@ -55,7 +102,7 @@ void CsvWriter::row(const std::vector<double>& values) {
       line += buf;
     }
   }
-  out_ << line << '\n';
+  append(line);
   ++rows_;
 }
 
@@ -64,12 +111,28 @@ void CsvWriter::rowText(const std::vector<std::string>& fields) {
   checkCount(fields.size());
   std::string line;
   for (std::size_t i = 0; i < fields.size(); ++i) line += (i ? "," : "") + quote(fields[i]);
-  out_ << line << '\n';
+  append(line);
   ++rows_;
 }
 
 void CsvWriter::flush() {
-  if (enabled()) out_.flush();
+  if (!enabled()) return;
+  writeBuffer();
+  if (!tmp_.empty()) {
+    // The open descriptor follows the rename: later rows are appended to the published file.
+    std::error_code ec;
+    std::filesystem::rename(tmp_, path_, ec);
+    if (ec) throw core::InvalidInput(path_ + ": cannot rename the temporary CSV log onto it: " + ec.message());
+    tmp_.clear();
+  }
+}
+
+void CsvWriter::close() {
+  if (!enabled()) return;
+  flush();
+  const int fd = fd_;
+  fd_ = -1;
+  if (::close(fd) != 0) throw core::InvalidInput(path_ + ": cannot write: " + std::strerror(errno));
 }
 
 LogDirectory::LogDirectory(const std::string& dir) : dir_(dir) {

@@ -81,6 +81,9 @@ std::vector<core::Camera> loadRig(const ConfigNode& node) {
 }
 
 std::vector<core::Camera> loadRig(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec))  // else yaml-cpp's read fails with "basic_filebuf::underflow", unnamed
+    throw core::InvalidInput(path + ": is a directory (expected a rig file)");
   const ConfigNode root = ConfigNode::loadFile(path);
   auto cams = loadRig(root);
   root.finish();

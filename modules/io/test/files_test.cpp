@@ -1,11 +1,14 @@
 #include <gtest/gtest.h>
+#include <sys/resource.h>
 
+#include <csignal>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 
 #include "temp_dir.h"
 #include "viewline/core/error.h"
+#include "viewline/core/interrupt.h"
 #include "viewline/io/files.h"
 #include "viewline/io/log.h"
 
@@ -100,4 +103,99 @@ TEST(Log, DisabledLogWritesNothing) {
   TempDir dir;
   const auto file = dir.write("plain_file", "x");
   EXPECT_THROW(CsvWriter(file + "/a.csv", {"a"}), InvalidInput);  // parent is a file
+}
+
+namespace {
+// A full disk, without privileges: RLIMIT_FSIZE makes write(2) fail with EFBIG past `bytes`
+// (SIGXFSZ ignored), exactly where ENOSPC would. Restored when the guard goes.
+struct FileSizeLimit {
+  rlimit old{};
+  void (*old_handler)(int) = nullptr;
+  explicit FileSizeLimit(rlim_t bytes) {
+    getrlimit(RLIMIT_FSIZE, &old);
+    old_handler = std::signal(SIGXFSZ, SIG_IGN);
+    rlimit lim = old;
+    lim.rlim_cur = bytes;
+    setrlimit(RLIMIT_FSIZE, &lim);
+  }
+  ~FileSizeLimit() {
+    setrlimit(RLIMIT_FSIZE, &old);
+    std::signal(SIGXFSZ, old_handler);
+  }
+};
+}  // namespace
+
+TEST(Files, AFullDiskNamesTheFileAndLeavesTheOldContent) {
+  TempDir dir;
+  const auto path = dir.write("summary.json", "old");
+  {
+    FileSizeLimit full(4096);
+    try {
+      writeTextFileAtomic(path, std::string(100000, 'x'));
+      FAIL() << "a write past the limit succeeded";
+    } catch (const InvalidInput& e) {
+      const std::string msg = e.what();
+      EXPECT_NE(msg.find(path), std::string::npos) << msg;
+      EXPECT_NE(msg.find("cannot write"), std::string::npos) << msg;
+    }
+  }
+  EXPECT_EQ(slurp(path), "old");
+  EXPECT_EQ(dir.count(), 1u);  // no temporary left behind
+}
+
+TEST(Files, SummaryOfAnInterruptedRunSaysSo) {
+  TempDir dir;
+  const auto path = dir.file("s.json");
+  nlohmann::json j;
+  j["throws"] = 3;
+  writeSummaryFile(path, j);
+  EXPECT_FALSE(readJsonFile(path).contains("interrupted"));
+  viewline::core::noteInterrupt(SIGINT);
+  writeSummaryFile(path, j);
+  viewline::core::clearInterrupt();
+  const auto got = readJsonFile(path);
+  EXPECT_EQ(got["interrupted"], true);
+  EXPECT_EQ(got["interrupt_signal"], "SIGINT");
+  EXPECT_EQ(got["throws"], 3);
+}
+
+TEST(Log, CsvAppearsWholeAtTheFirstFlushThenGrows) {
+  TempDir dir;
+  LogDirectory log(dir.file("log"));
+  auto& s = log.stream("x", {"t"});
+  s.row({1.0});
+  EXPECT_FALSE(std::filesystem::exists(dir.file("log/x.csv")));  // only the hidden temporary so far
+  log.flush();
+  EXPECT_EQ(slurp(dir.file("log/x.csv")), "t\n1\n");
+  s.row({2.0});
+  log.flush();
+  EXPECT_EQ(slurp(dir.file("log/x.csv")), "t\n1\n2\n");
+  s.close();
+  s.row({3.0});  // closed: discarded
+  EXPECT_EQ(slurp(dir.file("log/x.csv")), "t\n1\n2\n");
+  std::size_t n = 0;
+  for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator(dir.path / "log")) ++n;
+  EXPECT_EQ(n, 1u);
+}
+
+TEST(Log, AFullDiskThrowsNamingTheLogAndLeavesNoPartialFile) {
+  TempDir dir;
+  const std::string path = dir.file("log/big.csv");
+  {
+    LogDirectory log(dir.file("log"));
+    auto& s = log.stream("big", {"a", "b", "c"});
+    FileSizeLimit full(8192);
+    try {
+      for (int i = 0; i < 100000; ++i) s.row({1.0 * i, 2.0 * i, 3.0 * i});
+      log.flush();
+      FAIL() << "no error past the file size limit";
+    } catch (const InvalidInput& e) {
+      EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+    }
+    EXPECT_FALSE(s.enabled());  // the log ended at the error
+  }
+  EXPECT_FALSE(std::filesystem::exists(path));
+  std::size_t n = 0;
+  for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator(dir.path / "log")) ++n;
+  EXPECT_EQ(n, 0u);
 }

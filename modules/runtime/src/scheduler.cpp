@@ -114,17 +114,17 @@ void Scheduler::runOne() {
 std::size_t Scheduler::runUntil(double t_end) {
   if (std::isnan(t_end)) throw core::InvalidInput("Scheduler::runUntil: end time is NaN");
   std::size_t n = 0;
-  while (!stop_ && !queue_.empty() && queue_.top().t <= t_end) {
+  while (!stopRequested() && !queue_.empty() && queue_.top().t <= t_end) {
     const bool live = entries_.count(queue_.top().id) != 0;
     runOne();
     if (live) ++n;
   }
-  if (!stop_ && t_end > now_ && std::isfinite(t_end)) now_ = t_end;
+  if (!stopRequested() && t_end > now_ && std::isfinite(t_end)) now_ = t_end;
   return n;
 }
 
 bool Scheduler::step() {
-  while (!stop_ && !queue_.empty()) {
+  while (!stopRequested() && !queue_.empty()) {
     if (entries_.count(queue_.top().id) == 0) {
       queue_.pop();
       continue;

@@ -140,3 +140,24 @@ TEST(DelayLine, DeliversInOrderOnceAvailable) {
   EXPECT_EQ(got, (std::vector<std::pair<double, int>>{{0.3, 1}, {0.2, 2}}));
   EXPECT_THROW(line.send(std::numeric_limits<double>::quiet_NaN(), 4), core::InvalidInput);
 }
+
+TEST(Scheduler, ASignalsStopRequestEndsTheRunBeforeTheNextEvent) {
+  Scheduler s;
+  int runs = 0;
+  s.every(0.0, 0.1, prio::Control, [&](double t) {
+    ++runs;
+    if (t >= 0.25) core::noteInterrupt(2);  // what the apps' SIGINT handler records
+  });
+  s.runUntil(10.0);
+  const bool stopped = s.stopRequested();
+  s.clearStop();  // the process-wide request is not the scheduler's to forget
+  const bool still = s.stopRequested();
+  core::clearInterrupt();
+  EXPECT_EQ(runs, 4);  // 0, 0.1, 0.2, 0.3: nothing after the request
+  EXPECT_NEAR(s.now(), 0.3, 1e-12);
+  EXPECT_TRUE(stopped);
+  EXPECT_TRUE(still);
+  EXPECT_FALSE(s.stopRequested());
+  s.runUntil(0.45);
+  EXPECT_EQ(runs, 5);  // goes on once the request is cleared
+}

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "viewline/core/error.h"
+#include "viewline/core/interrupt.h"
 #include "viewline/core/random.h"
 #include "viewline/estimation/consistency.h"
 #include "viewline/runtime/scheduler.h"
@@ -319,11 +320,15 @@ DartSummary runDartExperiments(const DartScenarioConfig& cfg, std::uint64_t seed
   sum.scenario_gate.gate = tracking::toString(cfg.tracker.gate.kind);
   Pools pools;
   DartRun one(cfg, cams, exact, offset, cb, pools, sum);
+  int done = 0;
   for (int run = 0; run < runs; ++run) {
     one.run(run, core::deriveSeed(seed, static_cast<std::uint64_t>(run)));
-    if (cb.progress) cb.progress(run + 1, runs);
+    done = run + 1;
+    if (cb.progress) cb.progress(done, runs);
+    if (core::interruptRequested()) break;  // Ctrl-C / SIGTERM: summarise the runs so far (the last one cut short)
   }
-  finish(sum, pools, cfg, runs);
+  sum.runs = done;
+  finish(sum, pools, cfg, done);
   sum.runtime_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
   return sum;
 }

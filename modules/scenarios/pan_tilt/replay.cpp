@@ -153,6 +153,11 @@ PanTiltReplayMetrics replayPanTiltFilter(const PanTiltScenarioConfig& cfg, std::
     }
     if (v.size() != header.size()) throw core::InvalidInput(frames_csv + ":" + std::to_string(row) + ": wrong number of columns");
     const double t = v[ct];
+    // A missing or infinite time stamp would reach the filter as NaN/inf (every measurement carries its time).
+    if (!std::isfinite(t))
+      throw core::InvalidInput(frames_csv + ":" + std::to_string(row) + ": column " + std::to_string(ct + 1) +
+                               " (t) is '" + (std::isnan(t) ? std::string("nan") : std::string("inf")) +
+                               "' (expected a finite time, s)");
     if (t >= cfg.duration) break;
     if (check_truth && (path.position(t) - Vector2d(v[ctx], v[cty])).norm() > 1e-6)
       throw core::InvalidInput(frames_csv + ":" + std::to_string(row) + ": the logged truth (" + std::to_string(v[ctx]) +

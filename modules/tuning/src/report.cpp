@@ -81,9 +81,7 @@ void HtmlReport::table(const std::vector<std::string>& header, const std::vector
 }
 
 std::string HtmlReport::dataFile(const std::string& file, const std::string& content) {
-  std::ofstream out(fs::path(dir_) / "plots" / file);
-  out << content;
-  if (!out) throw core::InvalidInput((fs::path(dir_) / "plots" / file).string() + ": cannot write");
+  io::writeTextFileAtomic((fs::path(dir_) / "plots" / file).string(), content);  // errors name the file
   return file;
 }
 

@@ -3,6 +3,7 @@
 // file: content goes to a temporary file next to the target, which is renamed
 // over the target (rename is atomic on POSIX within one file system).
 
+#include <cstddef>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -10,17 +11,26 @@
 
 namespace viewline::io {
 
-/// Writes `content` to `path` atomically (tmp file + rename). Creates missing parent
-/// directories. Throws core::InvalidInput naming the path on failure (the target is untouched).
+/// Writes `content` to `path` atomically (tmp file + fsync + rename). Creates missing parent
+/// directories. Throws core::InvalidInput naming the path and the cause (e.g. "No space left on
+/// device (the disk is full)") on failure; the target is then untouched and no temporary is left.
 void writeTextFileAtomic(const std::string& path, const std::string& content);
 
 /// nlohmann::json to a file, atomically (e.g. an app's --summary FILE).
 void writeJsonFile(const std::string& path, const nlohmann::json& j, int indent = 2);
 /// An app's --summary FILE: `j` with "viewline_version" (core::kVersion) added, written atomically,
-/// so every summary says which version produced it.
+/// so every summary says which version produced it. After a SIGINT/SIGTERM (core::interruptRequested())
+/// it also gets `"interrupted": true` and `"interrupt_signal"` ("SIGINT" or "SIGTERM"): a partial run.
 void writeSummaryFile(const std::string& path, nlohmann::json j);
 /// Reads a JSON file; errors name the file and the parse position.
 nlohmann::json readJsonFile(const std::string& path);
+
+/// A fresh name for a temporary file next to `path` (same folder, so a rename onto `path` is atomic):
+/// ".<name>.tmp<pid>_<n>", hidden, unique within the process.
+std::string temporaryPathFor(const std::string& path);
+/// write(2) of all `size` bytes to `fd` (retried after EINTR); throws core::InvalidInput naming
+/// `path` and the cause (disk full, file size limit...) when the system refuses.
+void writeAllOrThrow(int fd, const char* data, std::size_t size, const std::string& path);
 
 /// All-or-nothing output of several files, whoever writes them (ofstream, cv::FileStorage,
 /// vpXmlParserCamera...):

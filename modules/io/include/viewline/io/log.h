@@ -5,8 +5,13 @@
 //   io::LogDirectory log(cli_log_dir);            // "" = logging off, every call a no-op
 //   auto& est = log.stream("estimates", {"t", "x", "y", "z"});
 //   est.row({t, x(0), x(1), x(2)});               // column count checked against the header
+//   log.flush();                                  // end of the run: every file complete, errors thrown
+//
+// Nothing half-written replaces a file: rows go to a temporary file next to `<name>.csv`, which is
+// renamed onto it at the first flush() (or when the writer closes, also when a run is interrupted
+// or fails); later rows are appended in whole lines. Write errors (a full disk) throw
+// core::InvalidInput naming the file.
 
-#include <fstream>
 #include <map>
 #include <memory>
 #include <string>
@@ -19,11 +24,18 @@ class CsvWriter {
 public:
   /// A disabled writer: rows are discarded.
   CsvWriter() = default;
-  /// Creates (truncates) `path` and writes the header. Throws InvalidInput naming the path.
+  /// Opens a temporary file next to `path` and writes the header. Throws InvalidInput naming the path.
   CsvWriter(const std::string& path, std::vector<std::string> header, int precision = 12);
+  /// Closes the file, renaming the temporary onto `path` if flush() never did (errors are printed
+  /// to stderr, not thrown: call close() to see them).
+  ~CsvWriter();
+  /// Not copyable: one writer owns its file.
+  CsvWriter(const CsvWriter&) = delete;
+  /// Not copyable: one writer owns its file.
+  CsvWriter& operator=(const CsvWriter&) = delete;
 
-  /// True when a file is open (rows are written).
-  bool enabled() const { return out_.is_open(); }
+  /// Whether rows are written (false for the disabled writer).
+  bool enabled() const { return fd_ >= 0; }
   /// Column names, as written in the header line.
   const std::vector<std::string>& header() const { return header_; }
   /// Path of the CSV file ("" when disabled).
@@ -35,14 +47,21 @@ public:
   void row(const std::vector<double>& values);
   /// Text fields (quoted when they contain a comma, quote or newline).
   void rowText(const std::vector<std::string>& fields);
-  /// Flushes the file to disk (no-op when disabled).
+  /// Writes the buffered rows and makes the file visible at path() (renames the temporary onto it
+  /// the first time). Throws InvalidInput naming the file when the system refuses (disk full).
   void flush();
+  /// flush(), then closes the file; later rows are discarded. Idempotent.
+  void close();
 
 private:
   void checkCount(std::size_t n) const;
+  void append(const std::string& line);
+  void writeBuffer();
   std::string path_;
+  std::string tmp_;            // the temporary until published, then empty
   std::vector<std::string> header_;
-  std::ofstream out_;
+  int fd_ = -1;
+  std::string buffer_;         // whole lines not yet written
   int precision_ = 12;
   std::size_t rows_ = 0;
 };
@@ -60,7 +79,7 @@ public:
   /// header throws. When disabled, a shared no-op writer. `precision`: significant digits (17: every
   /// double reads back exactly, for logs that are replayed).
   CsvWriter& stream(const std::string& name, const std::vector<std::string>& header, int precision = 12);
-  /// Flushes every stream.
+  /// Flushes every stream (each file complete at its path); throws naming the first file that fails.
   void flush();
 
 private:

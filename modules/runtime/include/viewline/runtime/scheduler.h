@@ -30,6 +30,8 @@
 #include <unordered_map>
 #include <vector>
 
+#include "viewline/core/interrupt.h"
+
 namespace viewline::runtime {
 
 /// Tie-breaking ranks at equal simulated time (smaller runs first). Scenarios may use any int;
@@ -104,12 +106,13 @@ public:
   /// The pacing in use.
   Pacing pacing() const { return pacing_; }
 
-  /// Asks runUntil()/step() to return before the next event (e.g. a display's quit key or
-  /// SIGINT); stopRequested() stays true until clearStop().
+  /// Asks runUntil()/step() to return before the next event (e.g. a display's quit key);
+  /// stopRequested() stays true until clearStop().
   void requestStop() { stop_ = true; }
-  /// True after requestStop() until clearStop().
-  bool stopRequested() const { return stop_; }
-  /// Clears a stop request so that runUntil()/step() run events again.
+  /// requestStop() was called, or a signal asked the process to stop (core::interruptRequested():
+  /// Ctrl-C / SIGTERM, recorded by the apps' handler), so every scheduler of the process ends its run.
+  bool stopRequested() const { return stop_ || core::interruptRequested(); }
+  /// Forgets requestStop() (not a signal's request, which belongs to the process).
   void clearStop() { stop_ = false; }
 
 private:
