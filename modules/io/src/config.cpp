@@ -99,8 +99,10 @@ template <> const char* typeName<Eigen::Vector3d>() { return "[x, y, z]"; }
 template <> const char* typeName<Eigen::Matrix3d>() { return "3x3 matrix, rows"; }
 
 // The shortest decimal text that reads back as `v` with at most `digits` significant digits (an
-// angle converted from radians reads "62", not "62.000000000000007"); YAML's .inf and .nan.
+// angle converted from radians, shown to 6 digits, reads "62", not "62.000000000000007"); YAML's
+// .inf and .nan; -0 as 0.
 std::string numberText(double v, int digits = 17) {
+  if (v == 0.0) return "0";
   if (std::isnan(v)) return ".nan";
   if (std::isinf(v)) return v > 0 ? ".inf" : "-.inf";
   char buf[64];
@@ -402,7 +404,7 @@ double ConfigNode::getAngle(const std::string& key) const {
 
 double ConfigNode::getAngleOr(const std::string& key, double fallback_rad) const {
   const KeyNote note = noteDefault(key, [] { return std::string("angle, degrees"); },
-                                   [&] { return numberText(core::rad2deg(fallback_rad), 12); });
+                                   [&] { return numberText(core::rad2deg(fallback_rad), 6); });
   return has(key) ? getAngle(key) : fallback_rad;
 }
 

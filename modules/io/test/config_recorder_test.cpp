@@ -18,6 +18,7 @@ void readExample(const ConfigNode& root) {
   root.getOr<double>("rate_hz", 50.0);
   root.get<std::string>("name");
   root.getAngleOr("pan_limit_deg", viewline::core::deg2rad(62.0));
+  root.getAngleOr("margin_deg", 0.02);
   root.getChoiceOr("gate", {"none", "mahalanobis"}, "mahalanobis");
   if (root.has("seed")) root.get<unsigned>("seed");
   root.getOr<Eigen::Vector3d>("p0", Eigen::Vector3d(0.0, 0.5, -1.25));
@@ -52,6 +53,7 @@ TEST(ConfigRecorder, RecordsTypeDefaultAndPresenceOfEveryKeyRead) {
   // round-off of the conversion.
   EXPECT_EQ(keyOf(*rec, "pan_limit_deg").type, "angle, degrees");
   EXPECT_EQ(keyOf(*rec, "pan_limit_deg").defaults.at(0), "62");
+  EXPECT_EQ(keyOf(*rec, "margin_deg").defaults.at(0), "1.14592");  // 0.02 rad, to 6 digits
   EXPECT_EQ(keyOf(*rec, "gate").type, "one of: none, mahalanobis");
   EXPECT_EQ(keyOf(*rec, "gate").defaults.at(0), "mahalanobis");
   EXPECT_EQ(keyOf(*rec, "p0").type, "[x, y, z]");
@@ -62,7 +64,7 @@ TEST(ConfigRecorder, RecordsTypeDefaultAndPresenceOfEveryKeyRead) {
   EXPECT_EQ(rec->find("seed"), nullptr);
   EXPECT_EQ(rec->find("tracker"), nullptr);
   // A getOr reads the key through get<T>: one record, not two.
-  EXPECT_EQ(rec->keys().size(), 7u);
+  EXPECT_EQ(rec->keys().size(), 8u);
 }
 
 TEST(ConfigRecorder, UnitesReadsInReadingOrderWithListItemsOnce) {
@@ -86,7 +88,7 @@ TEST(ConfigRecorder, UnitesReadsInReadingOrderWithListItemsOnce) {
   EXPECT_EQ(keyOf(*rec, "cameras[].enabled").defaults.at(0), "true");
   std::vector<std::string> order;
   for (const auto& k : rec->keys()) order.push_back(k.path);
-  const std::vector<std::string> expected = {"rate_hz", "name", "pan_limit_deg", "gate", "seed", "p0", "max_coast_s",
+  const std::vector<std::string> expected = {"rate_hz", "name", "pan_limit_deg", "margin_deg", "gate", "seed", "p0", "max_coast_s",
                                              "label", "tracker", "tracker.history", "cameras", "cameras[].enabled"};
   EXPECT_EQ(order, expected);
 }
@@ -111,6 +113,7 @@ TEST(ConfigRecorder, DefaultsAreYamlThatReadsBackAsTheDefault) {
   EXPECT_EQ(ConfigNode::configValueText(0.1), "0.1");
   EXPECT_EQ(ConfigNode::configValueText(1e-9), "1e-09");
   EXPECT_EQ(ConfigNode::configValueText(-std::numeric_limits<double>::infinity()), "-.inf");
+  EXPECT_EQ(ConfigNode::configValueText(-0.0), "0");
   EXPECT_EQ(ConfigNode::configValueText(std::string("true")), "\"true\"");
   EXPECT_EQ(ConfigNode::configValueText(std::string("known_radius")), "known_radius");
   EXPECT_EQ(ConfigNode::configValueText(std::vector<int>{0, 0, 4}), "[0, 0, 4]");

@@ -7,3 +7,5 @@ list(APPEND scenarios_sources
   ball_catching/metrics.cpp
   ball_catching/registration.cpp
   ball_catching/world.cpp)
+# Unit and meaning of every key its config reader reads (docs/config_reference.md is generated from it).
+list(APPEND scenarios_sources ball_catching/config_keys.cpp)

@@ -31,8 +31,10 @@
 #include "viewline/core/error.h"
 
 namespace viewline::io {
+class ConfigRecorder;  // the key recorder, below ConfigNode
+}  // namespace viewline::io
 
-class ConfigRecorder;
+namespace viewline::io {
 
 class ConfigNode {
 public:
@@ -201,12 +203,16 @@ class ConfigRecorder {
 public:
   /// How a key is read: without a default and unconditionally (required), only when present
   /// (optional: absent has a meaning the code gives), or with a default value.
-  enum class Presence { Required, Optional, Default };
+  enum class Presence {
+    Required,  ///< read without a default and without asking has() first
+    Optional,  ///< read only when present (has() asked first): absent keeps what the code chose
+    Default,   ///< read with getOr and its fallback: absent means that default
+  };
   /// One key: dotted path with list items as "cameras[]", type, presence and default(s).
   struct Key {
     std::string path;                   ///< "tracker.gate", "cameras[].name"
     std::string type;                   ///< "number", "integer >= 0", "one of: a, b", "section", ...
-    Presence presence = Presence::Required;
+    Presence presence = Presence::Required;  ///< how the code reads it (the loosest of all reads)
     std::vector<std::string> defaults;  ///< distinct defaults seen (YAML text); more than one: derived
   };
 
@@ -226,35 +232,65 @@ private:
   std::size_t cursor_ = 0;  ///< where a key first seen in the current read is inserted
 };
 
+/// Reference type name of a bool key: `bool`.
 template <> std::string ConfigNode::configTypeName<bool>();
+/// Reference type name of a int key: `integer`.
 template <> std::string ConfigNode::configTypeName<int>();
+/// Reference type name of a unsigned key: `integer >= 0`.
 template <> std::string ConfigNode::configTypeName<unsigned>();
+/// Reference type name of a long long key: `integer`.
 template <> std::string ConfigNode::configTypeName<long long>();
+/// Reference type name of a unsigned long key: `integer >= 0`.
 template <> std::string ConfigNode::configTypeName<unsigned long>();
+/// Reference type name of a unsigned long long key: `integer >= 0`.
 template <> std::string ConfigNode::configTypeName<unsigned long long>();
+/// Reference type name of a double key: `number`.
 template <> std::string ConfigNode::configTypeName<double>();
+/// Reference type name of a std::string key: `string`.
 template <> std::string ConfigNode::configTypeName<std::string>();
+/// Reference type name of a list of numbers key: `list of numbers`.
 template <> std::string ConfigNode::configTypeName<std::vector<double>>();
+/// Reference type name of a list of integers key: `list of integers`.
 template <> std::string ConfigNode::configTypeName<std::vector<int>>();
+/// Reference type name of a list of strings key: `list of strings`.
 template <> std::string ConfigNode::configTypeName<std::vector<std::string>>();
+/// Reference type name of a 2-vector key: `[x, y]`.
 template <> std::string ConfigNode::configTypeName<Eigen::Vector2d>();
+/// Reference type name of a 3-vector key: `[x, y, z]`.
 template <> std::string ConfigNode::configTypeName<Eigen::Vector3d>();
+/// Reference type name of a vector key: `list of numbers`.
 template <> std::string ConfigNode::configTypeName<Eigen::VectorXd>();
+/// Reference type name of a 3x3 matrix key: `3x3 matrix, rows`.
 template <> std::string ConfigNode::configTypeName<Eigen::Matrix3d>();
+/// A bool default as YAML text: true / false.
 template <> std::string ConfigNode::configValueText<bool>(const bool& value);
+/// A int default as YAML text: decimal.
 template <> std::string ConfigNode::configValueText<int>(const int& value);
+/// A unsigned default as YAML text: decimal.
 template <> std::string ConfigNode::configValueText<unsigned>(const unsigned& value);
+/// A long long default as YAML text: decimal.
 template <> std::string ConfigNode::configValueText<long long>(const long long& value);
+/// A unsigned long default as YAML text: decimal.
 template <> std::string ConfigNode::configValueText<unsigned long>(const unsigned long& value);
+/// A unsigned long long default as YAML text: decimal.
 template <> std::string ConfigNode::configValueText<unsigned long long>(const unsigned long long& value);
+/// A double default as YAML text: shortest decimal that reads back exactly; .inf, .nan.
 template <> std::string ConfigNode::configValueText<double>(const double& value);
+/// A std::string default as YAML text: plain, or double-quoted when YAML would read it otherwise.
 template <> std::string ConfigNode::configValueText<std::string>(const std::string& value);
+/// A list of numbers default as YAML text: [a, b, ...].
 template <> std::string ConfigNode::configValueText<std::vector<double>>(const std::vector<double>& value);
+/// A list of integers default as YAML text: [a, b, ...].
 template <> std::string ConfigNode::configValueText<std::vector<int>>(const std::vector<int>& value);
+/// A list of strings default as YAML text: [a, b, ...].
 template <> std::string ConfigNode::configValueText<std::vector<std::string>>(const std::vector<std::string>& value);
+/// A 2-vector default as YAML text: [x, y].
 template <> std::string ConfigNode::configValueText<Eigen::Vector2d>(const Eigen::Vector2d& value);
+/// A 3-vector default as YAML text: [x, y, z].
 template <> std::string ConfigNode::configValueText<Eigen::Vector3d>(const Eigen::Vector3d& value);
+/// A vector default as YAML text: [a, b, ...].
 template <> std::string ConfigNode::configValueText<Eigen::VectorXd>(const Eigen::VectorXd& value);
+/// A 3x3 matrix default as YAML text: [[row 0], [row 1], [row 2]].
 template <> std::string ConfigNode::configValueText<Eigen::Matrix3d>(const Eigen::Matrix3d& value);
 
 }  // namespace viewline::io
