@@ -23,6 +23,7 @@
 
 namespace viewline::scenarios {
 
+/// A calibrated rig folder: the true cameras the simulator renders with and the calibrated ones estimators use.
 struct SimulatedRig {
   std::string folder;                    ///< the rig folder as resolved (no trailing slash)
   calib::RigTruth truth;                 ///< what the simulator renders with (and scores against)
@@ -30,6 +31,7 @@ struct SimulatedRig {
 
   /// Throws core::InvalidInput naming the rig folder and the known camera names.
   const core::Camera& trueCamera(const std::string& name) const;
+  /// The calibrated camera `name` (rig.yaml: intrinsics and c_M_w); throws like trueCamera.
   const core::Camera& calibratedCamera(const std::string& name) const;
   /// Path of another file of the rig folder.
   std::string file(const std::string& name) const;

@@ -25,37 +25,42 @@
 
 namespace viewline::scenarios {
 
+/// One camera of the catching rig (config key cameras[]): geometry (inline or from the rig) and capture model.
 struct CatchCameraConfig {
-  std::string name = "camera";
-  unsigned width = 640, height = 480;
+  std::string name = "camera";  ///< camera name (with a rig: a camera of the rig)
+  unsigned width = 640,   ///< image width, px
+           height = 480;  ///< image height, px
   double hfov_rad = 1.0471975511965976;  ///< 60°
-  double cx = -1.0, cy = -1.0;           ///< principal point, px (< 0: image centre)
+  double cx = -1.0,  ///< principal point u0, px (< 0: image centre)
+         cy = -1.0;  ///< principal point v0, px (< 0: image centre)
   double kud = 0.0;                      ///< ViSP forward radial distortion
-  Eigen::Vector3d position = Eigen::Vector3d(1.0, -3.2, 1.9);
-  Eigen::Vector3d look_at = Eigen::Vector3d(2.2, 0.0, 1.3);
-  double rate_hz = 50.0;
+  Eigen::Vector3d position = Eigen::Vector3d(1.0, -3.2, 1.9);  ///< camera centre, world, m
+  Eigen::Vector3d look_at = Eigen::Vector3d(2.2, 0.0, 1.3);   ///< a point on the optical axis, world, m
+  double rate_hz = 50.0;  ///< frame rate, Hz
   double drift = 0.0;                 ///< relative clock period error
   double exposure_s = 0.002;          ///< motion blur exposure (0: none)
-  int blur_samples = 3;
+  int blur_samples = 3;               ///< renders averaged over the exposure
   double noise_sigma = 2.0;           ///< grey levels
-  double drop_probability = 0.0;
-  double trigger_jitter_s = 0.0002;
-  double stamp_jitter_s = 0.0;
+  double drop_probability = 0.0;      ///< probability that a frame is lost
+  double trigger_jitter_s = 0.0002;   ///< trigger-time jitter (std), s
+  double stamp_jitter_s = 0.0;        ///< time-stamp jitter (std), s
   /// With a `rig:` (scenarios::loadSimulatedRig): the TRUE camera the simulator renders with
   /// (truth.yaml) and the CALIBRATED one the detector and tracker use (rig.yaml); the geometry
   /// fields above are then unused (width/height are copied from the truth). Without a rig both are
   /// built from the fields above: a perfectly calibrated rig.
-  std::optional<core::Camera> true_camera, calibrated_camera;
+  std::optional<core::Camera> true_camera,        ///< truth.yaml's camera (rendering), with a rig
+                              calibrated_camera;  ///< rig.yaml's camera (detector and tracker), with a rig
   core::Camera renderCamera() const;     ///< true_camera, or the one built from the fields
   core::Camera estimatorCamera() const;  ///< calibrated_camera, or the one built from the fields
 };
 
+/// Where and how the throws go: release box, aim disc, speeds and the thrown body.
 struct ThrowDistribution {
   Eigen::Vector3d release_min = Eigen::Vector3d(-1.0, -0.3, 1.0);  ///< m (x: 3-5 m from the box at x = 4)
-  Eigen::Vector3d release_max = Eigen::Vector3d(1.0, 0.3, 1.6);
+  Eigen::Vector3d release_max = Eigen::Vector3d(1.0, 0.3, 1.6);  ///< release box, upper corner, world, m
   double aim_radius = 0.35;         ///< m, aim points uniform in this disc around home (box plane)
   double speed_min = 6.0;           ///< m/s, mean horizontal speed
-  double speed_max = 9.0;
+  double speed_max = 9.0;           ///< m/s, >= speed_min
   sim::DragBody body = sim::DragBody::ball5cm();  ///< 5 cm ball, 57 g, Cd 0.5, ρ 1.2 (k ≈ 0.0103 /m)
 };
 
@@ -75,24 +80,27 @@ struct ThrowDistribution {
 struct CatchRegistration {
   bool enabled = false;  ///< off unless the config's registration.enabled says so
   Eigen::Vector3d marker_offset = Eigen::Vector3d(0.15, 0.0, 0.175);  ///< m, from the hole centre (world axes)
-  double marker_radius = 0.025;
+  double marker_radius = 0.025;  ///< marker sphere radius, m
   Eigen::Vector3d marker_albedo_bgr = Eigen::Vector3d(0.15, 0.75, 0.15);  ///< green
-  vision::ColorRange marker_hsv{35, 85, 80, 255, 30, 255};
-  std::vector<double> offsets_x{-0.08, 0.08}, offsets_y{-0.4, 0.0, 0.4}, offsets_z{-0.3, 0.0, 0.3};  ///< m, from home
-  int min_points = 6;
+  vision::ColorRange marker_hsv{35, 85, 80, 255, 30, 255};  ///< HSV range of the green marker
+  std::vector<double> offsets_x{-0.08, 0.08},       ///< set points from home along x, m
+                      offsets_y{-0.4, 0.0, 0.4},    ///< set points from home along y, m
+                      offsets_z{-0.3, 0.0, 0.3};    ///< set points from home along z, m
+  int min_points = 6;  ///< fewer marker detections: the camera keeps its calibrated pose
   double gate_px = 10.0;          ///< detections farther than this from the expected pixel are dropped
   double max_rms_px = 0.5;        ///< refuse a camera's registration above this reprojection RMS,
   double max_shift_m = 0.05;      ///< or moving its centre more than this,
   double max_rotation_rad = 0.0087;  ///< or rotating it more than this (0.5°)
 };
 
+/// The ball-catching scenario's configuration (config/ball_catching*.yaml; keys in docs/config_reference.md).
 struct BallCatchingConfig {
-  std::string name = "ball_catching";
+  std::string name = "ball_catching";  ///< scenario name in summaries
   std::string rig;                   ///< rig folder as resolved ("" : inline cameras)
-  std::vector<CatchCameraConfig> cameras;
+  std::vector<CatchCameraConfig> cameras;  ///< the cameras, in config order
   std::size_t camera_count = 0;      ///< use the first N cameras (0: all)
   double rate_override_hz = 0.0;     ///< > 0: every camera at this rate (throws; registration keeps rate_hz)
-  ThrowDistribution throws;
+  ThrowDistribution throws;  ///< the throws
   Eigen::Vector3d ball_albedo_bgr = Eigen::Vector3d(0.08, 0.45, 0.95);  ///< orange (dart: flight colour)
   /// "ball" (a sphere of the body's radius) or "dart" (sim::makeDart oriented along its velocity;
   /// the detector then finds the coloured flights, 5 cm behind the centre of mass, and the
@@ -101,25 +109,25 @@ struct BallCatchingConfig {
   double hole_radius = 0.03;         ///< m (6 cm hole)
   Eigen::Vector3d box_normal = -Eigen::Vector3d::UnitX();  ///< box-front normal (unit), towards the thrower
   double box_size = 0.3;             ///< m, cube side (rendered)
-  bool render_box = true;
+  bool render_box = true;            ///< render the box in the images
   robots::SimulatedCartesianConfig robot;   ///< kind, limits, latency, home, workspace, arm geometry (w_R_box from box_normal)
   double control_period = 0.004;     ///< s between set points (250 Hz)
   double processing_latency = 0.008; ///< s from capture to the tracker/planner update
   double post_crossing_s = 0.05;     ///< s simulated after the true crossing
   double prediction_lead_s = 0.2;    ///< the early-prediction metric uses the last prediction this long before the crossing
-  vision::BallDetectorConfig detector;
+  vision::BallDetectorConfig detector;  ///< the colour-blob ball detector
   double sigma_px_floor = 0.3;       ///< px, floor of the measurement std given to the tracker
   /// px per axis: white Gaussian noise added to every detected pixel (pixel-noise table; 0: none).
   /// The tracker is told: its σ is the detector's σ and this one added in quadrature. Drawn from
   /// its own stream (deriveSeed(throw seed, 0xD37)), so the rest of a throw is unchanged.
   double pixel_noise_px = 0.0;
-  tracking::TrackerConfig tracker;
+  tracking::TrackerConfig tracker;  ///< the viewline tracker (gravity set from the world)
   /// The planner's own settings (model, thresholds). Home, limits and latency are the robot's and
   /// the plane normal is the box's: plannerConfig() and CatchPlanner(cfg, robot) ask their owners.
   planning::CatchPlannerConfig planner;
-  CatchRegistration registration;
-  sim::RenderSettings render;
-  sim::RoomParams room;
+  CatchRegistration registration;  ///< camera-to-robot registration before the throws
+  sim::RenderSettings render;      ///< renderer settings (supersampling)
+  sim::RoomParams room;            ///< the rendered room (walls, floor size)
   int threads = 2;                   ///< throws run in parallel (independent seeds: same results)
 
   /// The cameras a throw uses: the first camera_count (all when 0).

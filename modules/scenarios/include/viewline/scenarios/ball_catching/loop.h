@@ -45,17 +45,18 @@ namespace viewline::scenarios {
 
 /// What a live view gets for every image.
 struct CatchFrame {
-  int throw_index = 0;
-  std::size_t camera = 0;
+  int throw_index = 0;     ///< throw number (0-based)
+  std::size_t camera = 0;  ///< camera index
   const core::Camera* camera_model = nullptr;   ///< what the estimator believes (calibrated with rig:)
-  double t = 0.0;
-  const cv::Mat* image = nullptr;
-  std::optional<Eigen::Vector2d> detection;
+  double t = 0.0;                  ///< capture time, s
+  const cv::Mat* image = nullptr;  ///< the rendered BGR image (valid during the call)
+  std::optional<Eigen::Vector2d> detection;  ///< detected ball centre, px (none: not found)
   std::optional<planning::Crossing> crossing;   ///< planner's current target
-  Eigen::Vector3d hole = Eigen::Vector3d::Zero();
+  Eigen::Vector3d hole = Eigen::Vector3d::Zero();  ///< hole centre where the robot holds it, world, m
   std::optional<Eigen::Vector3d> estimate;      ///< tracker position
 };
 
+/// Optional hooks of a catching session: per-throw telemetry, live view, progress and pacing.
 struct CatchHooks {
   /// The telemetry sink of throw i, or null. Called once per throw, from the thread running it:
   /// with threads > 1 return a distinct sink per throw. The throw flushes it and drops its
@@ -64,7 +65,7 @@ struct CatchHooks {
   /// Live view of every image (the session then runs on one thread). Returning false stops the
   /// session: the throw under way is dropped, the throws done are summarised.
   std::function<bool(const CatchFrame&)> on_frame;
-  std::function<void(int done, int total)> progress;
+  std::function<void(int done, int total)> progress;  ///< after each throw
   runtime::Pacing pacing;  ///< wall-clock pacing of every throw (0: as fast as possible)
 };
 

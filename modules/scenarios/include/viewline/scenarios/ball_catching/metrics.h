@@ -36,59 +36,84 @@
 
 namespace viewline::scenarios {
 
+/// One throw: what was thrown, the truth, what the detector, tracker, planner and robot did, and the verdict.
 struct ThrowResult {
-  int index = 0;
-  std::uint64_t seed = 0;
+  int index = 0;           ///< throw number (0-based)
+  std::uint64_t seed = 0;  ///< the throw's own seed
   // Throw
-  Eigen::Vector3d release = Eigen::Vector3d::Zero(), launch_velocity = Eigen::Vector3d::Zero();
-  double launch_speed = 0.0, launch_elevation_deg = 0.0, distance = 0.0;
+  Eigen::Vector3d release = Eigen::Vector3d::Zero(),          ///< release point, world, m
+                  launch_velocity = Eigen::Vector3d::Zero();  ///< velocity at release, world, m/s
+  double launch_speed = 0.0,          ///< |launch_velocity|, m/s
+         launch_elevation_deg = 0.0,  ///< elevation of the launch velocity, deg
+         distance = 0.0;              ///< release to the box plane along its normal, m
   // Truth
   double t_cross = 0.0;                                 ///< true crossing time (release at 0)
   Eigen::Vector3d cross_true = Eigen::Vector3d::Zero(); ///< true crossing point
   double t_first_visible = -1.0;                        ///< first capture with the ball in an image
-  bool reachable = false;
+  bool reachable = false;                               ///< the oracle (home -> crossing in time) could catch it
   double oracle_time = 0.0;                             ///< T_min home -> crossing, s
   // Run
-  int frames = 0, detections = 0, fused = 0, gated = 0;
-  double t_first_detection = -1.0;
+  int frames = 0,      ///< frames captured during the throw
+      detections = 0,  ///< frames with the ball detected
+      fused = 0,       ///< detections the tracker fused
+      gated = 0;       ///< detections the tracker's gate rejected
+  double t_first_detection = -1.0;  ///< capture time of the first detection, s (-1: none)
   double t_first_move = -1.0;                           ///< planner's first move towards a target
-  bool had_target = false, committed = false, gave_up = false;
+  bool had_target = false,  ///< the planner had a target at some point
+       committed = false,   ///< the planner committed to a target
+       gave_up = false;     ///< the planner gave up (target unreachable)
   double give_up_lead = -1.0;                           ///< true crossing − give-up decision, s
   double decision_time = -1.0;                          ///< commit − first update, s
   Eigen::Vector3d target = Eigen::Vector3d::Zero();     ///< planner's final target
   double prediction_error = -1.0;                       ///< |target − true crossing|, m
   double prediction_error_lead = -1.0;                  ///< same, last prediction >= prediction_lead_s before it
-  Eigen::Vector3d hole_at_cross = Eigen::Vector3d::Zero();
+  Eigen::Vector3d hole_at_cross = Eigen::Vector3d::Zero();  ///< hole centre at the true crossing, world, m
   double miss_distance = 0.0;                           ///< in-plane |ball − hole| at the crossing, m
-  bool caught = false;
+  bool caught = false;                                  ///< the ball went through the hole
   std::string miss_reason;                              ///< "" when caught
-  std::size_t limit_violations = 0, refused_setpoints = 0;
-  double wall_s = 0.0;
+  std::size_t limit_violations = 0,   ///< robot set points beyond its limits
+              refused_setpoints = 0;  ///< set points the robot refused (outside its workspace)
+  double wall_s = 0.0;                ///< wall-clock time of the throw, s
 };
 
+/// A catching session's figures (the --summary JSON): catch rates, miss reasons, prediction and decision figures.
 struct CatchSummary {
-  std::uint64_t seed = 0;
-  int throws = 0, reachable_throws = 0, caught = 0, caught_reachable = 0;
-  double catch_rate_all = 0.0, catch_rate_reachable = 0.0;
-  std::map<std::string, int> miss_reasons;
-  double prediction_error_mm_median = 0.0, prediction_error_mm_p95 = 0.0;
-  double prediction_error_lead_mm_median = 0.0, prediction_error_lead_mm_p95 = 0.0;
-  int predictions_at_lead = 0;
-  double decision_time_s_median = 0.0, decision_time_s_p95 = 0.0;
-  int decisions = 0;
+  std::uint64_t seed = 0;  ///< master seed
+  int throws = 0,            ///< throws run
+      reachable_throws = 0,  ///< of them, reachable by the oracle
+      caught = 0,            ///< caught
+      caught_reachable = 0;  ///< reachable ones caught
+  double catch_rate_all = 0.0,        ///< caught / throws
+         catch_rate_reachable = 0.0;  ///< caught_reachable / reachable_throws
+  std::map<std::string, int> miss_reasons;  ///< missed throws per reason (see the top of this file)
+  double prediction_error_mm_median = 0.0,  ///< median |final target - true crossing|, mm
+         prediction_error_mm_p95 = 0.0;     ///< its 95th percentile, mm
+  double prediction_error_lead_mm_median = 0.0,  ///< median error of the prediction made prediction_lead_s early, mm
+         prediction_error_lead_mm_p95 = 0.0;     ///< its 95th percentile, mm
+  int predictions_at_lead = 0;  ///< throws with a prediction that early
+  double decision_time_s_median = 0.0,  ///< median time from the first update to the commitment, s
+         decision_time_s_p95 = 0.0;     ///< its 95th percentile, s
+  int decisions = 0;  ///< throws with a commitment
   int gave_up_unreachable = 0;   ///< not-reachable throws the planner gave up on (early decision)
   int gave_up_reachable = 0;     ///< reachable throws it gave up on (wrong decisions)
   double give_up_lead_s_median = 0.0;  ///< how long before the crossing it gave up (unreachable ones)
-  double miss_distance_mm_median_reachable = 0.0;
-  std::size_t limit_violations = 0, refused_setpoints = 0;
-  int frames = 0, detections = 0;
-  double detection_rate = 0.0;
-  std::optional<RegistrationResult> registration;
-  double launch_speed_min = 0.0, launch_speed_max = 0.0, launch_speed_mean = 0.0;
-  double elevation_deg_min = 0.0, elevation_deg_max = 0.0;
-  double flight_time_min = 0.0, flight_time_max = 0.0;
-  double wall_s = 0.0, ms_per_frame = 0.0;
-  std::vector<ThrowResult> results;
+  double miss_distance_mm_median_reachable = 0.0;  ///< median in-plane miss distance of the reachable throws, mm
+  std::size_t limit_violations = 0,   ///< robot set points beyond its limits, all throws
+              refused_setpoints = 0;  ///< set points the robot refused, all throws
+  int frames = 0,      ///< frames captured, all throws
+      detections = 0;  ///< frames with the ball detected
+  double detection_rate = 0.0;  ///< detections / frames
+  std::optional<RegistrationResult> registration;  ///< the registration, when enabled
+  double launch_speed_min = 0.0,   ///< slowest launch, m/s
+         launch_speed_max = 0.0,   ///< fastest launch, m/s
+         launch_speed_mean = 0.0;  ///< mean launch speed, m/s
+  double elevation_deg_min = 0.0,  ///< lowest launch elevation, deg
+         elevation_deg_max = 0.0;  ///< highest launch elevation, deg
+  double flight_time_min = 0.0,  ///< shortest release-to-crossing time, s
+         flight_time_max = 0.0;  ///< longest, s
+  double wall_s = 0.0,        ///< wall-clock time of the session, s
+         ms_per_frame = 0.0;  ///< wall-clock time per frame, ms
+  std::vector<ThrowResult> results;  ///< every throw, in throw order
 };
 
 /// The end of a throw: caught or not (and why), the oracle, the planner's decisions, the robot's
@@ -101,6 +126,7 @@ void scoreThrow(ThrowResult& res, const BallCatchingConfig& cfg, const robots::S
 CatchSummary summarise(std::vector<ThrowResult> results, std::uint64_t seed,
                        std::optional<RegistrationResult> registration);
 
+/// The session's --summary JSON (figures, config echo).
 nlohmann::json summaryJson(const CatchSummary& s, const BallCatchingConfig& cfg);
 
 /// One row per throw (throws.csv in a --log folder).

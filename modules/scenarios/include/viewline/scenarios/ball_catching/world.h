@@ -29,8 +29,9 @@ namespace viewline::scenarios {
 
 /// One drawn throw.
 struct ThrowDraw {
-  Eigen::Vector3d release = Eigen::Vector3d::Zero(), aim = Eigen::Vector3d::Zero();
-  Eigen::Vector3d launch_velocity = Eigen::Vector3d::Zero();
+  Eigen::Vector3d release = Eigen::Vector3d::Zero(),  ///< release point, world, m
+                  aim = Eigen::Vector3d::Zero();      ///< aim point in the box plane, world, m
+  Eigen::Vector3d launch_velocity = Eigen::Vector3d::Zero();  ///< velocity at release, world, m/s
   double flight_time = 0.0;  ///< release to the aim point, s
   double distance = 0.0;     ///< release to the box plane along its normal, m
 };
@@ -54,9 +55,12 @@ void appendBox(const BallCatchingConfig& cfg, const Eigen::Matrix3d& R, const Ei
 /// The room and the box held still with its hole at `hole` (registration).
 class StaticBoxWorld : public sim::World {
 public:
+  /// The box of `cfg` with its hole centre at `hole` (world, m) in `room` (both must outlive the world).
   StaticBoxWorld(const sim::Scene& room, const BallCatchingConfig& cfg, const Eigen::Vector3d& hole)
       : room_(room), cfg_(cfg), hole_(hole), R_(boxRotation(cfg.box_normal)) {}
+  /// The room.
   const sim::Scene& staticScene() const override { return room_; }
+  /// The box (and the marker), the same at every time.
   void dynamicObjects(double, std::vector<sim::Primitive>& out) const override { appendBox(cfg_, R_, hole_, out); }
 
 private:
@@ -70,10 +74,13 @@ private:
 /// holds it at time t (so the robot must have been commanded up to t before rendering).
 class CatchWorld : public sim::World {
 public:
+  /// The throw `flight` and the box on `robot` in `room` (all must outlive the world).
   CatchWorld(const sim::Scene& room, const sim::DragFlight& flight, const BallCatchingConfig& cfg,
              const robots::CartesianRobot& robot)
       : room_(room), flight_(flight), cfg_(cfg), robot_(robot), R_(boxRotation(cfg.box_normal)) {}
+  /// The room.
   const sim::Scene& staticScene() const override { return room_; }
+  /// The ball (or dart) at time t (s) on its flight and the box where the robot holds it then.
   void dynamicObjects(double t, std::vector<sim::Primitive>& out) const override;
 
 private:
@@ -95,10 +102,14 @@ std::vector<sim::SimCamera> throwCameras(const BallCatchingConfig& cfg, core::Rn
 /// The true objects of the last frame (a simulator's privilege) are kept for the metrics.
 class RigFrameSource : public runtime::FrameSource {
 public:
+  /// Frames of `cameras` (random phases from `rng`) rendering `world` until `t_end` (s).
   RigFrameSource(std::vector<sim::SimCamera> cameras, core::Rng& rng, const sim::RenderSettings& render,
                  const sim::World& world, double t_end);
+  /// The number of cameras.
   std::size_t cameraCount() const override { return rig_.cameras().size(); }
+  /// The end of the next frame's exposure (none after t_end).
   std::optional<core::Timestamp> nextReadyTime() const override;
+  /// Renders the next frame in capture-time order and keeps its truth.
   std::optional<runtime::Frame> grab() override;
   /// The truth of the last frame grabbed (empty before the first).
   const std::vector<sim::ObjectTruth>& lastTruth() const { return last_truth_; }

@@ -19,34 +19,36 @@
 
 namespace viewline::scenarios {
 
+/// One simulated camera of the dart rig (config key cameras[]).
 struct DartCameraConfig {
-  std::string name = "camera";
+  std::string name = "camera";  ///< name in logs and summaries
   Eigen::Vector3d eye_w = Eigen::Vector3d::Zero();     ///< camera centre, world, m
   Eigen::Vector3d target_w = Eigen::Vector3d::UnitX(); ///< look-at point, world, m
-  double hfov_rad = 1.0;
-  unsigned width = 656;
-  unsigned height = 480;
+  double hfov_rad = 1.0;  ///< horizontal field of view, rad
+  unsigned width = 656;   ///< image width, px
+  unsigned height = 480;  ///< image height, px
   double kud = 0.0;            ///< ViSP undistortion coefficient (pixel -> metre)
-  double rate_hz = 50.0;
+  double rate_hz = 50.0;  ///< frame rate, Hz
   double clock_drift_std = 1e-4;  ///< relative frequency error of the free-running clock (std)
   double jitter_std_s = 0.5e-3;   ///< capture-time jitter (std), s
 };
 
+/// The dart experiment's configuration (config/dart_tracking.yaml; keys in docs/config_reference.md).
 struct DartScenarioConfig {
-  std::vector<DartCameraConfig> cameras;
+  std::vector<DartCameraConfig> cameras;  ///< the simulated cameras (at least one)
   /// The one owner of gravity: the tracker's model asks trackerConfig() for it.
   Eigen::Vector3d gravity_w{0.0, 0.0, -9.81};
   // Throws.
-  Eigen::Vector3d release_mean{0.0, 0.0, 1.75};
-  Eigen::Vector3d release_std{0.05, 0.05, 0.05};
-  Eigen::Vector3d board_center{2.37, 0.0, 1.73};
+  Eigen::Vector3d release_mean{0.0, 0.0, 1.75};  ///< mean release point, world, m
+  Eigen::Vector3d release_std{0.05, 0.05, 0.05};  ///< std of the release point per axis, m
+  Eigen::Vector3d board_center{2.37, 0.0, 1.73};  ///< bull's eye, world, m
   double aim_std = 0.1;        ///< m, spread of the aim point on the board (y and z)
   double speed_min = 12.0;     ///< m/s
-  double speed_max = 16.0;
+  double speed_max = 16.0;     ///< m/s, >= speed_min
   double truth_accel_psd = 0.0;  ///< white acceleration of the true flights, m²/s³
   // Detection.
-  double pixel_noise_px = 0.5;
-  double outlier_rate = 0.05;
+  double pixel_noise_px = 0.5;  ///< detection noise (std per axis), px
+  double outlier_rate = 0.05;   ///< fraction of detections that are gross outliers, in [0, 1)
   /// Tracker (its prior, gate, model...); its model's gravity is gravity_w (see trackerConfig()).
   tracking::TrackerConfig tracker;
   double dt_offset_period = 0.01;  ///< grid of the Δt-offset filter, s
@@ -54,13 +56,13 @@ struct DartScenarioConfig {
   double alternate_step = 0.01;    ///< s between alternating images (camera rate = 1/(2 step))
   double late_max_delay = 0.1;     ///< s
   double late_horizon = 0.15;      ///< s
-  std::size_t single_camera = 0;
+  std::size_t single_camera = 0;    ///< index of the camera of the single-camera start (E)
   double single_offset_max = 70.0;  ///< m (and m/s for the velocity)
   double single_prior_std = 100.0;  ///< m
   double single_tolerance = 0.05;   ///< m
   std::size_t nees_index = 9;       ///< measurement (0-based) at which each run gives its NEES sample
   std::size_t settled_index = 4;    ///< RMSE / PCRLB pooled over measurements with index >= this
-  double confidence = 0.99;
+  double confidence = 0.99;  ///< confidence of the NEES intervals, in (0, 1)
 
   /// The tracker's configuration with the scenario's gravity in its model.
   tracking::TrackerConfig trackerConfig() const;

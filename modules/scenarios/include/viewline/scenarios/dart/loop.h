@@ -35,17 +35,18 @@ namespace viewline::scenarios {
 
 /// One logged detection (for --log): experiment, run, detection and the estimate after it.
 struct DartLogRow {
-  std::string experiment;
-  int run = 0;
-  DartDetection det;
-  tracking::Fate fate = tracking::Fate::Fused;
-  tracking::Vector6 estimate;
+  std::string experiment;  ///< "A" ... "E"
+  int run = 0;             ///< run (flight) index
+  DartDetection det;       ///< the detection and its truth
+  tracking::Fate fate = tracking::Fate::Fused;  ///< what the tracker did with it
+  tracking::Vector6 estimate;  ///< state (p, v) after it, world frame, m and m/s
 };
 
 /// The columns of the --log detections CSV and one row of it.
 std::vector<std::string> dartLogColumns();
 std::vector<std::string> dartLogRow(const DartLogRow& r);
 
+/// Optional hooks of runDartExperiments: progress, per-detection log, telemetry and pacing.
 struct DartRunCallbacks {
   std::function<void(int done, int total)> progress;  ///< after each run
   std::function<void(const DartLogRow&)> log;         ///< per processed detection (optional)

@@ -20,15 +20,15 @@ std::vector<core::Camera> makeDartCameras(const DartScenarioConfig& cfg);
 
 /// One generated detection with its truth.
 struct DartDetection {
-  tracking::ImageMeasurement m;
-  bool outlier = false;
+  tracking::ImageMeasurement m;  ///< the detection as the tracker receives it (pixel, σ, capture time, camera)
+  bool outlier = false;          ///< a generated gross outlier (not the dart)
   tracking::Vector6 truth;  ///< true state at the capture time
 };
 
 /// A generated flight: detections in capture-time order.
 struct DartFlight {
-  std::vector<DartDetection> detections;
-  double duration = 0.0;
+  std::vector<DartDetection> detections;  ///< in capture-time order
+  double duration = 0.0;                  ///< release to board, s
 };
 
 /// Alternating: camera 1 at odd, camera 2 at even steps of `alternate_step` ([L] §VI.A);

@@ -21,12 +21,16 @@ namespace viewline::scenarios {
 
 /// Gripper zones in the robot frame (x forward from the axle centre, y left), m.
 struct GripperZone {
-  double x_min = 0.12, x_max = 0.28, half_width = 0.07;
+  double x_min = 0.12,       ///< nearest x, m
+         x_max = 0.28,       ///< farthest x, m
+         half_width = 0.07;  ///< largest |y|, m
+  /// True when the point p_r (robot frame, m) is inside the zone.
   bool contains(const Eigen::Vector2d& p_r) const {
     return p_r.x() >= x_min && p_r.x() <= x_max && std::abs(p_r.y()) <= half_width;
   }
 };
 
+/// The mobile-capture scenario's configuration (config/mobile_capture.yaml; keys in docs/config_reference.md).
 struct MobileCaptureConfig {
   // Start ([K]) and world.
   Eigen::Vector2d robot_start = Eigen::Vector2d(-0.5, -0.5);  ///< m
@@ -38,14 +42,16 @@ struct MobileCaptureConfig {
   double floor_size = 30.0;             ///< m (textured floor square centred at the origin)
   /// Camera blackout (lens covered: frames give no detection) on [start, start + duration), s;
   /// start < 0: none. Exercises losing the target and finding it again.
-  double blackout_start = -1.0, blackout_duration = 0.0;
+  double blackout_start = -1.0,    ///< blackout start, s (< 0: none)
+         blackout_duration = 0.0;  ///< blackout length, s
 
   // Timing.
   double vision_period = 0.1;           ///< s ([K]); also the profile step and the planner's T
   double control_period = 0.01;         ///< s ([K]: wheel PID every 10 ms)
 
   // Camera (320x240, 50° x 40°).
-  unsigned width = 320, height = 240;
+  unsigned width = 320,   ///< image width, px
+           height = 240;  ///< image height, px
   double hfov = 0.8726646259971648;     ///< rad (50°)
   double vfov = 0.6981317008965228;     ///< rad (40°)
   double sensor_noise = 2.0;            ///< grey levels (std)
@@ -53,17 +59,17 @@ struct MobileCaptureConfig {
 
   /// Calibrated rig (key `rig`): replaces width, height, hfov, vfov (see mobile_capture.h).
   struct RigCameras {
-    std::string folder;
+    std::string folder;                 ///< the rig folder, normalised
     core::Camera truth;                 ///< renders (intrinsics; its pose is the DH head at q0)
     core::Camera calibrated;            ///< estimators (intrinsics; c_M_w = calibrated pose at q0)
     robots::PanTiltJoints q0;           ///< head joints of truth.yaml's pose
     Eigen::Isometry3d cal_M_c = Eigen::Isometry3d::Identity();  ///< c'_M_c, calibrated vs DH camera
   };
-  std::optional<RigCameras> rig;
+  std::optional<RigCameras> rig;  ///< set by the `rig` key
 
   // Robot.
-  robots::MobilePanTiltParams head;
-  robots::DifferentialDriveParams base;
+  robots::MobilePanTiltParams head;      ///< the pan-tilt head (DH lengths, joint and rate limits)
+  robots::DifferentialDriveParams base;  ///< the differential-drive base (track, limits, wheel PID)
   GripperZone jaws;                                 ///< grasp succeeds when the true object is here
   GripperZone trigger{0.14, 0.26, 0.045};           ///< grasp is attempted when the estimate is here
   double grasp_cooldown = 0.5;                      ///< s after a failed grasp
@@ -76,7 +82,7 @@ struct MobileCaptureConfig {
 
   // Estimation: the target track (keys filter.q_v, q_w, init_speed_sigma, init_turn_sigma,
   // gate_probability, predictor_window; it restarts after 5 rejections in a row).
-  tracking::UnicycleTrackerConfig filter;
+  tracking::UnicycleTrackerConfig filter;  ///< the object's track (unicycle EKF, gate)
   double init_speed = 0.3;              ///< m/s (key filter.init_speed; the two-point start measures it)
   /// The LS accelerations are used only once the window is full, clamped to these (physically
   /// plausible) bounds; 0 switches them off (constant v, ω prediction).
@@ -85,9 +91,9 @@ struct MobileCaptureConfig {
   int horizon_steps = 200;              ///< M of [K] eq 30
 
   // Planning and control.
-  planning::CapturePlannerParams planner;
-  control::GoToPointParams go;
-  control::SearchParams search;
+  planning::CapturePlannerParams planner;  ///< the interception planner ([K] eq 30)
+  control::GoToPointParams go;             ///< the go-to-point base controller
+  control::SearchParams search;            ///< the search for a lost object
 
   // Filter test ([K] §3.2).
   double filter_test_duration = 60.0;        ///< s
@@ -95,7 +101,7 @@ struct MobileCaptureConfig {
   double filter_test_q_v = 0.003;            ///< m²/s³ (ξv variance 3 (cm/s)² per 0.1 s step)
   double filter_test_q_w = 1.0;              ///< rad²/s³ (ξω variance 0.1 (rad/s)² per step)
   double convergence_time = 10.0;            ///< s: RMSE is taken after this
-  int filter_test_runs = 20;
+  int filter_test_runs = 20;                 ///< runs of the filter test
 
   // Field-of-view sweep of the ground localisation.
   int fov_sweep_poses = 50;             ///< random head/base poses

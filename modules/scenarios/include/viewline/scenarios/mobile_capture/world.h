@@ -21,7 +21,11 @@ namespace viewline::scenarios::mobile_capture {
 
 /// Independent random streams of one run, all derived from the run seed.
 struct Streams {
-  core::Rng object, room, render, drive;
+  core::Rng object,  ///< the object's profile noise
+      room,          ///< room and floor textures
+      render,        ///< sensor noise of the renderer
+      drive;         ///< wheel and encoder noise
+  /// The four streams derived from the run seed.
   explicit Streams(std::uint64_t seed);
 };
 
@@ -46,9 +50,11 @@ Eigen::Vector2d toRobot(const robots::BasePose& pose, const Eigen::Vector2d& p_w
 /// Control ticks i = 0..last at t = i · control_period (the product, not a running sum: every
 /// time stamp of the scenario is computed this one way).
 struct TickClock {
-  double period = 0.01;
-  long last = 0;
+  double period = 0.01;  ///< control period, s
+  long last = 0;         ///< index of the last tick
+  /// Time of tick i, s.
   double time(long i) const { return static_cast<double>(i) * period; }
+  /// The ticks of a run of `cfg` (control_period, max_time).
   static TickClock of(const MobileCaptureConfig& cfg);
   /// Control ticks per vision frame (vision_period / control_period, an integer).
   static long visionEvery(const MobileCaptureConfig& cfg);
@@ -56,10 +62,11 @@ struct TickClock {
 
 /// One simulated robot: base (wheels, PID, odometry) and rate-limited head joints.
 struct RobotSim {
-  const MobileCaptureConfig& cfg;
-  robots::MobilePanTilt head;
-  robots::DifferentialDrive base;
-  robots::PanTiltJoints q;
+  const MobileCaptureConfig& cfg;  ///< the run's config (must outlive the robot)
+  robots::MobilePanTilt head;      ///< head kinematics (DH) and limits
+  robots::DifferentialDrive base;  ///< the base with its wheels, PID and odometry
+  robots::PanTiltJoints q;         ///< current head joints, rad
+  /// The robot of `c` at its start pose.
   explicit RobotSim(const MobileCaptureConfig& c);
   /// One control period of the head servo towards `target` (clamped to the joint limits).
   void stepHead(const robots::PanTiltJoints& target);
@@ -73,11 +80,14 @@ class RenderedHeadCamera final : public runtime::FrameSource {
 public:
   /// c_M_w of the true camera at the time of a grab.
   using PoseProvider = std::function<Eigen::Isometry3d()>;
+  /// Renders `target` through the camera of `cfg` at `camera_pose()` (the target and streams must outlive it).
   RenderedHeadCamera(const MobileCaptureConfig& cfg, const sim::GroundTarget& target, Streams& rng,
                      PoseProvider camera_pose);
   ~RenderedHeadCamera() override;
-  std::size_t cameraCount() const override { return 1; }
+  std::size_t cameraCount() const override { return 1; }  ///< the head camera
+  /// The next vision tick's time (none after the last tick).
   std::optional<core::Timestamp> nextReadyTime() const override;
+  /// Renders the next frame (no detection possible during the blackout).
   std::optional<runtime::Frame> grab() override;
 
 private:

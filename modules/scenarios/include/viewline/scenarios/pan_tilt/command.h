@@ -20,16 +20,18 @@
 
 namespace viewline::scenarios::pan_tilt {
 
+/// The pan_tilt_tracking command line, as parsed: config, edits, seed, outputs, pacing, replay.
 struct CommandOptions {
-  std::string config_path;
+  std::string config_path;  ///< --config FILE
   std::vector<std::string> sets;        ///< --set KEY=VALUE, recorded in the summary (config_set)
   std::vector<std::string> shorthands;  ///< further KEY=VALUE edits from shorthand flags (not recorded)
-  std::uint64_t seed = 1;
-  std::string log_dir, summary_path;
+  std::uint64_t seed = 1;  ///< --seed
+  std::string log_dir,        ///< --log DIR ("": no log)
+              summary_path;   ///< --summary FILE ("": none)
   bool quiet = false;                   ///< no progress lines
-  runtime::Pacing pacing;
+  runtime::Pacing pacing;               ///< --realtime: paced to the wall clock, else as fast as possible
   std::string replay;                   ///< frames CSV of a logged run: filter-only replay instead of the loop
-  PanTiltReplayEstimator estimator = PanTiltReplayEstimator::Filter;
+  PanTiltReplayEstimator estimator = PanTiltReplayEstimator::Filter;  ///< what the replay runs
   std::size_t particles = 20000;        ///< of PanTiltReplayEstimator::WaypointParticles
 };
 

@@ -23,42 +23,48 @@
 
 namespace viewline::scenarios {
 
+/// The pan-tilt scenario's configuration (config/pan_tilt_*.yaml; keys in docs/config_reference.md).
 struct PanTiltScenarioConfig {
   // World
   sim::ScreenPathParams path;            ///< shape, speed, centre, width/height, radius (duration set by the run)
   double screen_distance = 1.3;          ///< m
   double screen_center_height = -0.26;   ///< m (z_f)
-  double screen_width = 2.4, screen_height = 1.8;  ///< m
+  double screen_width = 2.4,   ///< screen width, m
+         screen_height = 1.8;  ///< screen height, m
   double disc_radius = 0.03;             ///< m
   // Camera
-  unsigned image_width = 640, image_height = 480;
-  double fx = 944.0, fy = 928.0;         ///< px ([T])
-  double fps = 30.0;
+  unsigned image_width = 640,   ///< image width, px
+           image_height = 480;  ///< image height, px
+  double fx = 944.0,  ///< focal length along x, px ([T])
+         fy = 928.0;  ///< focal length along y, px ([T])
+  double fps = 30.0;  ///< frame rate (the control rate), Hz
   double sensor_noise = 2.0;             ///< grey levels
   double exposure = 0.0;                 ///< s (motion blur)
   // Rig (all set together by `rig:`, or none): the simulator's and the controllers'
   // camera (intrinsics and image size) and camera mount on the unit. Unset: the inline camera
   // above and vpPtu46's nominal mount for both. (image_width/height, fx, fy then hold the true
   // camera's values, for reporting.)
-  std::string rig_folder;
-  std::optional<core::Camera> true_camera, calibrated_camera;
-  std::optional<Eigen::Isometry3d> true_e_M_c, calibrated_e_M_c;
+  std::string rig_folder;  ///< the rig folder as resolved ("": inline camera)
+  std::optional<core::Camera> true_camera,        ///< the camera the simulator renders with (truth.yaml)
+                              calibrated_camera;  ///< the camera the controllers use (rig.yaml)
+  std::optional<Eigen::Isometry3d> true_e_M_c,        ///< true camera mount: camera pose in the end-effector frame
+                                   calibrated_e_M_c;  ///< calibrated mount (the rig's e_M_c.yaml, hand-eye output)
   // Measurement noise ([T])
-  double noise_fraction = 0.10;
+  double noise_fraction = 0.10;  ///< white measurement noise as a fraction of the signal amplitude, per axis ([T])
   // Unit
   robots::SimulatedPanTiltParams unit;   ///< limits, latency (q0 set from initial_offset)
   Eigen::Vector2d initial_offset = Eigen::Vector2d::Zero();  ///< rad from pointing at the start point
   double processing_delay = 0.01;        ///< s from capture to command
   // Detection
-  vision::ScreenTargetDetectorConfig detector;
+  vision::ScreenTargetDetectorConfig detector;  ///< [T]'s detection pipeline (crop, scale, threshold, median, area)
   // Control (the baseline uses control.servo)
-  control::PredictiveConfig control;
+  control::PredictiveConfig control;  ///< our law and its target filter; control.servo is the baseline's ViSP law
   // Run
   double duration = 60.0;                ///< s
   double metrics_start = 5.0;            ///< s
   double occlusion_start = -1.0;         ///< s (< 0: none)
   double occlusion_duration = 1.0;       ///< s
-  bool run_baseline = true;
+  bool run_baseline = true;  ///< also run ViSP's law on the same seed
 
   void validate() const;  ///< throws core::InvalidInput naming the field
 };

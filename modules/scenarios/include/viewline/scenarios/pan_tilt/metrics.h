@@ -24,44 +24,56 @@
 
 namespace viewline::scenarios {
 
+/// The figures of one pan-tilt run with one controller (ours or ViSP's baseline law).
 struct PanTiltRunMetrics {
-  std::string controller;
-  std::size_t frames = 0, detections = 0, metric_frames = 0;
-  double image_error_rms_px = 0.0, image_error_max_px = 0.0;
-  Eigen::Vector2d rmse_measured_cm = Eigen::Vector2d::Zero();
-  Eigen::Vector2d rmse_filtered_cm = Eigen::Vector2d::Constant(std::nan(""));
-  Eigen::Vector2d noise_sigma_cm = Eigen::Vector2d::Zero();
+  std::string controller;  ///< "predictive" (ours) or "baseline"
+  std::size_t frames = 0,         ///< frames captured
+              detections = 0,     ///< frames with the disc detected
+              metric_frames = 0;  ///< frames in the metric window (after run.metrics_start)
+  double image_error_rms_px = 0.0,  ///< RMS distance of the disc from the image centre, px
+         image_error_max_px = 0.0;  ///< largest such distance, px
+  Eigen::Vector2d rmse_measured_cm = Eigen::Vector2d::Zero();  ///< RMSE of the noisy measured target position (x, y), cm ([T] Table 1)
+  Eigen::Vector2d rmse_filtered_cm = Eigen::Vector2d::Constant(std::nan(""));  ///< RMSE of the filtered position (x, y), cm (NaN without a filter)
+  Eigen::Vector2d noise_sigma_cm = Eigen::Vector2d::Zero();  ///< std of the added measurement noise (x, y), cm
   double detection_pixel_rmse_px = 0.0;  ///< detector error (before [T] noise) vs the true centre projection
   // limits
-  std::size_t commands = 0, unsafe_commands = 0, rate_violations = 0, limit_hits = 0;
+  std::size_t commands = 0,         ///< joint commands issued
+              unsafe_commands = 0,  ///< commands outside the joint limits (before clamping)
+              rate_violations = 0,  ///< commands above the rate limit
+              limit_hits = 0;       ///< frames with a joint at its limit
   double max_rate_fraction = 0.0;            ///< max |q̇ cmd| / q̇max
   Eigen::Vector2d min_limit_distance_deg = Eigen::Vector2d::Constant(1e9);  ///< (pan, tilt)
-  Eigen::Vector2d pan_range_deg = Eigen::Vector2d::Zero(), tilt_range_deg = Eigen::Vector2d::Zero();
+  Eigen::Vector2d pan_range_deg = Eigen::Vector2d::Zero(),   ///< (min, max) pan reached, deg
+                  tilt_range_deg = Eigen::Vector2d::Zero();  ///< (min, max) tilt reached, deg
   // occlusion
-  bool occlusion = false, reacquired = false;
-  double reacquisition_delay_s = std::nan("");
-  std::size_t reacquisitions = 0;
-  std::size_t frames_searching = 0;
+  bool occlusion = false,   ///< the run had an occlusion
+       reacquired = false;  ///< the target was found again after it
+  double reacquisition_delay_s = std::nan("");  ///< occlusion end to the first detection, s (NaN: never)
+  std::size_t reacquisitions = 0;    ///< times the target was found again after being lost
+  std::size_t frames_searching = 0;  ///< frames spent in the spiral search
   std::size_t filter_jumps = 0;              ///< velocity jumps (corners) the filter detected (ours)
   /// Ours, Kalman models with jump detection: the corner settings in force at the end of the run (the
   /// configured filter.jump_min_samples / jump_corner_sigma, or what "auto" made of them); 0 otherwise.
-  int filter_min_samples = 0;
-  double filter_corner_sigma = 0.0;
+  int filter_min_samples = 0;        ///< jump_min_samples in force at the end
+  double filter_corner_sigma = 0.0;  ///< jump_corner_sigma in force at the end, m
   bool filter_region_dropped = false;        ///< ours: filter.region was dropped (the target left it: a wrong box)
-  double wall_ms_per_frame = 0.0;
+  double wall_ms_per_frame = 0.0;  ///< wall-clock time per frame (render, detect, control), ms
   /// Ours: the gate's decisions on the detected frames (start, accept, reject, restart), as the
   /// telemetry's innovation records report them. (Not in the JSON summary.)
   tracking::GateCounts gate;
   bool stopped = false;  ///< the run ended early (a display's quit key)
 
+  /// The figures as JSON (the summary's per-controller object).
   nlohmann::json toJson() const;
 };
 
+/// Ours and ViSP's baseline law on the same seed and path: the pan-tilt summary.
 struct PanTiltComparison {
-  PanTiltRunMetrics ours, baseline;
-  bool has_baseline = false;
-  std::string path;
-  std::uint64_t seed = 0;
+  PanTiltRunMetrics ours,      ///< the predictive law with the Kalman feed-forward
+                    baseline;  ///< ViSP's law (run.baseline)
+  bool has_baseline = false;   ///< the baseline was run
+  std::string path;            ///< path shape name
+  std::uint64_t seed = 0;      ///< seed of the run
   /// The summary (keys: rmse_measured_cm, rmse_filtered_cm, image_error_rms_px,
   /// baseline_image_error_rms_px, [T]'s Table 1 beside ours, limits, occlusion).
   nlohmann::json toJson(const PanTiltScenarioConfig& config) const;
@@ -69,8 +81,9 @@ struct PanTiltComparison {
 
 /// [T] Table 1 (RMSE in cm, (x, y)): noisy measurement and Kalman filter; nothing for the random path.
 struct TTable1Row {
-  bool available = false;
-  Eigen::Vector2d measured = Eigen::Vector2d::Zero(), kalman = Eigen::Vector2d::Zero();
+  bool available = false;  ///< [T] published figures for this path
+  Eigen::Vector2d measured = Eigen::Vector2d::Zero(),  ///< RMSE of the noisy measurement (x, y), cm
+                  kalman = Eigen::Vector2d::Zero();    ///< RMSE of [T]'s Kalman filter (x, y), cm
 };
 TTable1Row tTable1(sim::PathShape shape);
 
@@ -82,12 +95,14 @@ std::pair<int, double> cornerSettings(const tracking::PlanarTargetFilter& filter
 
 /// A sum of squares and its count: the RMS of a metric accumulated frame by frame.
 struct SquareSum {
-  double sum = 0.0;
-  long n = 0;
+  double sum = 0.0;  ///< sum of squares
+  long n = 0;        ///< values added
+  /// Adds one value.
   void add(double v) {
     sum += v;
     ++n;
   }
+  /// √(sum / n); 0 when empty.
   double rms() const { return core::rmsFromSum(sum, n); }
 };
 
@@ -97,8 +112,10 @@ const char* metText(bool met);
 /// Accumulates one run's metrics frame by frame (the loop feeds it in frame order).
 class Scorer {
 public:
+  /// A scorer for one run of `controller`; occlusion times in s (start 1e300: none), `sigma` [T]'s noise per axis, m.
   Scorer(const PanTiltScenarioConfig& config, double occlusion_start, double occlusion_end,
          const Eigen::Vector2d& sigma, std::string controller);
+  /// Counts a captured frame (dropped or not).
   void frameCaptured() { ++m_.frames; }
   /// The detector's pixel (before [T]'s noise) against the true projection (from metrics_start).
   void detectorError(double tc, const Eigen::Vector2d& detected_px, const Eigen::Vector2d& truth_px);
@@ -109,6 +126,7 @@ public:
   /// One command issued at the joints q (`safe`: within the limits from the predicted state).
   void command(const robots::PanTiltLimits& limits, const Eigen::Vector2d& q, const Eigen::Vector2d& qdot, bool safe,
                bool searching);
+  /// Counts one gate decision of ours on a detected frame.
   void decision(tracking::GateDecision d);
   /// The figures; `ours`: the predictive controller (filter figures), null for the baseline.
   PanTiltRunMetrics finish(const control::PredictivePanTiltController* ours, const robots::SimulatedPanTiltUnit& unit,

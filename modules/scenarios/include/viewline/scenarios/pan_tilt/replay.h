@@ -18,8 +18,10 @@ namespace viewline::scenarios {
 /// re-run (the measurements depend on it only through the detector's sub-pixel error). A log whose truth
 /// columns are not the path of `seed` (another seed, shape, size or speed) is refused (core::InvalidInput).
 struct PanTiltReplayMetrics {
-  std::size_t measurements = 0, jumps = 0;
-  Eigen::Vector2d rmse_measured_cm = Eigen::Vector2d::Zero(), rmse_filtered_cm = Eigen::Vector2d::Zero();
+  std::size_t measurements = 0,  ///< logged measurements re-filtered
+              jumps = 0;         ///< velocity jumps (corners) the filter detected
+  Eigen::Vector2d rmse_measured_cm = Eigen::Vector2d::Zero(),  ///< RMSE of the measurements (x, y), cm
+                  rmse_filtered_cm = Eigen::Vector2d::Zero();  ///< RMSE of the filtered position (x, y), cm
   double horizon_s = 0.0;  ///< processing delay + latency + lead: how far ahead the law predicts
   Eigen::Vector2d rmse_predicted_cm = Eigen::Vector2d::Zero();  ///< x(t + horizon | t) − truth, every frame
   double predicted_error_px = 0.0;  ///< its RMS norm × fx / screen distance (px near the image centre)
@@ -30,7 +32,8 @@ struct PanTiltReplayMetrics {
   double frame_predicted_error_px = 0.0;  ///< as predicted_error_px, at frame_horizon_s
   bool region_dropped = false;            ///< the filter dropped filter.region (the target left it)
   int min_samples = 0;                    ///< the filter's corner settings at the end (see PanTiltRunMetrics)
-  double corner_sigma = 0.0;
+  double corner_sigma = 0.0;              ///< jump_corner_sigma in force at the end, m
+  /// The figures as JSON (the replay's summary).
   nlohmann::json toJson() const;
 };
 /// What a replay runs on the logged measurements.

@@ -18,31 +18,35 @@ class LogDirectory;
 
 namespace viewline::scenarios::pan_tilt {
 
+/// Everything about one frame of a pan-tilt run, for the frames CSV and the display.
 struct FrameRecord {
   std::string controller;                  ///< "predictive" or "visp_baseline"
   const cv::Mat* image = nullptr;          ///< BGR as rendered (valid during the call)
   double t = 0.0;                          ///< capture time, s
   Eigen::Vector2d truth = Eigen::Vector2d::Zero();     ///< target on the screen (m)
-  bool detected = false;
+  bool detected = false;                   ///< the detector found the disc
   Eigen::Vector2d measured = Eigen::Vector2d::Zero();  ///< detection + [T] noise on the screen (m)
   Eigen::Vector2d filtered = Eigen::Vector2d::Zero();  ///< ours: the filter's estimate (NaN otherwise)
-  Eigen::Vector2d truth_px = Eigen::Vector2d::Zero();
+  Eigen::Vector2d truth_px = Eigen::Vector2d::Zero();      ///< true disc centre in the image, px
   Eigen::Vector2d measured_px = Eigen::Vector2d::Zero();   ///< in the camera the controllers believe in
-  bool has_prediction = false;
+  bool has_prediction = false;             ///< predicted_px is set
   Eigen::Vector2d predicted_px = Eigen::Vector2d::Zero();  ///< ŝ at the effect time (NaN without)
-  Eigen::Vector2d principal_px = Eigen::Vector2d::Zero();
+  Eigen::Vector2d principal_px = Eigen::Vector2d::Zero();  ///< principal point (the servo's goal), px
   double error_px = 0.0;                   ///< |truth − principal point|
-  Eigen::Vector2d q = Eigen::Vector2d::Zero(), qdot = Eigen::Vector2d::Zero();  ///< joints at the command
+  Eigen::Vector2d q = Eigen::Vector2d::Zero(),     ///< joint angles (pan, tilt) at the command, rad
+                  qdot = Eigen::Vector2d::Zero();  ///< joint rates at the command, rad/s
   Eigen::Vector2d command = Eigen::Vector2d::Zero();  ///< the joint velocity command (rad/s)
   int mode = 0;                            ///< control::TrackingMode
-  std::string mode_name;
+  std::string mode_name;                   ///< the mode as text ("tracking", "coasting", "searching", ...)
 };
 
+/// Receives each frame of a pan-tilt run (CSV log, display); every hook does nothing by default.
 class FrameSink {
 public:
   virtual ~FrameSink() = default;
   /// A run of `controller` starts (before its first frame).
   virtual void runStarted(const std::string& /*controller*/) {}
+  /// One frame (the record and its image are valid during the call only).
   virtual void frame(const FrameRecord& /*r*/) {}
   /// The person watching asked to end the run (a display's quit key).
   virtual bool quitRequested() const { return false; }
@@ -55,7 +59,9 @@ public:
   /// `log` must outlive the sink; a disabled directory writes nothing.
   explicit FrameCsvSink(io::LogDirectory& log) : log_(log) {}
   void runStarted(const std::string& controller) override;
+  /// Writes the frame's row.
   void frame(const FrameRecord& r) override;
+  /// The CSV header.
   static const std::vector<std::string>& columns();
 
 private:
@@ -66,11 +72,14 @@ private:
 /// Forwards to each sink in the order added (null ignored; not owned).
 class FrameFanout : public FrameSink {
 public:
+  /// Adds a sink (null is ignored; not owned).
   void add(FrameSink* sink) {
     if (sink != nullptr) sinks_.push_back(sink);
   }
+  /// True when no sink was added.
   bool empty() const { return sinks_.empty(); }
   void runStarted(const std::string& controller) override;
+  /// Forwards the frame to each sink.
   void frame(const FrameRecord& r) override;
   bool quitRequested() const override;
 

@@ -54,28 +54,36 @@ struct FrameTruth {
 /// offset) and the camera rig on it. Holds references into itself: neither copied nor moved.
 class World {
 public:
+  /// Builds the screen, the path of `seed`, the occlusion, the unit and its camera from `config`.
   World(const PanTiltScenarioConfig& config, std::uint64_t seed);
   World(const World&) = delete;
   World& operator=(const World&) = delete;
 
+  /// The target's path on the screen (screen coordinates, m).
   const sim::ScreenPath& path() const { return path_; }
+  /// Pose of the screen frame in the unit's base frame f (maps screen points to base coordinates).
   const Eigen::Isometry3d& f_M_screen() const { return f_M_screen_; }
+  /// [T]'s measurement noise std per screen axis, m.
   const Eigen::Vector2d& sigma() const { return sigma_; }
+  /// Measurement noise covariance on the screen, m².
   const Eigen::Matrix2d& R() const { return R_; }
   /// [T]'s noise of the next frame (drawn for every frame, detected or not).
   Eigen::Vector2d drawNoise();
+  /// The simulated unit (true camera mount).
   robots::SimulatedPanTiltUnit& unit() { return unit_; }
   /// The unit as the controllers know it (calibrated camera mount).
   const robots::PanTiltKinematics& modelKinematics() const { return kin_model_; }
+  /// The rendered camera on the unit.
   sim::CameraRig& rig() { return rig_; }
+  /// The rendered scene (the screen and the disc, hidden during the occlusion).
   const sim::World& scene() const { return occluded_; }
   /// Truth at capture time tc, through the camera as it was at capture (true pose).
   FrameTruth truth(const core::Camera& camera_at_capture, double tc) const;
   /// The true camera's principal point (px): the image error is measured from it.
   const Eigen::Vector2d& principal() const { return principal_; }
   double occlusionStart() const { return occ0_; }  ///< 1e300 without one
-  double occlusionEnd() const { return occ1_; }
-  double exposure() const { return exposure_; }
+  double occlusionEnd() const { return occ1_; }  ///< s; 1e300 without one
+  double exposure() const { return exposure_; }  ///< exposure time of a frame, s
 
 private:
   class Occluded : public sim::World {
@@ -113,9 +121,10 @@ class RendererSource : public runtime::FrameSource {
 public:
   /// `frames`: how many captures (dropped ones included) before the source ends.
   RendererSource(World& world, std::size_t frames);
-  std::size_t cameraCount() const override { return 1; }
+  std::size_t cameraCount() const override { return 1; }  ///< one camera on the unit
   /// The end of the next frame's exposure: everything it shows has been simulated by then.
   std::optional<core::Timestamp> nextReadyTime() const override;
+  /// Renders the next capture (nothing once `frames` were taken).
   std::optional<runtime::Frame> grab() override;
   /// The camera (true pose) of the last frame grabbed.
   const core::Camera& lastCamera() const { return last_camera_; }

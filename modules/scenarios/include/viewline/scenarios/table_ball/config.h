@@ -16,15 +16,18 @@
 
 namespace viewline::scenarios {
 
+/// A set point for the ball (config events.setpoints[]), in force from time t.
 struct TableBallSetpoint {
-  double t = 0.0;
+  double t = 0.0;  ///< time from which it holds, s
   Eigen::Vector2d xy = Eigen::Vector2d::Zero();  ///< table frame, m
 };
+/// An impulse on the ball (config events.pushes[]).
 struct TableBallPush {
-  double t = 0.0;
+  double t = 0.0;  ///< time of the push, s
   Eigen::Vector2d dv = Eigen::Vector2d::Zero();  ///< added to the ball velocity, m/s
 };
 
+/// The table-ball scenario's configuration (config/table_ball*.yaml; keys in docs/config_reference.md).
 struct TableBallConfig {
   // World
   double table_side = 0.3;                                     ///< L, m
@@ -37,29 +40,31 @@ struct TableBallConfig {
   double tag_size = 0.05;                                      ///< m
   robots::TableTiltLimits wrist;                               ///< angle/rate limits, delay
   // Camera
-  unsigned width = 320, height = 240;
+  unsigned width = 320,   ///< image width, px
+           height = 240;  ///< image height, px
   double hfov = 1.5707963267948966;                            ///< rad (90°)
-  std::optional<double> cx, cy;                                ///< principal point, px (absent: image centre)
-  double rate_hz = 50.0;
-  Eigen::Vector3d camera_position = Eigen::Vector3d(0.0, -0.3, 1.3);
-  Eigen::Vector3d camera_look_at = Eigen::Vector3d(0.0, 0.0, 0.9);
+  std::optional<double> cx,  ///< principal point u0, px (absent: image centre)
+                        cy;  ///< principal point v0, px (absent: image centre)
+  double rate_hz = 50.0;     ///< frame rate, Hz
+  Eigen::Vector3d camera_position = Eigen::Vector3d(0.0, -0.3, 1.3);  ///< camera centre at rest, world, m
+  Eigen::Vector3d camera_look_at = Eigen::Vector3d(0.0, 0.0, 0.9);    ///< a point on the optical axis, world, m
   double sway = 0.0087;                                        ///< head rotation amplitude, rad
-  double sway_hz = 0.3;
+  double sway_hz = 0.3;                                        ///< head sway base frequency, Hz
   double sway_translation = 0.003;                             ///< m
   double ground_rotation_noise = 0.0;                          ///< rad (std per axis, per frame)
   double sensor_noise = 2.0;                                   ///< grey levels
   double exposure = 0.004;                                     ///< s (motion blur)
-  int blur_samples = 3;
-  double drop_probability = 0.0;
-  int supersampling = 3;
+  int blur_samples = 3;            ///< renders averaged over the exposure
+  double drop_probability = 0.0;   ///< probability that a frame is lost
+  int supersampling = 3;           ///< renderer anti-aliasing sub-samples on edge pixels
   /// Calibrated rig (key `rig`): when set, it replaces width, height, hfov, cx, cy,
   /// camera_position and camera_look_at (see table_ball.h).
   struct RigCameras {
-    std::string folder;
+    std::string folder;       ///< the rig folder, normalised
     core::Camera truth;       ///< renders; c_M_w = rest pose (before the sway)
     core::Camera calibrated;  ///< the observer's; c_M_w = calibrated rest pose, rotation from ground.yaml
   };
-  std::optional<RigCameras> rig;
+  std::optional<RigCameras> rig;  ///< set by the `rig` key
   // Observer, controller
   TableBallObserverConfig observer;                            ///< as read; observerConfig() completes it
   bool border_aware_pnp = true;                                ///< correct the PnP for the border occlusion
@@ -67,11 +72,11 @@ struct TableBallConfig {
   control::TableBalancerConfig controller;                     ///< as read; controllerConfig() completes it
   // Events and metrics
   std::vector<TableBallSetpoint> setpoints;                    ///< sorted by t; first at t = 0
-  std::vector<TableBallPush> pushes;
+  std::vector<TableBallPush> pushes;                           ///< sorted by t
   double duration = 30.0;                                      ///< s
   double warmup = 1.0;                                         ///< s, excluded from the RMSEs
   double min_step = 0.05;                                      ///< m, set-point changes scored as steps
-  double settle_fraction = 0.02;
+  double settle_fraction = 0.02;                               ///< settling band as a fraction of the step
   double steady_window = 1.0;                                  ///< s
   double push_band = 0.005;                                    ///< m
   bool compare_tunings = true;                                 ///< run the side filters

@@ -26,12 +26,13 @@ namespace viewline::scenarios {
 struct TableBallFrameView {
   const cv::Mat* image = nullptr;        ///< the camera image (null for a dropped frame)
   const core::Camera* camera = nullptr;  ///< the observer's camera at capture (calibrated with a rig)
-  const ObserverFrame* observer = nullptr;
-  Eigen::Vector2d truth = Eigen::Vector2d::Zero();
-  Eigen::Vector2d setpoint = Eigen::Vector2d::Zero();
+  const ObserverFrame* observer = nullptr;  ///< what the observer made of the frame
+  Eigen::Vector2d truth = Eigen::Vector2d::Zero();     ///< true ball position, table frame, m
+  Eigen::Vector2d setpoint = Eigen::Vector2d::Zero();  ///< set point in force, table frame, m
   Eigen::Vector2d tilt = Eigen::Vector2d::Zero();  ///< true table tilt
 };
 
+/// Optional hooks of a table-ball run: per-frame view, progress and telemetry.
 struct TableBallHooks {
   /// Called after every frame (e.g. a display); returning false stops the run (quit key).
   std::function<bool(const TableBallFrameView&)> on_frame;

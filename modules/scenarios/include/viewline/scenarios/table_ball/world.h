@@ -26,9 +26,12 @@ namespace viewline::scenarios {
 /// Head sway: small rotations about the camera axes and a small translation, sums of sines at
 /// incommensurate frequencies around f (deterministic; phases from the seed).
 struct HeadSway {
-  Eigen::Isometry3d c_M_w0;
-  double amplitude, f, translation;
-  std::array<double, 6> phase{};
+  Eigen::Isometry3d c_M_w0;  ///< camera pose at rest (maps world points to camera coordinates)
+  double amplitude,    ///< rotation amplitude, rad
+         f,            ///< base frequency, Hz
+         translation;  ///< translation amplitude, m
+  std::array<double, 6> phase{};  ///< phases of the six sines (three rotations, three translations), rad
+  /// The swayed camera pose c_M_w at time t (s).
   Eigen::Isometry3d at(double t) const;
 };
 
@@ -36,6 +39,7 @@ struct HeadSway {
 /// in vpDetectorAprilTag's tag frame: sim::TableWorld::table_M_vispTag).
 std::vector<vision::TagOnTable> tableTagLayout(const sim::TableWorld& world);
 
+/// The simulated table-ball world: ball and tilting table physics, the wrist, the rendered scene and the swaying head camera.
 class TableBallWorld {
 public:
   /// Physics and command interpolation step, s.
@@ -52,16 +56,21 @@ public:
   /// table follows the wrist's actual tilt at the tick's end. Tick k starts at k · kTick
   /// (computed from k, not accumulated, so long runs do not drift).
   void step();
+  /// Simulated time, s.
   double time() const { return static_cast<double>(ticks_) * kTick; }
+  /// Ticks simulated so far.
   long ticks() const { return ticks_; }
+  /// The table and ball state now (ball in the table frame, tilt in rad).
   const sim::TiltTableState& state() const { return table_.state(); }
   /// The recorded state at an earlier time (a frame's capture instant).
   sim::TiltTableState stateAt(double t) const { return table_.stateAt(t); }
   /// The table pose the arm's kinematics predict for given tilt angles.
   Eigen::Isometry3d tablePose(const Eigen::Vector2d& tilt) const { return table_.tablePose(tilt); }
+  /// The simulated wrist (the controller commands it).
   robots::TableTilt& wrist() { return wrist_; }
 
   // --- head camera ---------------------------------------------------------------------------
+  /// The true head camera at rest (intrinsics and c_M_w before the sway).
   const core::Camera& renderCamera() const { return camera_; }
   /// The camera the observer believes in (calibrated with a rig, else the render camera).
   const core::Camera& observerCamera() const { return obs_camera_; }
@@ -75,7 +84,9 @@ public:
   /// fixes (L, r, border height, tag layout).
   TableBallObserverConfig observerConfig() const;
 
+  /// The rendered head camera (capture model).
   sim::CameraRig& cameraRig() { return rig_; }
+  /// The rendered scene (room, arm-held table, ball, tags).
   const sim::TableWorld& scene() const { return scene_; }
 
 private:
@@ -99,8 +110,10 @@ class RenderedHeadCamera final : public runtime::FrameSource {
 public:
   /// `world` renders; both must outlive the source.
   RenderedHeadCamera(TableBallWorld& world, double exposure, double end);
-  std::size_t cameraCount() const override { return 1; }
+  std::size_t cameraCount() const override { return 1; }  ///< the head camera
+  /// The end of the next frame's exposure (none after `end`).
   std::optional<core::Timestamp> nextReadyTime() const override;
+  /// Renders the next capture (a lost frame gives an empty image).
   std::optional<runtime::Frame> grab() override;
   /// The capture grab() took last, lost or not (a driver reports a lost frame's time stamp
   /// through the gap in its sequence numbers; the observer predicts to it).
