@@ -28,7 +28,9 @@ int main(int argc, char** argv) {
   cli.set_version_flag("--version", std::string("viewline ") + core::kVersion);
   std::string config_dir = "config";
   std::string output = "-";
-  cli.add_option("--config-dir", config_dir, "folder of the shipped scenario configs (config/ of the source tree)");
+  cli.add_option("--config-dir", config_dir,
+                 "folder of the shipped scenario configs: config/ of the source tree, or share/viewline/config "
+                 "of an installation");
   cli.add_option("--output", output, "the Markdown file to write; - for standard output");
   if (const auto code = apps::parseCommandLine(cli, argc, argv)) return *code;
   return apps::runGuarded("viewline_config_reference", [&] {

@@ -234,15 +234,15 @@ private:
 
 /// Reference type name of a bool key: `bool`.
 template <> std::string ConfigNode::configTypeName<bool>();
-/// Reference type name of a int key: `integer`.
+/// Reference type name of an int key: `integer`.
 template <> std::string ConfigNode::configTypeName<int>();
-/// Reference type name of a unsigned key: `integer >= 0`.
+/// Reference type name of an unsigned key: `integer >= 0`.
 template <> std::string ConfigNode::configTypeName<unsigned>();
 /// Reference type name of a long long key: `integer`.
 template <> std::string ConfigNode::configTypeName<long long>();
-/// Reference type name of a unsigned long key: `integer >= 0`.
+/// Reference type name of an unsigned long key: `integer >= 0`.
 template <> std::string ConfigNode::configTypeName<unsigned long>();
-/// Reference type name of a unsigned long long key: `integer >= 0`.
+/// Reference type name of an unsigned long long key: `integer >= 0`.
 template <> std::string ConfigNode::configTypeName<unsigned long long>();
 /// Reference type name of a double key: `number`.
 template <> std::string ConfigNode::configTypeName<double>();
@@ -264,15 +264,15 @@ template <> std::string ConfigNode::configTypeName<Eigen::VectorXd>();
 template <> std::string ConfigNode::configTypeName<Eigen::Matrix3d>();
 /// A bool default as YAML text: true / false.
 template <> std::string ConfigNode::configValueText<bool>(const bool& value);
-/// A int default as YAML text: decimal.
+/// An int default as YAML text: decimal.
 template <> std::string ConfigNode::configValueText<int>(const int& value);
-/// A unsigned default as YAML text: decimal.
+/// An unsigned default as YAML text: decimal.
 template <> std::string ConfigNode::configValueText<unsigned>(const unsigned& value);
 /// A long long default as YAML text: decimal.
 template <> std::string ConfigNode::configValueText<long long>(const long long& value);
-/// A unsigned long default as YAML text: decimal.
+/// An unsigned long default as YAML text: decimal.
 template <> std::string ConfigNode::configValueText<unsigned long>(const unsigned long& value);
-/// A unsigned long long default as YAML text: decimal.
+/// An unsigned long long default as YAML text: decimal.
 template <> std::string ConfigNode::configValueText<unsigned long long>(const unsigned long long& value);
 /// A double default as YAML text: shortest decimal that reads back exactly; .inf, .nan.
 template <> std::string ConfigNode::configValueText<double>(const double& value);
