@@ -56,7 +56,7 @@ struct CatchFrame {
   std::optional<Eigen::Vector3d> estimate;      ///< tracker position
 };
 
-/// Optional hooks of a catching session: per-throw telemetry, live view, progress and pacing.
+/// Optional hooks of a set of throws: per-throw telemetry, live view, progress and pacing.
 struct CatchHooks {
   /// The telemetry sink of throw i, or null. Called once per throw, from the thread running it:
   /// with threads > 1 return a distinct sink per throw. The throw flushes it and drops its

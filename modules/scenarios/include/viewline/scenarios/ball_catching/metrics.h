@@ -76,7 +76,7 @@ struct ThrowResult {
   double wall_s = 0.0;                ///< wall-clock time of the throw, s
 };
 
-/// A catching session's figures (the --summary JSON): catch rates, miss reasons, prediction and decision figures.
+/// The figures of a set of throws (the --summary JSON): catch rates, miss reasons, prediction and decision figures.
 struct CatchSummary {
   std::uint64_t seed = 0;  ///< master seed
   int throws = 0,            ///< throws run
@@ -111,7 +111,7 @@ struct CatchSummary {
          elevation_deg_max = 0.0;  ///< highest launch elevation, deg
   double flight_time_min = 0.0,  ///< shortest release-to-crossing time, s
          flight_time_max = 0.0;  ///< longest, s
-  double wall_s = 0.0,        ///< wall-clock time of the session, s
+  double wall_s = 0.0,        ///< wall-clock time of all the throws, s
          ms_per_frame = 0.0;  ///< wall-clock time per frame, ms
   std::vector<ThrowResult> results;  ///< every throw, in throw order
 };
@@ -126,7 +126,7 @@ void scoreThrow(ThrowResult& res, const BallCatchingConfig& cfg, const robots::S
 CatchSummary summarise(std::vector<ThrowResult> results, std::uint64_t seed,
                        std::optional<RegistrationResult> registration);
 
-/// The session's --summary JSON (figures, config echo).
+/// The --summary JSON of a set of throws (figures, config echo).
 nlohmann::json summaryJson(const CatchSummary& s, const BallCatchingConfig& cfg);
 
 /// One row per throw (throws.csv in a --log folder).
