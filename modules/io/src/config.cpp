@@ -1,10 +1,13 @@
 #include "viewline/io/config.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <limits>
 #include <optional>
+#include <cstdio>
+#include <cstdlib>
 #include <sstream>
 
 #include "viewline/core/error.h"
@@ -75,6 +78,63 @@ T convert(const YAML::Node& n, bool& ok) {
   } catch (const YAML::Exception&) {
     return T{};
   }
+}
+
+// Key recorder: the type names of the reference and YAML text of defaults.
+template <class T> const char* typeName();
+template <> const char* typeName<bool>() { return "bool"; }
+template <> const char* typeName<int>() { return "integer"; }
+template <> const char* typeName<long long>() { return "integer"; }
+template <> const char* typeName<unsigned>() { return "integer >= 0"; }
+template <> const char* typeName<unsigned long>() { return "integer >= 0"; }
+template <> const char* typeName<unsigned long long>() { return "integer >= 0"; }
+template <> const char* typeName<double>() { return "number"; }
+template <> const char* typeName<std::string>() { return "string"; }
+template <> const char* typeName<std::vector<double>>() { return "list of numbers"; }
+template <> const char* typeName<std::vector<int>>() { return "list of integers"; }
+template <> const char* typeName<std::vector<std::string>>() { return "list of strings"; }
+template <> const char* typeName<Eigen::VectorXd>() { return "list of numbers"; }
+template <> const char* typeName<Eigen::Vector2d>() { return "[x, y]"; }
+template <> const char* typeName<Eigen::Vector3d>() { return "[x, y, z]"; }
+template <> const char* typeName<Eigen::Matrix3d>() { return "3x3 matrix, rows"; }
+
+// The shortest decimal text that reads back as `v` with at most `digits` significant digits (an
+// angle converted from radians, shown to 6 digits, reads "62", not "62.000000000000007"); YAML's
+// .inf and .nan; -0 as 0.
+std::string numberText(double v, int digits = 17) {
+  if (v == 0.0) return "0";
+  if (std::isnan(v)) return ".nan";
+  if (std::isinf(v)) return v > 0 ? ".inf" : "-.inf";
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*g", digits, v);
+  const double target = std::strtod(buf, nullptr);
+  // At least the integer digits, so that 50 reads "50", not "5e+01".
+  const int integer_digits = std::abs(v) >= 1.0 && std::abs(v) < 1e15 ? static_cast<int>(std::log10(std::abs(v))) + 1 : 1;
+  for (int p = integer_digits; p < digits; ++p) {
+    char shorter[64];
+    std::snprintf(shorter, sizeof shorter, "%.*g", p, v);
+    if (std::strtod(shorter, nullptr) == target) return shorter;
+  }
+  return buf;
+}
+
+std::string choiceType(const std::vector<std::string>& choices) {
+  std::string t = "one of:";
+  for (std::size_t i = 0; i < choices.size(); ++i) t += (i ? ", " : " ") + choices[i];
+  return t;
+}
+
+template <class T>
+std::string listText(const std::vector<T>& values) {
+  std::string t = "[";
+  for (std::size_t i = 0; i < values.size(); ++i) t += (i ? ", " : "") + ConfigNode::configValueText(values[i]);
+  return t + "]";
+}
+
+std::string vectorText(const Eigen::VectorXd& v) {
+  std::string t = "[";
+  for (Eigen::Index i = 0; i < v.size(); ++i) t += (i ? ", " : "") + numberText(v(i));
+  return t + "]";
 }
 
 }  // namespace
@@ -149,6 +209,7 @@ std::string ConfigNode::location(const std::string& key) const {
 }
 
 bool ConfigNode::has(const std::string& key) const {
+  if (shared_->recorder && !shared_->noting) shared_->probed.insert(ConfigRecorder::normalisePath(keyPath(key)));
   if (!node_.IsMap()) return false;
   return keyNode(node_, key).has_value();
 }
@@ -179,12 +240,16 @@ bool ConfigNode::isWord(const std::string& key, const std::string& word) const {
   return true;
 }
 
-void ConfigNode::ignore(const std::string& key) const { shared_->consumed.insert(keyPath(key)); }
+void ConfigNode::ignore(const std::string& key) const {
+  const KeyNote note = shared_->recorder ? noteWith(key, "ignored", "", false) : KeyNote();
+  shared_->consumed.insert(keyPath(key));
+}
 
 // ---- scalars ---------------------------------------------------------------------------------
 
 template <>
 bool ConfigNode::get<bool>(const std::string& key) const {
+  const KeyNote note = noteRead(key, typeName<bool>());
   const char* what = "a boolean (true/false)";
   bool ok = false;
   const bool v = convert<bool>(valueNode(key, what), ok);
@@ -194,6 +259,7 @@ bool ConfigNode::get<bool>(const std::string& key) const {
 
 template <>
 long long ConfigNode::get<long long>(const std::string& key) const {
+  const KeyNote note = noteRead(key, typeName<long long>());
   const char* what = "an integer";
   bool ok = false;
   const long long v = convert<long long>(valueNode(key, what), ok);
@@ -203,6 +269,7 @@ long long ConfigNode::get<long long>(const std::string& key) const {
 
 template <>
 int ConfigNode::get<int>(const std::string& key) const {
+  const KeyNote note = noteRead(key, typeName<int>());
   const long long v = get<long long>(key);
   if (v < std::numeric_limits<int>::min() || v > std::numeric_limits<int>::max())
     fail(key, "an integer in the range of int");
@@ -211,6 +278,7 @@ int ConfigNode::get<int>(const std::string& key) const {
 
 template <>
 unsigned long long ConfigNode::get<unsigned long long>(const std::string& key) const {
+  const KeyNote note = noteRead(key, typeName<unsigned long long>());
   const char* what = "a non-negative integer";
   const YAML::Node n = valueNode(key, what);
   if (!n.IsScalar() || n.Scalar().empty() || n.Scalar()[0] == '-') fail(key, what);
@@ -222,6 +290,7 @@ unsigned long long ConfigNode::get<unsigned long long>(const std::string& key) c
 
 template <>
 unsigned long ConfigNode::get<unsigned long>(const std::string& key) const {
+  const KeyNote note = noteRead(key, typeName<unsigned long>());
   const unsigned long long v = get<unsigned long long>(key);
   if (v > std::numeric_limits<unsigned long>::max()) fail(key, "a non-negative integer in range");
   return static_cast<unsigned long>(v);
@@ -229,6 +298,7 @@ unsigned long ConfigNode::get<unsigned long>(const std::string& key) const {
 
 template <>
 unsigned ConfigNode::get<unsigned>(const std::string& key) const {
+  const KeyNote note = noteRead(key, typeName<unsigned>());
   const unsigned long long v = get<unsigned long long>(key);
   if (v > std::numeric_limits<unsigned>::max()) fail(key, "a non-negative integer in the range of unsigned");
   return static_cast<unsigned>(v);
@@ -236,6 +306,7 @@ unsigned ConfigNode::get<unsigned>(const std::string& key) const {
 
 template <>
 double ConfigNode::get<double>(const std::string& key) const {
+  const KeyNote note = noteRead(key, typeName<double>());
   const char* what = "a finite number";
   bool ok = false;
   const double v = convert<double>(valueNode(key, what), ok);
@@ -245,6 +316,7 @@ double ConfigNode::get<double>(const std::string& key) const {
 
 template <>
 std::string ConfigNode::get<std::string>(const std::string& key) const {
+  const KeyNote note = noteRead(key, typeName<std::string>());
   const char* what = "a string";
   const YAML::Node n = valueNode(key, what);
   if (!n.IsScalar()) fail(key, what);
@@ -279,29 +351,34 @@ Eigen::VectorXd toEigen(const std::vector<double>& v) {
 
 template <>
 std::vector<double> ConfigNode::get<std::vector<double>>(const std::string& key) const {
+  const KeyNote note = noteRead(key, typeName<std::vector<double>>());
   const char* what = "a list of numbers, e.g. [1.0, 2.0]";
   return readList<double>(*this, valueNode(key, what), key, what, "a finite number");
 }
 
 template <>
 std::vector<int> ConfigNode::get<std::vector<int>>(const std::string& key) const {
+  const KeyNote note = noteRead(key, typeName<std::vector<int>>());
   const char* what = "a list of integers, e.g. [1, 2]";
   return readList<int>(*this, valueNode(key, what), key, what, "an integer");
 }
 
 template <>
 std::vector<std::string> ConfigNode::get<std::vector<std::string>>(const std::string& key) const {
+  const KeyNote note = noteRead(key, typeName<std::vector<std::string>>());
   const char* what = "a list of strings, e.g. [a, b]";
   return readList<std::string>(*this, valueNode(key, what), key, what, "a string");
 }
 
 template <>
 Eigen::VectorXd ConfigNode::get<Eigen::VectorXd>(const std::string& key) const {
+  const KeyNote note = noteRead(key, typeName<Eigen::VectorXd>());
   return toEigen(get<std::vector<double>>(key));
 }
 
 template <>
 Eigen::Vector2d ConfigNode::get<Eigen::Vector2d>(const std::string& key) const {
+  const KeyNote note = noteRead(key, typeName<Eigen::Vector2d>());
   const std::vector<double> v = get<std::vector<double>>(key);
   if (v.size() != 2) fail(key, "a list of 2 numbers [x, y]");
   return {v[0], v[1]};
@@ -309,6 +386,7 @@ Eigen::Vector2d ConfigNode::get<Eigen::Vector2d>(const std::string& key) const {
 
 template <>
 Eigen::Vector3d ConfigNode::get<Eigen::Vector3d>(const std::string& key) const {
+  const KeyNote note = noteRead(key, typeName<Eigen::Vector3d>());
   const std::vector<double> v = get<std::vector<double>>(key);
   if (v.size() != 3) fail(key, "a list of 3 numbers [x, y, z]");
   return {v[0], v[1], v[2]};
@@ -316,6 +394,7 @@ Eigen::Vector3d ConfigNode::get<Eigen::Vector3d>(const std::string& key) const {
 
 template <>
 Eigen::Matrix3d ConfigNode::get<Eigen::Matrix3d>(const std::string& key) const {
+  const KeyNote note = noteRead(key, typeName<Eigen::Matrix3d>());
   const char* what = "a 3x3 matrix as 3 rows of 3 numbers, e.g. [[1,0,0],[0,1,0],[0,0,1]]";
   const YAML::Node n = valueNode(key, what);
   if (!n.IsSequence() || n.size() != 3) fail(key, what);
@@ -331,16 +410,20 @@ Eigen::Matrix3d ConfigNode::get<Eigen::Matrix3d>(const std::string& key) const {
 // ---- helpers ---------------------------------------------------------------------------------
 
 double ConfigNode::getAngle(const std::string& key) const {
+  const KeyNote note = noteRead(key, "angle, degrees");
   if (key.size() < 4 || key.compare(key.size() - 4, 4, "_deg") != 0)
     throw core::Error("ConfigNode::getAngle('" + key + "'): angle keys must end in _deg");
   return core::deg2rad(get<double>(key));
 }
 
 double ConfigNode::getAngleOr(const std::string& key, double fallback_rad) const {
+  const KeyNote note = noteDefault(key, [] { return std::string("angle, degrees"); },
+                                   [&] { return numberText(core::rad2deg(fallback_rad), 6); });
   return has(key) ? getAngle(key) : fallback_rad;
 }
 
 std::string ConfigNode::getChoice(const std::string& key, const std::vector<std::string>& choices) const {
+  const KeyNote note = shared_->recorder ? noteWith(key, choiceType(choices), "", false) : KeyNote();
   const std::string v = get<std::string>(key);
   if (std::find(choices.begin(), choices.end(), v) == choices.end()) {
     std::string list;
@@ -352,10 +435,12 @@ std::string ConfigNode::getChoice(const std::string& key, const std::vector<std:
 
 std::string ConfigNode::getChoiceOr(const std::string& key, const std::vector<std::string>& choices,
                                     const std::string& fallback) const {
+  const KeyNote note = noteDefault(key, [&] { return choiceType(choices); }, [&] { return configValueText(fallback); });
   return has(key) ? getChoice(key, choices) : fallback;
 }
 
 std::string ConfigNode::getPath(const std::string& key) const {
+  const KeyNote note = noteRead(key, "path (relative to the config file)");
   const std::string v = get<std::string>(key);
   if (v.empty()) fail(key, "a non-empty file path");
   const std::filesystem::path p(v);
@@ -364,6 +449,7 @@ std::string ConfigNode::getPath(const std::string& key) const {
 }
 
 ConfigNode ConfigNode::child(const std::string& key) const {
+  const KeyNote note = noteRead(key, "section");
   const char* what = "a map of keys";
   if (!has(key)) {
     std::string parent = path_.empty() ? "the top level" : "'" + path_ + "'";
@@ -381,6 +467,7 @@ ConfigNode ConfigNode::child(const std::string& key) const {
 }
 
 std::vector<ConfigNode> ConfigNode::childList(const std::string& key) const {
+  const KeyNote note = noteRead(key, "list of sections");
   const char* what = "a list of maps";
   if (!has(key)) {
     std::string parent = path_.empty() ? "the top level" : "'" + path_ + "'";
@@ -442,6 +529,145 @@ void ConfigNode::finish() const {
   std::string msg = errors.front();
   for (std::size_t i = 1; i < errors.size(); ++i) msg += "\n" + errors[i];
   throw InvalidInput(msg);
+}
+
+// ---- key recorder ----------------------------------------------------------------------------
+
+void ConfigNode::recordTo(std::shared_ptr<ConfigRecorder> recorder) const {
+  shared_->recorder = std::move(recorder);
+  shared_->probed.clear();
+  if (shared_->recorder) shared_->recorder->beginRead();
+}
+
+ConfigNode::KeyNote ConfigNode::noteRead(const std::string& key, const char* type) const {
+  return noteWith(key, type, "", false);
+}
+
+ConfigNode::KeyNote ConfigNode::noteWith(const std::string& key, const std::string& type,
+                                         const std::string& default_text, bool has_default) const {
+  if (!shared_->recorder || shared_->noting) return KeyNote();
+  const std::string path = ConfigRecorder::normalisePath(keyPath(key));
+  // A read without a default is optional when the code asked has() first (absent keeps a value the
+  // code chose), required otherwise.
+  const ConfigRecorder::Presence presence = has_default ? ConfigRecorder::Presence::Default
+                                            : shared_->probed.count(path) ? ConfigRecorder::Presence::Optional
+                                                                          : ConfigRecorder::Presence::Required;
+  shared_->recorder->note(path, type, presence, default_text);
+  shared_->noting = true;
+  return KeyNote(shared_.get());
+}
+
+#define VIEWLINE_CONFIG_TYPE(T)                                  \
+  template <>                                                    \
+  std::string ConfigNode::configTypeName<T>() {                  \
+    return typeName<T>();                                        \
+  }
+VIEWLINE_CONFIG_TYPE(bool)
+VIEWLINE_CONFIG_TYPE(int)
+VIEWLINE_CONFIG_TYPE(unsigned)
+VIEWLINE_CONFIG_TYPE(long long)
+VIEWLINE_CONFIG_TYPE(unsigned long)
+VIEWLINE_CONFIG_TYPE(unsigned long long)
+VIEWLINE_CONFIG_TYPE(double)
+VIEWLINE_CONFIG_TYPE(std::string)
+VIEWLINE_CONFIG_TYPE(std::vector<double>)
+VIEWLINE_CONFIG_TYPE(std::vector<int>)
+VIEWLINE_CONFIG_TYPE(std::vector<std::string>)
+VIEWLINE_CONFIG_TYPE(Eigen::Vector2d)
+VIEWLINE_CONFIG_TYPE(Eigen::Vector3d)
+VIEWLINE_CONFIG_TYPE(Eigen::VectorXd)
+VIEWLINE_CONFIG_TYPE(Eigen::Matrix3d)
+#undef VIEWLINE_CONFIG_TYPE
+
+template <> std::string ConfigNode::configValueText<bool>(const bool& value) { return value ? "true" : "false"; }
+template <> std::string ConfigNode::configValueText<int>(const int& value) { return std::to_string(value); }
+template <> std::string ConfigNode::configValueText<unsigned>(const unsigned& value) { return std::to_string(value); }
+template <> std::string ConfigNode::configValueText<long long>(const long long& value) { return std::to_string(value); }
+template <>
+std::string ConfigNode::configValueText<unsigned long>(const unsigned long& value) {
+  return std::to_string(value);
+}
+template <>
+std::string ConfigNode::configValueText<unsigned long long>(const unsigned long long& value) {
+  return std::to_string(value);
+}
+template <> std::string ConfigNode::configValueText<double>(const double& value) { return numberText(value); }
+template <>
+std::string ConfigNode::configValueText<std::string>(const std::string& value) {
+  // Plain when YAML reads it back as this string; quoted otherwise (empty, a number-like word).
+  bool plain = !value.empty() && (std::isalpha(static_cast<unsigned char>(value[0])) || value[0] == '_' || value[0] == '/');
+  for (const char c : value)
+    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.' || c == '/')) plain = false;
+  for (const char* word : {"true", "false", "yes", "no", "on", "off", "null", "y", "n"})
+    if (value == word) plain = false;
+  if (plain) return value;
+  std::string t = "\"";
+  for (const char c : value) t += (c == '"' || c == '\\') ? std::string("\\") + c : std::string(1, c);
+  return t + "\"";
+}
+template <>
+std::string ConfigNode::configValueText<std::vector<double>>(const std::vector<double>& value) {
+  return listText(value);
+}
+template <>
+std::string ConfigNode::configValueText<std::vector<int>>(const std::vector<int>& value) {
+  return listText(value);
+}
+template <>
+std::string ConfigNode::configValueText<std::vector<std::string>>(const std::vector<std::string>& value) {
+  return listText(value);
+}
+template <>
+std::string ConfigNode::configValueText<Eigen::Vector2d>(const Eigen::Vector2d& value) {
+  return vectorText(value);
+}
+template <>
+std::string ConfigNode::configValueText<Eigen::Vector3d>(const Eigen::Vector3d& value) {
+  return vectorText(value);
+}
+template <>
+std::string ConfigNode::configValueText<Eigen::VectorXd>(const Eigen::VectorXd& value) {
+  return vectorText(value);
+}
+template <>
+std::string ConfigNode::configValueText<Eigen::Matrix3d>(const Eigen::Matrix3d& value) {
+  std::string t = "[";
+  for (Eigen::Index r = 0; r < 3; ++r) t += (r ? ", " : "") + vectorText(value.row(r).transpose());
+  return t + "]";
+}
+
+std::string ConfigRecorder::normalisePath(const std::string& path) {
+  std::string out;
+  out.reserve(path.size());
+  for (std::size_t i = 0; i < path.size(); ++i) {
+    out += path[i];
+    if (path[i] == '[') {
+      while (i + 1 < path.size() && path[i + 1] != ']') ++i;
+    }
+  }
+  return out;
+}
+
+const ConfigRecorder::Key* ConfigRecorder::find(const std::string& path) const {
+  for (const Key& k : keys_)
+    if (k.path == path) return &k;
+  return nullptr;
+}
+
+void ConfigRecorder::note(const std::string& path, const std::string& type, Presence presence,
+                          const std::string& default_text) {
+  auto it = std::find_if(keys_.begin(), keys_.end(), [&](const Key& k) { return k.path == path; });
+  if (it == keys_.end()) {
+    it = keys_.insert(keys_.begin() + static_cast<std::ptrdiff_t>(std::min(cursor_, keys_.size())), Key{path, type, presence, {}});
+  } else if (it->type != type && it->type.find(type) == std::string::npos) {
+    it->type += " | " + type;  // read as two types on two paths of the code: both are documented
+  }
+  // A key read with a default anywhere has that default; optional beats required (some branch of
+  // the code reads it only when present).
+  if (static_cast<int>(presence) > static_cast<int>(it->presence)) it->presence = presence;
+  if (presence == Presence::Default && std::find(it->defaults.begin(), it->defaults.end(), default_text) == it->defaults.end())
+    it->defaults.push_back(default_text);
+  cursor_ = static_cast<std::size_t>(it - keys_.begin()) + 1;
 }
 
 }  // namespace viewline::io

@@ -8,3 +8,5 @@ list(APPEND scenarios_sources
   ball_catching/registration.cpp
   ball_catching/world.cpp)
 list(APPEND scenarios_tests test/summary_text_test.cpp)
+# Unit and meaning of every key its config reader reads (docs/config_reference.md is generated from it).
+list(APPEND scenarios_sources ball_catching/config_keys.cpp)

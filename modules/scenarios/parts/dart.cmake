@@ -2,3 +2,5 @@
 # the viewline tracker's consistency, gates, asynchronous and late data, single-camera start):
 # config (the one YAML reader), world (flights and detections), loop (experiments A-E), metrics.
 list(APPEND scenarios_sources dart/config.cpp dart/world.cpp dart/loop.cpp dart/metrics.cpp)
+# Unit and meaning of every key its config reader reads (docs/config_reference.md is generated from it).
+list(APPEND scenarios_sources dart/config_keys.cpp)

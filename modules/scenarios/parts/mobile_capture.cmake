@@ -2,3 +2,5 @@
 # on the scenario runtime with its oracle, and the metrics (filter test, localisation sweep, batch).
 list(APPEND scenarios_sources mobile_capture/config.cpp mobile_capture/world.cpp mobile_capture/loop.cpp
   mobile_capture/metrics.cpp)
+# Unit and meaning of every key its config reader reads (docs/config_reference.md is generated from it).
+list(APPEND scenarios_sources mobile_capture/config_keys.cpp)

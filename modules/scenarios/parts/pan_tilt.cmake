@@ -8,3 +8,5 @@ list(APPEND scenarios_sources
   pan_tilt/replay.cpp
   pan_tilt/telemetry.cpp
   pan_tilt/world.cpp)
+# Unit and meaning of every key its config reader reads (docs/config_reference.md is generated from it).
+list(APPEND scenarios_sources pan_tilt/config_keys.cpp)

@@ -3,3 +3,5 @@
 list(APPEND scenarios_sources table_ball/observer.cpp
   table_ball/config.cpp table_ball/world.cpp table_ball/loop.cpp table_ball/metrics.cpp)
 list(APPEND scenarios_tests test/table_ball_observer_test.cpp)
+# Unit and meaning of every key its config reader reads (docs/config_reference.md is generated from it).
+list(APPEND scenarios_sources table_ball/config_keys.cpp)

@@ -1,0 +1,72 @@
+// Unit and meaning of every key the dart config reader (config.cpp) reads. The reference
+// docs/config_reference.md is generated from this table and the recorded reads; the unit test
+// ScenarioConfigKeys fails when a key is read without an entry here or an entry is never read.
+#include "viewline/scenarios/config_keys.h"
+#include "viewline/scenarios/dart/config.h"
+
+namespace viewline::scenarios {
+
+io::ConfigReferenceSection dartConfigReference() {
+  io::ConfigReferenceSection s;
+  s.name = "dart";
+  s.title = "Dart tracking (`dart_tracking`)";
+  s.summary =
+      "The measurement-level dart experiment of [L] §VI: generated detections of thrown darts from "
+      "simulated cameras, the viewline tracker's consistency, gates, asynchronous and late data and "
+      "single-camera start. Every key is optional (defaults: `scenarios::defaultDartScenario()`).";
+  s.shipped = {"dart_tracking.yaml"};
+  s.read = [](const io::ConfigNode& root) { dartScenarioFromNode(root); };
+  s.keys = {
+      {"cameras", "", "the simulated cameras (absent: two cameras, side and rear, 2-3 m from the thrower)"},
+      {"cameras[].name", "", "camera name in logs and summaries"},
+      {"cameras[].eye", "m", "camera centre, world frame"},
+      {"cameras[].target", "m", "a point on the optical axis, world frame (differs from eye)"},
+      {"cameras[].hfov_deg", "deg", "horizontal field of view, in (0, 170)"},
+      {"cameras[].width", "px", "image width"},
+      {"cameras[].height", "px", "image height"},
+      {"cameras[].kud", "", "ViSP radial distortion coefficient (pixel -> metre)"},
+      {"cameras[].rate_hz", "Hz", "frame rate of the free-running camera"},
+      {"cameras[].clock_drift_std", "", "relative frequency error of the camera clock (std), in [0, 0.1)"},
+      {"cameras[].jitter_std_s", "s", "capture-time jitter (std), below a quarter frame period"},
+      {"gravity", "m/s²", "gravity in the world frame; the one owner (the tracker's model asks for it)"},
+      {"throw", "", "the thrown darts"},
+      {"throw.release_mean", "m", "mean release point, world frame"},
+      {"throw.release_std", "m", "std of the release point per axis"},
+      {"throw.board_center", "m", "bull's eye, world frame"},
+      {"throw.aim_std", "m", "spread of the aim point on the board (y and z)"},
+      {"throw.speed_min", "m/s", "smallest release speed"},
+      {"throw.speed_max", "m/s", "largest release speed (>= speed_min)"},
+      {"throw.truth_accel_psd", "m²/s³", "white acceleration of the true flights (0: pure ballistic)"},
+      {"pixel_noise_px", "px", "detection noise (std per axis)"},
+      {"outlier_rate", "", "fraction of detections that are gross outliers anywhere in the image, in [0, 1)"},
+      {"tracker", "", "the viewline tracker (tracking::TrackerConfig)"},
+      {"tracker.prior_position", "m", "prior position of a new track (absent: [1, 0, 1.75], mid-flight)"},
+      {"tracker.prior_velocity", "m/s", "prior velocity of a new track (absent: [12, 0, 0], towards the board)"},
+      {"tracker.prior_std", "m, m/s", "prior std of position and velocity (absent: 10, P0 = 100 I)"},
+      {"tracker.accel_psd", "m²/s³", "white acceleration of the tracker's ballistic model"},
+      {"tracker.gate", "", "measurement gate: none, directional ([L] §V) or mahalanobis (chi-square; absent: mahalanobis)"},
+      {"tracker.directional_p", "", "p of the directional gate of [L] §V"},
+      {"tracker.mahalanobis_alpha", "", "false-rejection probability of the chi-square gate"},
+      {"tracker.restart_after_rejections", "", "consecutive gated images of one camera before the track restarts"},
+      {"tracker.max_coast_s", "s", "time without a fused image after which the next one starts a new track"},
+      {"tracker.history_capacity", "", "measurements kept per track for a restart"},
+      {"tracker.min_depth", "m", "floor of the predicted depth in the measurement noise model"},
+      {"tracker.max_forward_gap_s", "s", "a measurement further than this after the newest stamp is refused"},
+      {"tracker.image_margin_px", "px", "pixels this far outside the image are still accepted"},
+      {"tracker.dt_offset_period_s", "s", "grid of the Δt-offset filter ([L] eq 26) in the comparison"},
+      {"experiments", "", "the experiments A-E of [L] §VI"},
+      {"experiments.alternate_step_s", "s", "time between alternating images (each camera at 1 / (2 step))"},
+      {"experiments.late_max_delay_s", "s", "arrivals shuffled up to this late"},
+      {"experiments.late_horizon_s", "s", "how far back the tracker re-processes late data (>= late_max_delay_s)"},
+      {"experiments.single_camera", "", "index of the camera of the single-camera start"},
+      {"experiments.single_offset_max", "m, m/s", "largest offset of the single-camera prior from the truth"},
+      {"experiments.single_prior_std", "m", "prior std of the single-camera start ([L] §VI.B)"},
+      {"experiments.single_tolerance", "m", "converged when within this distance of a filter started at the truth"},
+      {"experiments.nees_index", "", "measurement (0-based) at which each run gives its NEES sample"},
+      {"experiments.settled_index", "", "RMSE and PCRLB pooled over measurements with this index and later"},
+      {"experiments.confidence", "", "confidence of the consistency intervals, in (0, 1)"},
+  };
+  return s;
+}
+
+}  // namespace viewline::scenarios
