@@ -61,6 +61,8 @@ io::ConfigReferenceSection tableBallConfigReference() {
       {"observer.prediction_steps", "", "N predicted positions per frame"},
       {"observer.stationary_gain", "", "use the DARE gain for the nominal frame period"},
       {"observer.initial_velocity_std", "m/s", "velocity prior at the first detection"},
+      {"observer.gate_probability", "", "chi-square gate on the update's NIS (tracking::TrackGate); 1: no gate, as [M]"},
+      {"observer.restart_after", "", "rejections in a row that restart the track (with a gate)"},
       {"observer.refine", "", "detector refinements after [M]'s steps (false: [M] exactly)"},
       {"observer.edge_tracking", "", "track the sides and the ball locally between full [M] detections"},
       {"observer.border_aware_pnp", "", "re-solve the PnP for the strip of surface the borders hide (false: [M])"},
