@@ -209,28 +209,6 @@ TEST(PlanarTargetFilter, SoftJumpsAndConstantSpeedLegsOnASquare) {
   EXPECT_NO_THROW(g.startLeg(0.1));
 }
 
-TEST(PlanarTargetFilter, LegEvidenceOnARandomPolyline) {
-  // The pan-tilt app's random path: uniformly random turns every ~2 s, [T]'s 10 % noise (σ 3.6 / 2.1 cm).
-  // The kinks filter (CV, corners by the kink test, soft mixture from kinks) against the legs filter
-  // (constant-speed legs, soft mixture from leg evidence, uniform turn prior), and the oracle.
-  const tracking::TargetFilterConfig kinks = randomKinksFilter(), legs = randomLegsFilter();
-  tracking::TargetFilterConfig oracle = legs;
-  oracle.jump_threshold = 1e300;
-  oracle.jump_rate = 0.0;
-  oracle.jump_evidence = "kink";
-  oracle.constant_speed_sigma = 0.0;
-  const double r_kinks = randomPolylineRms(kinks);
-  const double r_legs = randomPolylineRms(legs, false, [](std::uint64_t seed, const tracking::PlanarTargetFilter& f) {
-    EXPECT_NEAR(f.speedEstimate(), 0.15, 0.01) << seed;
-  });
-  const double r_oracle = randomPolylineRms(oracle, true);
-  std::cout << "random polyline, RMS (mm): kinks " << 1e3 * r_kinks << ", legs + leg evidence " << 1e3 * r_legs
-            << ", oracle corners " << 1e3 * r_oracle << "\n";
-  // measured (mm): kinks 17.32, legs + leg evidence 13.99, oracle 10.17
-  EXPECT_LT(r_legs, 0.9 * r_kinks);
-  EXPECT_LT(r_oracle, r_legs);  // knowing the corners is a bound
-}
-
 TEST(PlanarTargetFilter, AutoCornerSettingsFollowTheNoiseAndTheStep) {
   // "auto": jump_min_samples = round(2.44 ρ^(2/3)), ρ = σ / (ŝ Δt), and jump_corner_sigma = 0.34 σ, with σ
   // the per-axis RMS of the measurement noise. On the app's random polyline at [T]'s 10 % noise and 30 Hz
@@ -320,35 +298,58 @@ TEST(PlanarTargetFilter, WaypointDirectionDensityAndNewKeys) {
   EXPECT_THROW(tracking::PlanarTargetFilter{bad}, core::InvalidInput);
 }
 
-TEST(PlanarTargetFilter, WaypointRegionOnARandomPolyline) {
-  // The same random polylines, whose waypoints are uniform in the 0.8 x 0.43 m box: the legs
-  // filter without and with that box as its waypoint region (direction prior and turn odds), and with
-  // its jumps then decided by the mixture's posterior instead of the chi-square test.
-  const tracking::TargetFilterConfig legs = randomLegsFilter();
+// The pan-tilt app's random path (uniformly random turns every ~2 s, [T]'s 10 % noise, σ 3.6 / 2.1 cm):
+// the filters of that path compared on the same four 40 s polylines. One test, so that the legs filter
+// and config/pan_tilt_random.yaml's filter (legs + waypoint region + posterior decisions), each compared
+// with two others, run once.
+TEST(PlanarTargetFilter, RandomPolylineLegEvidenceWaypointRegionAndAWrongRegion) {
+  // Leg evidence: the kinks filter (CV, corners by the kink test, soft mixture from kinks) against the
+  // legs filter (constant-speed legs, soft mixture from leg evidence, uniform turn prior), and the oracle.
+  const tracking::TargetFilterConfig kinks = randomKinksFilter(), legs = randomLegsFilter();
+  tracking::TargetFilterConfig oracle = legs;
+  oracle.jump_threshold = 1e300;
+  oracle.jump_rate = 0.0;
+  oracle.jump_evidence = "kink";
+  oracle.constant_speed_sigma = 0.0;
+  const double r_kinks = randomPolylineRms(kinks);
+  const double r_legs = randomPolylineRms(legs, false, [](std::uint64_t seed, const tracking::PlanarTargetFilter& f) {
+    EXPECT_NEAR(f.speedEstimate(), 0.15, 0.01) << seed;
+  });
+  const double r_oracle = randomPolylineRms(oracle, true);
+  std::cout << "random polyline, RMS (mm): kinks " << 1e3 * r_kinks << ", legs + leg evidence " << 1e3 * r_legs
+            << ", oracle corners " << 1e3 * r_oracle << "\n";
+  // measured (mm): kinks 17.32, legs + leg evidence 13.99, oracle 10.17
+  EXPECT_LT(r_legs, 0.9 * r_kinks);
+  EXPECT_LT(r_oracle, r_legs);  // knowing the corners is a bound
+
+  // Waypoint region: the legs filter without and with the 0.8 x 0.43 m box its waypoints are uniform in
+  // as its waypoint region (direction prior and turn odds), and with its jumps then decided by the
+  // mixture's posterior instead of the chi-square test (config/pan_tilt_random.yaml, randomRegionFilter).
   tracking::TargetFilterConfig region = legs;
   region.region_size = Eigen::Vector2d(0.80, 0.43);
-  tracking::TargetFilterConfig posterior = region;  // config/pan_tilt_random.yaml
+  tracking::TargetFilterConfig posterior = region;
   posterior.jump_decision = "posterior";
   posterior.jump_posterior = 0.99;
-  const double r_legs = randomPolylineRms(legs), r_region = randomPolylineRms(region);
-  const double r_posterior = randomPolylineRms(posterior);
+  const tracking::TargetFilterConfig shipped = randomRegionFilter();
+  ASSERT_EQ(shipped.region_size, posterior.region_size);  // the same filter: its run serves both parts
+  ASSERT_EQ(shipped.jump_decision, posterior.jump_decision);
+  ASSERT_EQ(shipped.jump_posterior, posterior.jump_posterior);
+  const double r_region = randomPolylineRms(region);
+  // The true box is never dropped on these tracks.
+  const double r_posterior = randomPolylineRms(shipped, false, [](std::uint64_t seed, const tracking::PlanarTargetFilter& f) {
+    EXPECT_FALSE(f.regionDropped()) << seed;
+  });
   std::cout << "random polyline, RMS (mm): legs " << 1e3 * r_legs << ", legs + waypoint region " << 1e3 * r_region
             << ", + jumps decided by the posterior " << 1e3 * r_posterior << "\n";
   EXPECT_LT(r_region, 0.97 * r_legs);
   EXPECT_LT(r_posterior, 0.97 * r_region);
-}
 
-TEST(PlanarTargetFilter, AWrongWaypointRegionIsDropped) {
-  // A box of half the size: the measurements leave it, the filter drops it and goes on as without one.
-  // The true box is never dropped on these tracks.
-  const tracking::TargetFilterConfig region = randomRegionFilter();
-  tracking::TargetFilterConfig wrong = region;
+  // A wrong waypoint region, a box of half the size: the measurements leave it, the filter drops it and
+  // goes on as without one.
+  tracking::TargetFilterConfig wrong = shipped;
   wrong.region_size = Eigen::Vector2d(0.40, 0.215);
-  tracking::TargetFilterConfig none = region;
+  tracking::TargetFilterConfig none = shipped;
   none.region_size = Eigen::Vector2d::Zero();
-  randomPolylineRms(region, false, [](std::uint64_t seed, const tracking::PlanarTargetFilter& f) {
-    EXPECT_FALSE(f.regionDropped()) << seed;
-  });
   const double r_wrong = randomPolylineRms(wrong, false, [](std::uint64_t seed, const tracking::PlanarTargetFilter& f) {
     EXPECT_TRUE(f.regionDropped()) << seed;
   });

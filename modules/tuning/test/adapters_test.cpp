@@ -89,7 +89,7 @@ TEST(ScenarioAdapters, TableBallTinySweepWithAutotune) {
                                    "scenario: table_ball\nconfig: " + configPath("table_ball.yaml") +
                                        "\nseeds: 1\nmetric: observer_rmse_mm\nparameters:\n"
                                        "  - key: observer.sigma_v\n    values: [0.003, 0.01]\n"
-                                       "adapter: {duration: 3}\n"
+                                       "adapter: {duration: 2}\n"
                                        "autotune: {start_scale: 10, outlier_prior: 0.01, grid_points: 5}\n",
                                    {"observer_rmse_mm", "measurement_rmse_mm", "ball_detection_rate", "nis_mean", "nees_mean"});
   // The auto-tuning replayed the observer's measurements: NIS before and after, tuned noise written.
@@ -112,9 +112,9 @@ TEST(ScenarioAdapters, MobileCaptureTinySweep) {
   const nlohmann::json j = runTiny("mobile_capture",
                                    "scenario: mobile_capture\nconfig: " + configPath("mobile_capture.yaml") +
                                        "\nseeds: 1\nmetric: estimate_rmse_mm\nparameters:\n"
-                                       "  - key: filter.q_v\n    values: [0.003, 0.03]\nadapter: {max_time: 8, settle_s: 1}\n",
+                                       "  - key: filter.q_v\n    values: [0.003, 0.03]\nadapter: {max_time: 5, settle_s: 1}\n",
                                    {"estimate_rmse_mm", "detection_rate", "capture_time_s", "nees_mean", "nis_mean"});
-  // The gate's NIS of every tested measurement after the settle time (8 s at the vision rate).
+  // The gate's NIS of every tested measurement after the settle time (4 s at the 10 Hz vision rate).
   for (const auto& s : j.at("all_settings")) EXPECT_GT(s.at("nis").at("samples").get<double>(), 20.0) << s.dump();
 }
 
