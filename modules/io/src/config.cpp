@@ -145,6 +145,8 @@ ConfigNode::ConfigNode(std::shared_ptr<Shared> shared, YAML::Node node, std::str
 ConfigNode ConfigNode::loadFile(const std::string& path) {
   std::error_code ec;  // the throwing overload raised filesystem_error on e.g. a name too long
   if (!std::filesystem::exists(path, ec)) throw InvalidInput(path + ": config file does not exist");
+  // A directory opens as a stream on Linux and fails only when read ("basic_filebuf::underflow").
+  if (std::filesystem::is_directory(path, ec)) throw InvalidInput(path + ": is a directory, expected a YAML config file");
   YAML::Node root;
   try {
     root = YAML::LoadFile(path);

@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <filesystem>
+
 #include "temp_dir.h"
 #include "viewline/core/error.h"
 #include "viewline/io/config.h"
@@ -207,4 +209,16 @@ TEST(Config, FromTreeRefusesWhatTheParserWould) {
   const std::string twice = errorOf([&] { ConfigNode::fromTree(dup, "d.yaml"); });
   EXPECT_NE(twice.find("duplicate key 'a'"), std::string::npos) << twice;
   EXPECT_EQ(twice.rfind("d.yaml", 0), 0u) << twice;
+}
+
+TEST(Config, ADirectoryGivenAsTheConfigFileIsNamed) {
+  const std::string dir = ::testing::TempDir() + "config_test_a_directory";
+  std::filesystem::create_directories(dir);
+  try {
+    ConfigNode::loadFile(dir);
+    ADD_FAILURE() << "a directory was read as a config";
+  } catch (const InvalidInput& e) {
+    EXPECT_NE(std::string(e.what()).find(dir + ": is a directory"), std::string::npos) << e.what();
+  }
+  std::filesystem::remove(dir);
 }
