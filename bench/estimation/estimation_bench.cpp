@@ -34,51 +34,16 @@
 
 #include "viewline/estimation/kalman_filter.h"
 #include "viewline/estimation/models/ballistic.h"
+#include "ballistic_problem.h"
 
 namespace {
 
 using namespace viewline;
 using namespace viewline::estimation;
 
-struct Problem {
-  LinearTransition tr;
-  LinearMeasurement meas;
-  Eigen::VectorXd x0;
-  Eigen::MatrixXd P0;
-};
+using bench::Problem;
+using bench::makeProblem;
 
-// m = 2 * cameras rows: the two viewline planes of each camera through a point near p = (0, 0, 3).
-Problem makeProblem(int rows) {
-  Problem pb;
-  BallisticModel model;
-  model.q = 1.0;
-  pb.tr = model.transition(0.02);
-  const int cameras = rows / 2;
-  pb.meas.C = Eigen::MatrixXd::Zero(rows, 6);
-  pb.meas.y = Eigen::VectorXd::Zero(rows);
-  pb.meas.R = Eigen::MatrixXd::Zero(rows, rows);
-  const Eigen::Vector3d target(0.0, 0.0, 3.0);
-  for (int c = 0; c < cameras; ++c) {
-    // Camera c on a circle looking at the target; its planes contain the viewline.
-    const double a = 2.0 * M_PI * c / cameras;
-    const Eigen::Vector3d centre(4.0 * std::cos(a), 4.0 * std::sin(a), 1.5);
-    const Eigen::Vector3d dir = (target - centre).normalized();
-    const Eigen::Vector3d n1 = dir.cross(Eigen::Vector3d::UnitZ()).normalized();
-    const Eigen::Vector3d n2 = dir.cross(n1).normalized();
-    const double dt_capture = 0.004 * c;  // unsynchronised cameras ([L] eq 26)
-    for (int k = 0; k < 2; ++k) {
-      const Eigen::Vector3d n = (k == 0) ? n1 : n2;
-      const int r = 2 * c + k;
-      pb.meas.C.block<1, 3>(r, 0) = n.transpose();
-      pb.meas.C.block<1, 3>(r, 3) = dt_capture * n.transpose();
-      pb.meas.y[r] = n.dot(target);
-      pb.meas.R(r, r) = std::pow(0.002 * (1.0 + 0.1 * r), 2);
-    }
-  }
-  pb.x0 = (Eigen::VectorXd(6) << 0.1, -0.1, 3.2, 0.0, 0.0, -8.0).finished();
-  pb.P0 = Eigen::MatrixXd::Identity(6, 6);
-  return pb;
-}
 
 void BM_Ours(benchmark::State& state) {
   const Problem pb = makeProblem(static_cast<int>(state.range(0)));
