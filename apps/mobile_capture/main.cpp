@@ -48,9 +48,13 @@ int main(int argc, char** argv) {
         hooks.quit_requested = [&] { return view->quitRequested(); };
       }
       const auto r = scenarios::runMobileCapture(cfg, core::deriveSeed(opt.seed, 0), &hooks);
-      std::printf("run 0: %s at %.1f s (oracle %.1f s), %d grasp attempts, %d/%d frames with a detection\n",
-                  r.captured ? "captured" : "NOT captured", r.capture_time, r.oracle_time, r.grasp_attempts,
-                  r.detections, r.frames);
+      if (r.interrupted)
+        std::printf("run 0: stopped early (%s), %d grasp attempts, %d/%d frames with a detection; not scored\n",
+                    r.captured ? "captured" : "not captured", r.grasp_attempts, r.detections, r.frames);
+      else
+        std::printf("run 0: %s at %.1f s (oracle %.1f s), %d grasp attempts, %d/%d frames with a detection\n",
+                    r.captured ? "captured" : "NOT captured", r.capture_time, r.oracle_time, r.grasp_attempts,
+                    r.detections, r.frames);
       if (view) view->waitForClose();
       scenarios::logFilterTest(scenarios::runFilterTest(cfg, core::deriveSeed(opt.seed, 100000)), log);
     }

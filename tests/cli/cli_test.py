@@ -121,12 +121,7 @@ def cases():
                 continue
             out.append(f"{exe}.{cls}")
     for app in SCENARIO_APPS:
-        out.append(f"{app}.full_disk_summary")
-        # mobile_capture's batch (modules/scenarios/mobile_capture/metrics.cpp) goes on taking runs and
-        # then computes its FOV sweep and filter test after a stop: its runs end at once, the rest took
-        # 183 s after SIGINT with --runs 40. It needs its loops to poll core::interruptRequested().
-        if app != "mobile_capture":
-            out += [f"{app}.sigint", f"{app}.sigterm"]
+        out += [f"{app}.full_disk_summary", f"{app}.sigint", f"{app}.sigterm"]
     out.append("dart_tracking.full_disk_log")
     return out
 

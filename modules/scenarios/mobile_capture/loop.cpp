@@ -3,6 +3,7 @@
 #include <cmath>
 #include <optional>
 
+#include "viewline/core/interrupt.h"
 #include "viewline/robots/mobile_ground_localization.h"
 #include "viewline/scenarios/mobile_capture/world.h"
 
@@ -232,7 +233,10 @@ MobileCaptureRun runMobileCapture(const MobileCaptureConfig& cfg, std::uint64_t 
       f.mode = mode;
       hooks->on_frame(f);
     }
-    if (hooks && hooks->quit_requested && hooks->quit_requested()) sched.requestStop();
+    if (hooks && hooks->quit_requested && hooks->quit_requested()) {
+      run.interrupted = true;
+      sched.requestStop();
+    }
   };
   // Frames when the source has them (a renderer: every vision period, on the control ticks).
   std::function<void()> next_frame = [&] {
@@ -282,6 +286,9 @@ MobileCaptureRun runMobileCapture(const MobileCaptureConfig& cfg, std::uint64_t 
   if (!run.captured) run.capture_time = cfg.max_time;
   run.gate = track.gate().counts();
   if (sink) sink->flush();
+  // requestStop() also ends a run at its capture; a signal or the view's quit ends it early.
+  if (core::interruptRequested()) run.interrupted = true;
+  if (run.interrupted) return run;
 
   const OracleResult oracle = runOracle(cfg, seed);
   run.oracle_captured = oracle.captured;

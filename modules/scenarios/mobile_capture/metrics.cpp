@@ -137,14 +137,29 @@ MobileCaptureSummary runMobileCaptureBatch(const MobileCaptureConfig& cfg, int r
   MobileCaptureSummary s;
   s.runs.resize(static_cast<std::size_t>(runs));
   std::atomic<int> next{0}, done{0};
+  std::atomic<bool> stopped{false};
+  std::vector<char> completed(static_cast<std::size_t>(runs), 0);
   std::mutex mutex;
   std::exception_ptr error;
+  // A stop request (SIGINT/SIGTERM) ends the batch after the runs in flight: they return early
+  // (their scheduler polls the request) and are dropped, no new run starts, and the summary is
+  // over the runs that completed.
   auto worker = [&]() {
     for (;;) {
+      if (core::interruptRequested()) {
+        stopped = true;
+        return;
+      }
       const int i = next++;
       if (i >= runs) return;
       try {
-        s.runs[static_cast<std::size_t>(i)] = runMobileCapture(cfg, core::deriveSeed(seed, static_cast<std::uint64_t>(i)));
+        auto& r = s.runs[static_cast<std::size_t>(i)];
+        r = runMobileCapture(cfg, core::deriveSeed(seed, static_cast<std::uint64_t>(i)));
+        if (r.interrupted) {
+          stopped = true;
+          return;
+        }
+        completed[static_cast<std::size_t>(i)] = 1;
       } catch (...) {
         std::lock_guard<std::mutex> lock(mutex);
         if (!error) error = std::current_exception();
@@ -163,6 +178,12 @@ MobileCaptureSummary runMobileCaptureBatch(const MobileCaptureConfig& cfg, int r
   for (int k = 0; k < n_threads; ++k) pool.emplace_back(worker);
   for (auto& th : pool) th.join();
   if (error) std::rethrow_exception(error);
+  std::vector<MobileCaptureRun> finished;
+  for (std::size_t k = 0; k < s.runs.size(); ++k)
+    if (completed[k]) finished.push_back(std::move(s.runs[k]));
+  s.runs = std::move(finished);
+  s.interrupted = stopped;
+  const auto kept = static_cast<double>(s.runs.size());
 
   std::vector<double> ratios, times, oracle_times;
   int ok = 0, oracle_ok = 0;
@@ -174,8 +195,9 @@ MobileCaptureSummary runMobileCaptureBatch(const MobileCaptureConfig& cfg, int r
     if (r.oracle_captured) oracle_times.push_back(r.oracle_time);
     if (r.captured && r.oracle_captured) ratios.push_back(r.capture_time / r.oracle_time);
   }
-  s.success_rate = static_cast<double>(ok) / runs;
-  s.oracle_success_rate = static_cast<double>(oracle_ok) / runs;
+  // No completed run (stopped at once): the rates are not scored (NaN, JSON null).
+  s.success_rate = ok / kept;
+  s.oracle_success_rate = oracle_ok / kept;
   s.ratio_runs = static_cast<int>(ratios.size());
   if (!ratios.empty()) {
     s.ratio_median = core::percentile(ratios, 0.5);
@@ -187,6 +209,10 @@ MobileCaptureSummary runMobileCaptureBatch(const MobileCaptureConfig& cfg, int r
   }
   if (!oracle_times.empty()) s.oracle_time_median = core::percentile(oracle_times, 0.5);
 
+  if (stopped) {  // the filter test and the field-of-view sweep are long: not after a stop request
+    s.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return s;
+  }
   for (int k = 0; k < cfg.filter_test_runs; ++k) {
     FilterTestResult f = runFilterTest(cfg, core::deriveSeed(seed, 100000 + static_cast<std::uint64_t>(k)));
     s.filter_rmse_theta += f.rmse_theta / cfg.filter_test_runs;
@@ -254,6 +280,10 @@ std::string summaryJson(const MobileCaptureSummary& s, const MobileCaptureConfig
                       {"rmse_omega_vs_nominal_rad_s", s.filter_rmse_omega_nominal},
                       {"rmse_position_m", s.filter_rmse_position},
                       {"rmse_measurement_m", s.filter_rmse_measurement}};
+  if (s.interrupted) {  // not run after a stop request
+    j["ground_localization_fov_sweep"] = nullptr;
+    j["filter_test"] = nullptr;
+  }
   j["rig"] = cfg.rig ? nlohmann::json(cfg.rig->folder) : nlohmann::json(nullptr);
   j["wall_time_s"] = s.wall_time;
   return j.dump(indent);
@@ -262,8 +292,12 @@ std::string summaryJson(const MobileCaptureSummary& s, const MobileCaptureConfig
 std::string summaryText(const MobileCaptureSummary& s, const MobileCaptureConfig& cfg, int runs, std::uint64_t seed) {
   std::string out;
   char line[512];
-  std::snprintf(line, sizeof line, "mobile_capture: %d runs, seed %llu, %.0f s wall\n", runs,
-                static_cast<unsigned long long>(seed), s.wall_time);
+  if (s.interrupted)
+    std::snprintf(line, sizeof line, "mobile_capture: %zu of %d runs (interrupted), seed %llu, %.0f s wall\n",
+                  s.runs.size(), runs, static_cast<unsigned long long>(seed), s.wall_time);
+  else
+    std::snprintf(line, sizeof line, "mobile_capture: %d runs, seed %llu, %.0f s wall\n", runs,
+                  static_cast<unsigned long long>(seed), s.wall_time);
   out += line;
   if (cfg.rig) {
     std::snprintf(line, sizeof line, "  camera: rig %s (renders with truth.yaml; estimators use rig.yaml + ground.yaml)\n",
@@ -275,6 +309,10 @@ std::string summaryText(const MobileCaptureSummary& s, const MobileCaptureConfig
   const bool any_capture = std::any_of(s.runs.begin(), s.runs.end(), [](const MobileCaptureRun& r) { return r.captured; });
   const bool any_oracle =
       std::any_of(s.runs.begin(), s.runs.end(), [](const MobileCaptureRun& r) { return r.oracle_captured; });
+  if (s.runs.empty()) {
+    out += "  no run completed: nothing scored\n";
+    return out;
+  }
   std::snprintf(line, sizeof line, "  capture success %.3f (oracle %.3f); ", s.success_rate, s.oracle_success_rate);
   out += line;
   if (any_capture) {
@@ -302,6 +340,10 @@ std::string summaryText(const MobileCaptureSummary& s, const MobileCaptureConfig
                 "horizontal range %.3f m\n",
                 rms(l.sse_exact, l.count), rms(l.sse_printed, l.count), rms(l.sse_horizontal, l.count));
   out += line;
+  if (s.interrupted) {
+    out += "  FOV sweep and filter test: not run (interrupted)\n";
+    return out;
+  }
   const LocalizationErrors& f = s.fov.all;
   std::snprintf(line, sizeof line, "  FOV sweep RMS: exact %.3f m, printed %.3f m, horizontal %.3f m\n",
                 rms(f.sse_exact, f.count), rms(f.sse_printed, f.count), rms(f.sse_horizontal, f.count));

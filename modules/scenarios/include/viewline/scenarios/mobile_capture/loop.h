@@ -83,9 +83,11 @@ struct MobileCaptureRun {
   double longest_lost = 0.0;           ///< s, longest gap between detections after the first one
   LocalizationErrors localization;     ///< ground-localisation errors over the run's detections
   tracking::GateCounts gate;           ///< the track's gate decisions
+  bool interrupted = false;            ///< a stop request (signal, closed view) ended the run early: not scored
 };
 
-/// One run of our loop and of the oracle with the same object path (seed).
+/// One run of our loop and of the oracle with the same object path (seed). A stop request
+/// (core::interruptRequested(), the view's quit) ends it early with `interrupted` set and no oracle run.
 MobileCaptureRun runMobileCapture(const MobileCaptureConfig& cfg, std::uint64_t seed,
                                   const MobileCaptureHooks* hooks = nullptr);
 

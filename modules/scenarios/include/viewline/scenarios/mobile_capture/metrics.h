@@ -47,7 +47,8 @@ FovSweepResult compareGroundLocalization(const MobileCaptureConfig& cfg, std::ui
 
 /// A batch's figures: capture success and time against the oracle, filter test, FOV sweep.
 struct MobileCaptureSummary {
-  std::vector<MobileCaptureRun> runs;  ///< every run, in seed order
+  std::vector<MobileCaptureRun> runs;  ///< every completed run, in seed order
+  bool interrupted = false;            ///< a stop request ended the batch early (runs holds those that completed)
   double success_rate = 0.0,         ///< fraction of runs captured before max_time
          oracle_success_rate = 0.0;  ///< the same for the oracle
   double ratio_median = 0.0,  ///< median capture time / oracle's, over runs where both captured
