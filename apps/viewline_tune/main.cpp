@@ -19,12 +19,15 @@ using namespace viewline;
 
 namespace {
 
-std::atomic<bool> g_stop{false};  // set by SIGINT: no new runs are started (signal handlers need a global)
+std::atomic<bool> g_stop{false};  // set by SIGINT/SIGTERM: no new runs are started (handlers need a global)
+std::atomic<int> g_signal{0};     // the signal that set it
 
-// First Ctrl-C: stop launching runs and write what is done; a second one ends the program.
-extern "C" void onSigint(int) {
+// First SIGINT (Ctrl-C) or SIGTERM: stop launching runs and write what is done; a second one ends
+// the program (the default action).
+extern "C" void onStopSignal(int sig) {
+  g_signal.store(sig);
   g_stop.store(true);
-  std::signal(SIGINT, SIG_DFL);
+  std::signal(sig, SIG_DFL);
 }
 
 // The live curves of `run --display`: the error and the NIS (2 rows per image) in a vpPlot window.
@@ -42,12 +45,16 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string("viewline ") + viewline::core::kVersion);
   tuning::TuneCommandLine command_line(app);
   if (const auto code = apps::parseCommandLine(app, argc, argv)) return *code;
-  std::signal(SIGINT, onSigint);
+  std::signal(SIGINT, onStopSignal);
+  std::signal(SIGTERM, onStopSignal);
   // Bad input (a sweep file's key, a scenario refusing a value) is a usage error here: exit 2, as
-  // tutorials/tune_tracking_loop documents; anything else is a runtime error (1).
+  // tutorials/tune_tracking_loop documents; anything else (a full disk, a numerical failure) is a
+  // runtime error (1). A session stopped by a signal exits 128 + its number (130, 143).
   try {
-    return command_line.run(tuning::makeBuiltinAdapters(), &g_stop, livePlot);
-  } catch (const core::Error& e) {
+    const int status = command_line.run(tuning::makeBuiltinAdapters(), &g_stop, livePlot);
+    if (const int sig = g_signal.load(); sig != 0 && status == 130) return 128 + sig;
+    return status;
+  } catch (const core::InvalidInput& e) {
     std::fprintf(stderr, "viewline_tune: error: %s\n", e.what());
     return 2;
   } catch (const std::exception& e) {

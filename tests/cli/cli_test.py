@@ -62,14 +62,12 @@ def table():
                                                "--oracle-corners", "--particles"]
     t["viewline_demo"] = dict(file=None, outputs=[], wrong_type=["--runs", "abc"], contradictory=None, valid=["--runs", "1"])
     # viewline_tune documents bad input in a file (a sweep's key, a scenario's value) as a usage error: exit 2.
-    # viewline_tune documents bad input in a file (a sweep's key, a scenario's value) as a usage error: exit 2.
-    # Its `run` accepts --headless with --display (no contradictory pair is refused): not tested here.
     t["viewline_tune"] = dict(
         prefix=["run"],
         file=("--config", ["--scenario", "dart", "--quiet"]),
         outputs=["--out", "{out}/tune"],
         wrong_type=["--scenario", "dart", "--config", "config/dart_tracking.yaml", "--seed", "abc"],
-        contradictory=None,
+        contradictory=["--scenario", "dart", "--config", "config/dart_tracking.yaml", "--headless", "--display"],
         status={"empty_file": 2, "binary_file": 2},
         valid=["--scenario", "dart", "--config", "config/dart_tracking.yaml"],
     )

@@ -129,7 +129,7 @@ void saveVispCameraXml(const std::string& path, const std::string& camera_name,
   writeVispCameraXmlTo(tmp, camera_name, without_distortion, with_distortion, width, height, additional_info);
   std::error_code ec;
   fs::rename(tmp, fs::path(tmp).replace_extension().string(), ec);
-  if (ec) throw core::InvalidInput(path + ": cannot write: " + ec.message());
+  if (ec) throwFileError(path + ": cannot write", ec.value());
   out.commit();
 }
 

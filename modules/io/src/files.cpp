@@ -45,6 +45,16 @@ const char* signalName(int sig) {
 
 }  // namespace
 
+void throwFileError(const std::string& what, int err) {
+  const std::string msg = what + ": " + errnoText(err);
+  switch (err) {
+    case ENOSPC: case EDQUOT: case EFBIG: case EIO: case EROFS:
+      throw core::IoError(msg);
+    default:
+      throw core::InvalidInput(msg);
+  }
+}
+
 std::string temporaryPathFor(const std::string& path) {
   static std::atomic<unsigned> counter{0};
   const fs::path p(path);
@@ -58,7 +68,7 @@ void writeAllOrThrow(int fd, const char* data, std::size_t size, const std::stri
     const ssize_t n = ::write(fd, data, size);
     if (n < 0) {
       if (errno == EINTR) continue;  // a signal arrived mid-write: the write itself goes on
-      throw core::InvalidInput(path + ": cannot write: " + errnoText(errno));
+      throwFileError(path + ": cannot write", errno);
     }
     data += n;
     size -= static_cast<std::size_t>(n);
@@ -69,17 +79,17 @@ void writeTextFileAtomic(const std::string& path, const std::string& content) {
   StagedFiles out;
   const std::string tmp = out.stage(path);
   const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
-  if (fd < 0) throw core::InvalidInput(path + ": cannot open for writing: " + errnoText(errno));
+  if (fd < 0) throwFileError(path + ": cannot open for writing", errno);
   try {
     writeAllOrThrow(fd, content.data(), content.size(), path);
     // fsync before the rename: after a power cut the target holds the old or the new content,
     // never a renamed but empty file (ext4's delayed allocation).
-    if (::fsync(fd) != 0 && errno != EINVAL) throw core::InvalidInput(path + ": cannot write: " + errnoText(errno));
+    if (::fsync(fd) != 0 && errno != EINVAL) throwFileError(path + ": cannot write", errno);
   } catch (...) {
     ::close(fd);
     throw;  // `out` removes the temporary; the target is untouched
   }
-  if (::close(fd) != 0) throw core::InvalidInput(path + ": cannot write: " + errnoText(errno));
+  if (::close(fd) != 0) throwFileError(path + ": cannot write", errno);
   out.commit();
 }
 
@@ -139,7 +149,7 @@ void StagedFiles::commit() {
     if (ec) {
       const std::string target = f.second;  // (as above)
       discard();
-      throw core::InvalidInput(target + ": cannot rename the temporary file onto it: " + ec.message());
+      throwFileError(target + ": cannot rename the temporary file onto it", ec.value());
     }
   }
   files_.clear();

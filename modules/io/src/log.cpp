@@ -38,7 +38,7 @@ CsvWriter::CsvWriter(const std::string& path, std::vector<std::string> header, i
   tmp_ = temporaryPathFor(path);
   fd_ = ::open(tmp_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd_ < 0)
-    throw core::InvalidInput(path + ": cannot open the CSV log for writing: " + std::strerror(errno));
+    throwFileError(path + ": cannot open the CSV log for writing", errno);
   std::string line;
   for (std::size_t i = 0; i < header_.size(); ++i) line += (i ? "," : "") + quote(header_[i]);
   append(line);
@@ -122,7 +122,7 @@ void CsvWriter::flush() {
     // The open descriptor follows the rename: later rows are appended to the published file.
     std::error_code ec;
     std::filesystem::rename(tmp_, path_, ec);
-    if (ec) throw core::InvalidInput(path_ + ": cannot rename the temporary CSV log onto it: " + ec.message());
+    if (ec) throwFileError(path_ + ": cannot rename the temporary CSV log onto it", ec.value());
     tmp_.clear();
   }
 }
@@ -132,7 +132,7 @@ void CsvWriter::close() {
   flush();
   const int fd = fd_;
   fd_ = -1;
-  if (::close(fd) != 0) throw core::InvalidInput(path_ + ": cannot write: " + std::strerror(errno));
+  if (::close(fd) != 0) throwFileError(path_ + ": cannot write", errno);
 }
 
 LogDirectory::LogDirectory(const std::string& dir) : dir_(dir) {

@@ -51,8 +51,9 @@ TuneCommandLine::TuneCommandLine(CLI::App& app) {
   run_->add_option("--out", ro.out_dir, "output folder");
   run_->add_option("--log", ro.log_dir, "CSV logs of the run (measurements, estimates, innovations and S)");
   run_->add_option("--option", run_adapter_options_, "adapter option name=value (viewline_tune list)");
-  run_->add_flag("--display", ro.display, "live curves (vpPlot) and the scenario's camera view, when an X display exists");
-  run_->add_flag("--headless", "no display (the default)");
+  auto* display = run_->add_flag("--display", ro.display,
+                                 "live curves (vpPlot) and the scenario's camera view, when an X display exists");
+  run_->add_flag("--headless", "no display (the default)")->excludes(display);
   run_->add_flag("--quiet", quiet_, "no progress output");
 
   autotune_ = app.add_subcommand("autotune", "estimate process and measurement noise from a log or a live run");

@@ -21,6 +21,13 @@ public:
   using Error::Error;
 };
 
+/// The system refused an operation on valid input: a full disk, a file size limit, an I/O error,
+/// a read-only file system. Apps report it as a runtime error (exit 1), not a usage error.
+class IoError : public Error {
+public:
+  using Error::Error;
+};
+
 /// A numerical failure that good input can still cause (e.g. a Riccati
 /// iteration that does not converge).
 class NumericalError : public Error {

@@ -28,7 +28,12 @@ nlohmann::json readJsonFile(const std::string& path);
 /// A fresh name for a temporary file next to `path` (same folder, so a rename onto `path` is atomic):
 /// ".<name>.tmp<pid>_<n>", hidden, unique within the process.
 std::string temporaryPathFor(const std::string& path);
-/// write(2) of all `size` bytes to `fd` (retried after EINTR); throws core::InvalidInput naming
+/// Throws the error for a failed file operation with errno `err`, the message `what: <cause>`:
+/// core::IoError when the system refused (ENOSPC/EDQUOT "the disk is full", EFBIG, EIO, EROFS),
+/// core::InvalidInput when the path cannot be used as given (missing folder, not a folder,
+/// permission).
+[[noreturn]] void throwFileError(const std::string& what, int err);
+/// write(2) of all `size` bytes to `fd` (retried after EINTR); throws (throwFileError) naming
 /// `path` and the cause (disk full, file size limit...) when the system refuses.
 void writeAllOrThrow(int fd, const char* data, std::size_t size, const std::string& path);
 
