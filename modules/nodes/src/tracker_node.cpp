@@ -116,14 +116,20 @@ nlohmann::json runTrackerNode(const scenarios::BallCatchingConfig& cfg, const No
       publishTrack();
       planner.update(std::max(clock.now(), stamp), tracker.state());
     });
+    // A writer that lost its liveliness (process killed, hung, cut off) turns "not alive"; one
+    // deleted cleanly (its node ended) is unmatched instead, so only the first is a camera lost.
     const dds::LivelinessStatus live = det_r.liveliness();
     if (live.alive_change < 0) {
       const auto it = writer_camera.find(live.last_writer);
-      const std::string who = it != writer_camera.end() ? cam[it->second].name : "a camera";
+      const std::string who = it != writer_camera.end() ? cam[it->second].name : "unknown";
       if (it != writer_camera.end()) cam[it->second].alive = false;
-      ctx.log("camera %s left (liveliness lost, lease %.1f s) at t = %.3f s; going on with %d cameras", who.c_str(),
-              dds::Qos::kCameraLeaseS, clock.now(), live.alive);
-      left.push_back({{"camera", who}, {"t", clock.now()}, {"wall_s", ctx.wallSeconds()}, {"alive", live.alive}});
+      if (live.not_alive_change > 0) {
+        ctx.log("camera %s left (liveliness lost, lease %.1f s) at t = %.3f s; going on with %d cameras", who.c_str(),
+                dds::Qos::kCameraLeaseS, clock.now(), live.alive);
+        left.push_back({{"camera", who}, {"t", clock.now()}, {"wall_s", ctx.wallSeconds()}, {"alive", live.alive}});
+      } else {
+        ctx.log("camera %s closed its writer at t = %.3f s", who.c_str(), clock.now());
+      }
     }
     // Set points every control period of simulated time, up to the newest tick.
     while (clock.started() && next_control <= clock.latest()) {
@@ -153,10 +159,12 @@ nlohmann::json runTrackerNode(const scenarios::BallCatchingConfig& cfg, const No
   j["rig_hash"] = detail::hex(ctx.rig_hash);
   j["initialised"] = tracker.initialised();
   const estimation::StateEstimate& s = tracker.state();
-  j["t"] = s.t();
-  j["x"] = std::vector<double>(s.x().data(), s.x().data() + 6);
-  const Eigen::Matrix<double, 6, 6> P = s.P().topLeftCorner<6, 6>();
-  j["P"] = std::vector<double>(P.data(), P.data() + 36);  // column-major = row-major (symmetric)
+  if (s.x().size() >= 6) {  // empty before the first track
+    j["t"] = s.t();
+    j["x"] = std::vector<double>(s.x().data(), s.x().data() + 6);
+    const Eigen::Matrix<double, 6, 6> P = s.P().topLeftCorner<6, 6>();
+    j["P"] = std::vector<double>(P.data(), P.data() + 36);  // column-major = row-major (symmetric)
+  }
   j["fused_in_track"] = tracker.trackState().fused_in_track;
   j["tracks_started"] = tracker.trackState().tracks_started;
   j["track_messages"] = track_msgs;

@@ -167,6 +167,7 @@ struct LivelinessStatus {
   int alive = 0;          ///< writers alive now
   int not_alive = 0;      ///< writers matched but not alive
   int alive_change = 0;   ///< change of `alive` since the last query
+  int not_alive_change = 0;  ///< change of `not_alive` since the last query (> 0: a lease expired)
   dds_instance_handle_t last_writer = 0;  ///< the writer whose change was last
 };
 
@@ -214,7 +215,8 @@ public:
     dds_liveliness_changed_status_t s;
     check(dds_get_liveliness_changed_status(handle(), &s), "dds_get_liveliness_changed_status " + topic_);
     return {static_cast<int>(s.alive_count), static_cast<int>(s.not_alive_count),
-            static_cast<int>(s.alive_count_change), s.last_publication_handle};
+            static_cast<int>(s.alive_count_change), static_cast<int>(s.not_alive_count_change),
+            s.last_publication_handle};
   }
 
 private:
