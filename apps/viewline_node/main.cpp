@@ -39,6 +39,7 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   cli.add_option("--pixel-sigma", opt.pixel_sigma, "camera: pixel noise std, px")->capture_default_str();
   cli.add_option("--clock-offset", opt.clock_offset_s, "camera: error of its clock, s")->capture_default_str();
+  cli.add_flag("--render", opt.render, "camera: render the images and run the ball detector (default: generator)");
   cli.add_option("--deadline", opt.setpoint_deadline_s, "set-point deadline, s (robot halts past it)")
       ->capture_default_str()->check(CLI::PositiveNumber);
   cli.add_option("--max-wall", opt.max_wall_s, "end after this much wall time, s")->capture_default_str();

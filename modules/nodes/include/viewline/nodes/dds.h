@@ -61,6 +61,7 @@ class Qos {
 public:
   /// An empty QoS (Cyclone's defaults for every policy).
   Qos();
+  /// Frees the policy set.
   ~Qos();
   /// Copies every policy.
   Qos(const Qos& other);
@@ -102,8 +103,11 @@ class Entity {
 public:
   /// Takes ownership of handle h (> 0).
   explicit Entity(dds_entity_t h = 0) : h_(h) {}
+  /// Deletes the entity (and its children) in Cyclone.
   ~Entity();
+  /// Not copyable: one owner per handle.
   Entity(const Entity&) = delete;
+  /// Not copyable: one owner per handle.
   Entity& operator=(const Entity&) = delete;
   /// Takes the other's handle.
   Entity(Entity&& o) noexcept : h_(std::exchange(o.h_, 0)) {}

@@ -4,8 +4,10 @@
 //   world    simulated time on rt/clock (ticks of tick_s, paced at `realtime` x wall clock) and
 //            the true ball on rt/viewline/truth; waits until `expect` nodes follow its clock, runs
 //            `duration_s` of simulated time, then publishes Finished in its health (every node ends)
-//   camera   a free-running camera (nodes::DetectionGenerator over the world's truth) publishing
-//            rt/viewline/detections; its writer asserts liveliness (lease dds::Qos::kCameraLeaseS)
+//   camera   a free-running camera over the world's truth publishing rt/viewline/detections: the
+//            generator's noisy projection (nodes::DetectionGenerator), or (render) the image
+//            rendered by the simulator and the scenario's ball detector; its writer asserts
+//            liveliness (lease dds::Qos::kCameraLeaseS)
 //   tracker  viewline's multi-view tracker and the catch planner, built from the scenario config
 //            as the ball-catching loop builds them; publishes rt/viewline/track and, every control
 //            period of simulated time, rt/viewline/setpoint; reports each camera's delivery delay
@@ -42,6 +44,10 @@ struct NodeOptions {
   int expect = 0;                ///< world: nodes that must follow the clock before it starts
   double pixel_sigma = 0.5;      ///< camera: pixel noise std, px
   double clock_offset_s = 0.0;   ///< camera: error of its clock (added to its capture stamps), s
+  /// camera: render each frame (the scenario's room, the box at home, the ball at the world's
+  /// truth; sensor noise noise_sigma) and run the scenario's ball detector on it, instead of the
+  /// generator's noisy projection
+  bool render = false;
   double setpoint_deadline_s = 0.1;  ///< set-point deadline, s of wall time (robot halts past it)
   double max_wall_s = 60.0;      ///< any node ends after this much wall time, s
   std::string summary_path;      ///< JSON summary written here at the end ("" : none)
