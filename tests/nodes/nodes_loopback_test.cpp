@@ -13,6 +13,7 @@
 
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -41,7 +42,7 @@ double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock:
 class Nodes {
 public:
   explicit Nodes(std::string tag) : dir_("/tmp/viewline_nodes_" + tag + "_" + std::to_string(getpid())) {
-    std::system(("mkdir -p " + dir_).c_str());
+    if (std::system(("mkdir -p " + dir_).c_str()) != 0) ADD_FAILURE() << "cannot make " << dir_;
   }
   ~Nodes() {
     for (auto& [name, pid] : pids_) {
@@ -49,6 +50,8 @@ public:
       kill(pid, SIGKILL);
       waitpid(pid, nullptr, 0);
     }
+    // The logs stay for a failed test (its messages name them), go otherwise.
+    if (!::testing::Test::HasFailure()) std::system(("rm -rf " + dir_).c_str());
   }
   std::string path(const std::string& file) const { return dir_ + "/" + file; }
 
@@ -124,7 +127,9 @@ private:
 
 class NodesLoopback : public ::testing::Test {
 protected:
-  static void SetUpTestSuite() { nodes::test::useLoopback(); }
+  static void SetUpTestSuite() { xml_ = nodes::test::useLoopback(); }
+  static void TearDownTestSuite() { std::remove(xml_.c_str()); }
+  static inline std::string xml_;
 };
 
 }  // namespace
@@ -196,7 +201,7 @@ TEST_F(NodesLoopback, RobotHaltsWithinItsDeadlineWhenTheTrackerIsKilled) {
   n.start("tracker", n.args("tracker", "tracker", domain));
   n.start("robot", n.args("robot", "robot", domain, {"--deadline", "0.1"}));
   n.start("camera0", n.args("camera", "camera0", domain, {"--camera", "0"}));
-  n.start("world", n.args("world", "world", domain, {"--expect", "3", "--duration", "2.0"}));
+  n.start("world", n.args("world", "world", domain, {"--expect", "3", "--duration", "1.5"}));
   ASSERT_TRUE(n.waitForLog("world", "nodes follow the clock", 20.0)) << n.log("world");
   std::this_thread::sleep_for(std::chrono::milliseconds(600));
   n.killNode("tracker");
@@ -218,7 +223,7 @@ TEST_F(NodesLoopback, TrackerNotesACameraLeavingWithinTheLeaseAndGoesOn) {
   n.start("tracker", n.args("tracker", "tracker", domain));
   n.start("camera0", n.args("camera", "camera0", domain, {"--camera", "0"}));
   n.start("camera1", n.args("camera", "camera1", domain, {"--camera", "1"}));
-  n.start("world", n.args("world", "world", domain, {"--expect", "3", "--duration", "2.0"}));
+  n.start("world", n.args("world", "world", domain, {"--expect", "3", "--duration", "1.5"}));
   ASSERT_TRUE(n.waitForLog("world", "nodes follow the clock", 20.0)) << n.log("world");
   std::this_thread::sleep_for(std::chrono::milliseconds(400));
   const double t_kill = since(t_tracker);
@@ -237,7 +242,7 @@ TEST_F(NodesLoopback, TrackerNotesACameraLeavingWithinTheLeaseAndGoesOn) {
   // And it went on: camera 0's frames after the kill reached it.
   const auto frames0 = n.summary("camera0").at("frames").get<std::uint64_t>();
   EXPECT_GE(tr.at("cameras").at(0).at("received").get<std::uint64_t>(), frames0 * 95 / 100);
-  EXPECT_GE(frames0, 95u);  // 2 s at 50 Hz
+  EXPECT_GE(frames0, 70u);  // 1.5 s at 50 Hz
 }
 
 TEST_F(NodesLoopback, ACameraWithAnotherRigIsRefused) {

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cstdio>
 #include <thread>
 
 #include "loopback.h"
@@ -14,7 +15,9 @@ namespace {
 
 class DdsTest : public ::testing::Test {
 protected:
-  static void SetUpTestSuite() { test::useLoopback(); }
+  static void SetUpTestSuite() { xml_ = test::useLoopback(); }
+  static void TearDownTestSuite() { std::remove(xml_.c_str()); }
+  static inline std::string xml_;
 };
 
 // Waits until the writer has matched the reader (discovery is asynchronous).
