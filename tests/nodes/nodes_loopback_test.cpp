@@ -153,7 +153,8 @@ TEST_F(NodesLoopback, TrackOfTwoCameraNodesMatchesTheInProcessTrack) {
     EXPECT_GE(frames, 70u);                        // 1.5 s at 50 Hz
     EXPECT_GE(received, frames * 95 / 100) << c;  // best effort on loopback: nearly all
     EXPECT_LE(received, frames) << c;
-    EXPECT_GE(tr.at("cameras").at(c).at("delay_p50_s").get<double>(), 0.0);
+    // Clocks in step: −min(delay) is minus the smallest transport delay (loopback: well under 1 ms).
+    EXPECT_NEAR(tr.at("cameras").at(c).at("apparent_clock_offset_s").get<double>(), 0.0, 1e-3) << c;
   }
 
   // The same simulation in one process: every frame of both generators, in capture order, into
@@ -221,7 +222,8 @@ TEST_F(NodesLoopback, TrackerNotesACameraLeavingWithinTheLeaseAndGoesOn) {
   Nodes n("leave");
   const auto t_tracker = Clock::now();
   n.start("tracker", n.args("tracker", "tracker", domain));
-  n.start("camera0", n.args("camera", "camera0", domain, {"--camera", "0"}));
+  // Camera 0's clock runs 4 ms ahead of the time base: the tracker sees it as its apparent offset.
+  n.start("camera0", n.args("camera", "camera0", domain, {"--camera", "0", "--clock-offset", "0.004"}));
   n.start("camera1", n.args("camera", "camera1", domain, {"--camera", "1"}));
   n.start("world", n.args("world", "world", domain, {"--expect", "3", "--duration", "1.5"}));
   ASSERT_TRUE(n.waitForLog("world", "nodes follow the clock", 20.0)) << n.log("world");
@@ -243,6 +245,8 @@ TEST_F(NodesLoopback, TrackerNotesACameraLeavingWithinTheLeaseAndGoesOn) {
   const auto frames0 = n.summary("camera0").at("frames").get<std::uint64_t>();
   EXPECT_GE(tr.at("cameras").at(0).at("received").get<std::uint64_t>(), frames0 * 95 / 100);
   EXPECT_GE(frames0, 70u);  // 1.5 s at 50 Hz
+  // −min(delay) = offset − the smallest transport delay (loopback: well under 1 ms).
+  EXPECT_NEAR(tr.at("cameras").at(0).at("apparent_clock_offset_s").get<double>(), 0.004, 1e-3);
 }
 
 TEST_F(NodesLoopback, ACameraWithAnotherRigIsRefused) {

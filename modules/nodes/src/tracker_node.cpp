@@ -175,8 +175,11 @@ nlohmann::json runTrackerNode(const scenarios::BallCatchingConfig& cfg, const No
   nlohmann::json cj = nlohmann::json::array();
   for (const CameraDelivery& cd : cam) {
     const std::uint64_t span = cd.any ? cd.last_frame - cd.first_frame + 1 : 0;
-    double offset = 0.0;  // apparent clock offset: the lower envelope of the delays (NTP's minimum filter)
-    if (!cd.delays.empty()) offset = *std::min_element(cd.delays.begin(), cd.delays.end());
+    // Apparent clock offset, the minimum filter of NTP: delay = transport − offset for a camera
+    // whose clock runs `offset` ahead of the time base, so −min(delay) = offset − the smallest
+    // transport delay (a slight underestimate of the offset).
+    double offset = 0.0;
+    if (!cd.delays.empty()) offset = -*std::min_element(cd.delays.begin(), cd.delays.end());
     cj.push_back({{"name", cd.name},
                   {"received", cd.received},
                   {"detected", cd.detected},
