@@ -24,7 +24,9 @@ int main(int argc, char** argv) {
   nodes::NodeOptions opt;
   cli.add_option("role", role, "world | camera | tracker | robot")->required()->check(
       CLI::IsMember({"world", "camera", "tracker", "robot"}));
-  cli.add_option("--config", config_path, "scenario YAML (the ball-catching scenario's keys)")->capture_default_str();
+  cli.add_option("--config", config_path, "scenario YAML (the ball-catching scenario's keys)")
+      ->capture_default_str()
+      ->check(CLI::ExistingFile);
   cli.add_option("--set", sets, "KEY=VALUE edits of the config (repeatable)");
   cli.add_option("--camera", opt.camera, "camera role: index of the camera in the config")->capture_default_str();
   cli.add_option("--seed", opt.seed, "seed of the throw, camera phases and pixel noise")->capture_default_str();
