@@ -39,6 +39,6 @@ set(CPACK_GENERATOR DEB)
 set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)
 set(CPACK_DEBIAN_PACKAGE_SECTION science)
 set(CPACK_DEBIAN_PACKAGE_DEPENDS
-  "libvisp-dev (>= 3.5), libopencv-dev (>= 4.6), libopencv-contrib-dev, libeigen3-dev, libboost-dev, libyaml-cpp-dev, nlohmann-json3-dev, libcli11-dev, libapriltag-dev, gnuplot-nox")
+  "libvisp-dev (>= 3.5), libopencv-dev (>= 4.6), libopencv-contrib-dev, libeigen3-dev, libboost-dev, libyaml-cpp-dev, nlohmann-json3-dev, libcli11-dev, libapriltag-dev, gnuplot-nox, cyclonedds-dev (>= 0.10)")
 set(CPACK_PACKAGING_INSTALL_PREFIX /usr)
 include(CPack)
