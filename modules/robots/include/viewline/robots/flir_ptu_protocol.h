@@ -58,7 +58,7 @@ PtuErrorClass classifyPtuError(std::string_view message);
 /// Short name of an error class ("position limit", "illegal command", ...).
 const char* toString(PtuErrorClass error);
 
-/// The line shown in messages: control characters as \xNN, at most 60 characters.
+/// The line shown in messages: control characters as backslash-x and two hex digits, at most 60 characters.
 std::string printableLine(std::string_view line);
 
 /// Seconds of arc per position -> radians per position.

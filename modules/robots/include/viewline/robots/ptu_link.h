@@ -53,8 +53,9 @@ public:
   virtual ~PtuLink() = default;
   /// Writes all bytes before `deadline`; throws PtuLinkError (Timeout, Disconnected, Io).
   virtual void write(std::string_view bytes, Deadline deadline) = 0;
-  /// Next line without its terminator ('\r' dropped); throws PtuLinkError Timeout when no full
-  /// line arrives before `deadline`, Disconnected when the other end closed.
+  /// Next line without its terminator (a carriage return before the line feed dropped); throws
+  /// PtuLinkError Timeout when no full line arrives before `deadline`, Disconnected when the
+  /// other end closed.
   virtual std::string readLine(Deadline deadline) = 0;
   /// Discards every byte already received (stale replies), without waiting.
   virtual void drain() = 0;
