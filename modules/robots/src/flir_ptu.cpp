@@ -212,7 +212,7 @@ JointState FlirPtu::read(core::Timestamp t) {
     }
   }
   JointState s;
-  s.t = t + 0.5 * last_round_trip_;
+  s.t = t;
   s.q = Eigen::Vector2d(static_cast<double>(*r[0].integer) * resolution_(0), static_cast<double>(*r[1].integer) * resolution_(1));
   s.qdot = Eigen::Vector2d(static_cast<double>(*r[2].integer) * resolution_(0), static_cast<double>(*r[3].integer) * resolution_(1));
   return s;

@@ -439,15 +439,17 @@ void FlirPtuEmulator::run() {
       for (const auto& c : clients_) fds.push_back({c.fd, POLLIN, 0});
       if (listen_fd_ >= 0) fds.push_back({listen_fd_, POLLIN, 0});
     }
-    int timeout_ms = std::max(1, static_cast<int>(std::lround(params_.tick * 1000.0)));
+    // ppoll: the next reply may be due in a fraction of a millisecond (one byte at 115200 baud
+    // is 87 µs); poll's millisecond time-out would round every exchange up.
+    double wait = params_.tick;
     {
       std::lock_guard<std::mutex> lock(mutex_);
-      if (!outbox_.empty()) {
-        const double wait = std::max(0.0, outbox_.front().due - now());
-        timeout_ms = std::min(timeout_ms, static_cast<int>(std::ceil(wait * 1000.0)));
-      }
+      if (!outbox_.empty()) wait = std::clamp(outbox_.front().due - now(), 0.0, wait);
     }
-    const int ready = ::poll(fds.data(), static_cast<nfds_t>(fds.size()), timeout_ms);
+    timespec timeout{};
+    timeout.tv_sec = static_cast<time_t>(wait);
+    timeout.tv_nsec = static_cast<long>((wait - static_cast<double>(timeout.tv_sec)) * 1e9);
+    const int ready = ::ppoll(fds.data(), static_cast<nfds_t>(fds.size()), &timeout, nullptr);
     {
       std::lock_guard<std::mutex> lock(mutex_);
       advance(now());

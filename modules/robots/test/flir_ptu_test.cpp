@@ -255,13 +255,15 @@ TEST(FlirPtu, VelocityCommandMovesTheUnitAndReadsBack) {
   const auto t0 = Clock::now();
   ptu.commandVelocity(0.0, qdot);
   sleepSeconds(0.4);
-  const JointState s = ptu.read(secondsSince(t0));
+  const double t_read = secondsSince(t0);
+  const JointState s = ptu.read(t_read);
+  EXPECT_EQ(s.t, t_read);
   const Eigen::Vector2d res = ptu.resolution();
   // At speed (the ramp takes 0.5/20.9 = 24 ms), speeds read back to the position.
   EXPECT_NEAR(s.qdot(0), qdot(0), res(0));
   EXPECT_NEAR(s.qdot(1), qdot(1), res(1));
   // Travelled about qdot × elapsed (less the ramp), read back within the exchange's time.
-  const double elapsed = s.t;
+  const double elapsed = s.t + ptu.lastRoundTrip();
   EXPECT_NEAR(s.q(0), qdot(0) * elapsed, 0.5 * 0.05 + 2 * res(0));
   EXPECT_NEAR(s.q(1), qdot(1) * elapsed, 0.25 * 0.05 + 2 * res(1));
   const JointState truth = rig.emu.state();

@@ -90,8 +90,9 @@ public:
   /// Pure velocity command (switches to CV first when in position mode): PSn TSm in
   /// positions/s, rounded, clipped to the speed bounds. `t` must not go backwards.
   void commandVelocity(core::Timestamp t, const Eigen::Vector2d& qdot) override;
-  /// Queries PP TP PD TD (positions and current speeds); the state is stamped t plus half the
-  /// exchange's round trip (when the unit sampled it, on the caller's clock).
+  /// Queries PP TP PD TD (positions and current speeds). The state is stamped t, the request's
+  /// time on the caller's clock (as PanTiltUnit::read promises "now"); the unit sampled it up to
+  /// lastRoundTrip() later, which is the protocol's share of the measurement latency.
   JointState read(core::Timestamp t) override;
   /// Halt (H): both axes decelerate to rest.
   void stop(core::Timestamp t) override;
