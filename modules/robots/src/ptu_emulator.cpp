@@ -240,6 +240,12 @@ void FlirPtuEmulator::advance(double t) {
   }
 }
 
+bool FlirPtuEmulator::moving() const {
+  // A position move is over when both axes rest at their targets (within half a position).
+  return !velocity_mode_ && ((target_steps_.cwiseProduct(res_) - state_.q).cwiseAbs().maxCoeff() > 0.5 * res_.maxCoeff() ||
+                             state_.qdot.cwiseAbs().maxCoeff() > 0.0);
+}
+
 std::string FlirPtuEmulator::process(std::string_view token, double t) {
   advance(t);
   ++commands_;
@@ -357,9 +363,7 @@ std::string FlirPtuEmulator::process(std::string_view token, double t) {
     return ok();
   }
   if (cmd == "A" && !arg) {
-    const bool moving = !velocity_mode_ && ((target_steps_.cwiseProduct(res_) - state_.q).cwiseAbs().maxCoeff() > 0.5 * res_.maxCoeff() ||
-                                            state_.qdot.cwiseAbs().maxCoeff() > 0.0);
-    if (moving) {
+    if (moving()) {
       awaiting_ = true;
       return {};
     }
@@ -458,16 +462,12 @@ void FlirPtuEmulator::run() {
     // A deferred A (await) is answered once the move has ended.
     {
       std::unique_lock<std::mutex> lock(mutex_);
-      if (awaiting_) {
-        const std::string r = process("A", now());
-        if (!r.empty()) {
-          awaiting_ = false;
-          --commands_;  // the same A, answered now
-          const int fd = await_fd_;
-          lock.unlock();
-          for (auto& c : clients_) {
-            if (c.fd == fd) sendReply(c, "A", r);
-          }
+      if (awaiting_ && !moving()) {
+        awaiting_ = false;
+        const int fd = await_fd_;
+        lock.unlock();
+        for (auto& c : clients_) {
+          if (c.fd == fd) sendReply(c, "A", "*");
         }
       }
     }

@@ -111,6 +111,7 @@ private:
   void serveBytes(Client& c, const char* data, std::size_t n);
   void sendReply(Client& c, const std::string& command, const std::string& reply);
   void command(double t, const Eigen::Vector2d& qdot);
+  bool moving() const;
   void closeAll();
 
   PtuEmulatorParams params_;
