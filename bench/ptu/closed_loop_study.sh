@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # The pan-tilt loop on the simulated unit and on the emulated FLIR PTU (TCP, pty at 115200 and 9600
 # baud emulated), same config and seeds: circle path, 15 frames/s, ours only, metrics after 2 s.
+# The emulated drive gets the simulated unit's 30 ms command latency (--drive-latency), so that
+# what differs is the protocol (its exchanges) and the wall clock (the run is paced to it).
 # Prints one line per run and the mean and standard deviation of the image error per mode.
 #
 #   bench/ptu/closed_loop_study.sh [SEEDS] [DURATION_S]     (default 5 seeds, 10 s; run from the repository root)
@@ -18,7 +20,7 @@ common=(--config config/pan_tilt_circle.yaml --headless --quiet --no-baseline --
 
 start_emulator() {  # start_emulator ARGS...: serves until killed
   rm -f "$work/endpoints"
-  "$bin/viewline_ptu_emulator" "$@" --endpoints "$work/endpoints" >"$work/emulator.out" 2>&1 &
+  "$bin/viewline_ptu_emulator" "$@" --drive-latency 0.03 --endpoints "$work/endpoints" >"$work/emulator.out" 2>&1 &
   emu_pid=$!
   for _ in $(seq 100); do [ -f "$work/endpoints" ] && return 0; sleep 0.05; done
   echo "the emulator did not start" >&2; exit 1
