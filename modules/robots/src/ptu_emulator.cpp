@@ -223,9 +223,12 @@ void FlirPtuEmulator::advance(double t) {
         }
         c(i) = std::copysign(std::min(speed_steps_(i) * res_(i), std::sqrt(2.0 * a * std::abs(e))), e);
       }
-      command(state_.t, c);
+      // The unit's own position loop acts at once: the drive latency is that of host commands.
+      recent_.assign(1, IssuedCommand{state_.t, c});
+      state_ = predictJointState(l, state_, recent_, 0.0, state_.t + h);
+    } else {
+      state_ = predictJointState(l, state_, recent_, params_.drive_latency, state_.t + h);
     }
-    state_ = predictJointState(l, state_, recent_, params_.drive_latency, state_.t + h);
     for (int i = 0; i < 2; ++i) {  // hard stops
       if ((state_.q(i) >= l.q_max(i) && state_.qdot(i) > 0.0) || (state_.q(i) <= l.q_min(i) && state_.qdot(i) < 0.0)) {
         state_.qdot(i) = 0.0;

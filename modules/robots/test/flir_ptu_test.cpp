@@ -140,6 +140,26 @@ TEST(FlirPtuEmulator, ProtocolRepliesAndPositionMove) {
   EXPECT_EQ(emu.process("PP0", 2.0).substr(0, 17), "! Illegal command");
 }
 
+TEST(FlirPtuEmulator, PositionMoveSettlesWithADriveLatency) {
+  // The latency delays host commands, not the unit's own position loop: a move still ends.
+  PtuEmulatorParams p;
+  p.drive_latency = 0.03;
+  FlirPtuEmulator emu(p);
+  emu.process("FT", 0.0);
+  EXPECT_EQ(emu.process("PP-700", 0.0), "*");
+  EXPECT_EQ(emu.process("A", 0.0), "");
+  emu.advance(3.0);
+  EXPECT_EQ(emu.process("PP", 3.0), "* -700");
+  EXPECT_EQ(emu.process("A", 3.0), "*");
+  // In velocity mode the command acts after the latency.
+  emu.process("CV", 3.0);
+  emu.process("PS1000", 3.0);
+  emu.advance(3.025);
+  EXPECT_EQ(emu.state().qdot(0), 0.0);
+  emu.advance(3.2);
+  EXPECT_NEAR(emu.state().qdot(0), 1000 * emu.resolution()(0), 1e-9);
+}
+
 TEST(FlirPtuEmulator, VelocityModeStopsAtTheHardLimit) {
   PtuEmulatorParams p;
   FlirPtuEmulator emu(p);
