@@ -63,7 +63,7 @@ Eigen::VectorXd vec(const Vector2d& v) { return Eigen::VectorXd(v); }
 PanTiltRunMetrics runPanTilt(const PanTiltScenarioConfig& cfg, std::uint64_t seed, PanTiltControllerKind kind,
                              const PanTiltRunIo& io) {
   cfg.validate();
-  const auto wall0 = std::chrono::steady_clock::now();
+  auto wall0 = std::chrono::steady_clock::now();
   // A FLIR PTU (or its emulator) replaces the simulated unit: the camera rides on it, the laws
   // drive it, and the run is paced to the wall clock, the unit's time.
   std::unique_ptr<robots::FlirPtu> hardware;
@@ -74,6 +74,7 @@ PanTiltRunMetrics runPanTilt(const PanTiltScenarioConfig& cfg, std::uint64_t see
   if (hardware) {  // the simulated unit's start: pointing at the path's start plus the offset
     hardware->moveTo(world.unit().params().q0.cwiseMax(limits.q_min).cwiseMin(limits.q_max), 0.5 * limits.qdot_max);
     hardware->await(10.0);
+    wall0 = std::chrono::steady_clock::now();  // the time per frame is the loop's, as on the simulated unit
   }
   const double latency = unit.commandLatency();  // the unit owns its latency; the laws ask it
   const robots::PanTiltKinematics& kin_model = world.modelKinematics();
