@@ -6,6 +6,7 @@
 //   viewline_ptu_emulator --pty --tcp 4000             # both; prints "pty: /dev/pts/N", "tcp: 127.0.0.1:4000"
 //   viewline_ptu_emulator --tcp 0 --endpoints FILE     # any free port, written to FILE when ready
 //   viewline_ptu_emulator --pty --baud 9600 --fault slow --reply-delay 0.2
+//   viewline_ptu_emulator --tcp 0 --fault no_reply --fault-after 2   # behaves for 2 s, then stops answering
 #include <CLI/CLI.hpp>
 #include <chrono>
 #include <cstdio>
@@ -26,12 +27,14 @@ int main(int argc, char** argv) {
   int tcp = -1;
   int baud = 0;
   std::string fault = "none";
-  double reply_delay = 0.0, drive_latency = 0.0, duration = 0.0;
+  double reply_delay = 0.0, drive_latency = 0.0, duration = 0.0, fault_after = 0.0;
   std::string endpoints;
   cli.add_flag("--pty", pty, "serve on a pseudo-terminal (its path is printed: pass it as the serial port)");
   cli.add_option("--tcp", tcp, "serve on 127.0.0.1:PORT (0: any free port; the port is printed)")->check(CLI::Range(0, 65535));
   cli.add_option("--baud", baud, "emulated line rate, bit/s (10 bit times per byte in and out; 0: none)")->check(CLI::NonNegativeNumber);
   cli.add_option("--fault", fault, "none, no_reply, garbled, limit_error, disconnect or slow");
+  cli.add_option("--fault-after", fault_after, "s of good behaviour before --fault switches on (0: from the start)")
+      ->check(CLI::NonNegativeNumber);
   cli.add_option("--reply-delay", reply_delay, "s before each reply under --fault slow")->check(CLI::NonNegativeNumber);
   cli.add_option("--drive-latency", drive_latency, "s between a command's arrival and its effect")->check(CLI::NonNegativeNumber);
   cli.add_option("--duration", duration, "s to run (0: until SIGINT/SIGTERM)")->check(CLI::NonNegativeNumber);
@@ -46,7 +49,8 @@ int main(int argc, char** argv) {
     robots::PtuEmulatorParams params;
     params.drive_latency = drive_latency;
     robots::FlirPtuEmulator emu(params);
-    emu.setFault(robots::parsePtuFault(fault));
+    const robots::PtuFault the_fault = robots::parsePtuFault(fault);
+    if (fault_after <= 0.0) emu.setFault(the_fault);
     emu.setReplyDelay(reply_delay);
     emu.setBaud(baud);
     std::string lines;
@@ -61,8 +65,15 @@ int main(int argc, char** argv) {
       std::rename(tmp.c_str(), endpoints.c_str());  // readers never see half a file
     }
     const auto t0 = std::chrono::steady_clock::now();
-    while (!core::interruptRequested() &&
-           (duration <= 0.0 || std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() < duration)) {
+    const auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
+    bool faulty = fault_after <= 0.0;
+    while (!core::interruptRequested() && (duration <= 0.0 || elapsed() < duration)) {
+      if (!faulty && elapsed() >= fault_after) {
+        emu.setFault(the_fault);
+        faulty = true;
+        std::printf("fault %s on after %.1f s\n", fault.c_str(), fault_after);
+        std::fflush(stdout);
+      }
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
     }
     emu.stop();

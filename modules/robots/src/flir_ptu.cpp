@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 
 #include "viewline/core/checks.h"
 
@@ -19,6 +20,12 @@ std::string joined(const std::vector<std::string>& commands) {
     s += c;
   }
   return s;
+}
+
+std::string seconds(double s) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%g s", s);
+  return b;
 }
 
 bool startsWithNoCase(std::string_view s, std::string_view prefix) {
@@ -123,7 +130,7 @@ std::vector<PtuReply> FlirPtu::exchange(const std::vector<std::string>& commands
   } catch (const PtuLinkError& e) {
     const bool timeout = e.kind() == PtuLinkErrorKind::Timeout;
     failAndHalt(FlirPtuError(timeout ? FlirPtuErrorKind::Timeout : FlirPtuErrorKind::Link,
-                             what + (timeout ? "no reply within " + std::to_string(config_.reply_timeout) + " s (" : "") +
+                             what + (timeout ? "no reply within " + seconds(config_.reply_timeout) + " (" : "") +
                                  e.what() + (timeout ? ")" : ""),
                              PtuErrorClass::Other, e.kind()));
   } catch (const PtuProtocolError& e) {
