@@ -107,6 +107,7 @@ std::vector<PtuReply> FlirPtu::exchange(const std::vector<std::string>& commands
   const std::string what = "FLIR PTU on " + link_->port() + ", command '" + joined(commands) + "': ";
   std::vector<PtuReply> replies;
   replies.reserve(commands.size());
+  last_read_.reset();
   const auto t0 = Clock::now();
   try {
     // Stale bytes (a late reply, an asynchronous message) would be taken for this command's
@@ -210,6 +211,7 @@ void FlirPtu::commandVelocity(core::Timestamp t, const Eigen::Vector2d& qdot) {
 }
 
 JointState FlirPtu::read(core::Timestamp t) {
+  if (last_read_ && last_read_->t == t) return *last_read_;
   static const std::vector<std::string> queries{"PP", "TP", "PD", "TD"};
   const std::vector<PtuReply> r = exchange(queries);
   for (std::size_t i = 0; i < r.size(); ++i) {
@@ -222,6 +224,7 @@ JointState FlirPtu::read(core::Timestamp t) {
   s.t = t;
   s.q = Eigen::Vector2d(static_cast<double>(*r[0].integer) * resolution_(0), static_cast<double>(*r[1].integer) * resolution_(1));
   s.qdot = Eigen::Vector2d(static_cast<double>(*r[2].integer) * resolution_(0), static_cast<double>(*r[3].integer) * resolution_(1));
+  last_read_ = s;
   return s;
 }
 

@@ -294,6 +294,26 @@ TEST(FlirPtu, VelocityCommandMovesTheUnitAndReadsBack) {
   EXPECT_GE(rig.emu.haltsReceived(), 1u);
 }
 
+TEST(FlirPtu, ASecondReadAtTheSameTimeCostsNoExchange) {
+  Rig rig;
+  FlirPtu ptu(rig.tcp());
+  ptu.commandVelocity(0.0, Eigen::Vector2d(0.3, 0.0));
+  sleepSeconds(0.05);
+  const std::size_t sent = ptu.commandsSent();
+  const JointState a = ptu.read(1.0);
+  EXPECT_EQ(ptu.commandsSent(), sent + 4);
+  sleepSeconds(0.05);
+  const JointState b = ptu.read(1.0);  // the same sample: the unit is not asked again
+  EXPECT_EQ(ptu.commandsSent(), sent + 4);
+  EXPECT_EQ(a.q, b.q);
+  const JointState c = ptu.read(1.1);  // a new time: a new sample, the unit has moved on
+  EXPECT_EQ(ptu.commandsSent(), sent + 8);
+  EXPECT_GT(c.q(0), a.q(0));
+  ptu.commandVelocity(1.1, Eigen::Vector2d(0.3, 0.0));  // any exchange ends the sample's reuse
+  ptu.read(1.1);
+  EXPECT_EQ(ptu.commandsSent(), sent + 14);
+}
+
 TEST(FlirPtu, PositionModeMoveAndAwait) {
   Rig rig;
   FlirPtu ptu(rig.serial());

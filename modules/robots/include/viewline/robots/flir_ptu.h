@@ -19,6 +19,7 @@
 
 #include <chrono>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -92,7 +93,9 @@ public:
   void commandVelocity(core::Timestamp t, const Eigen::Vector2d& qdot) override;
   /// Queries PP TP PD TD (positions and current speeds). The state is stamped t, the request's
   /// time on the caller's clock (as PanTiltUnit::read promises "now"); the unit sampled it up to
-  /// lastRoundTrip() later, which is the protocol's share of the measurement latency.
+  /// lastRoundTrip() later, which is the protocol's share of the measurement latency. Asked again
+  /// for the same t with no command in between, it returns that sample without an exchange (a
+  /// loop reading the joints at one capture time for several consumers pays the line once).
   JointState read(core::Timestamp t) override;
   /// Halt (H): both axes decelerate to rest.
   void stop(core::Timestamp t) override;
@@ -133,6 +136,7 @@ private:
   double last_round_trip_ = 0.0;
   std::size_t commands_sent_ = 0;
   core::Timestamp last_command_t_ = -1e300;
+  std::optional<JointState> last_read_;  // the last sample, until the next exchange
   std::string model_;
 };
 
