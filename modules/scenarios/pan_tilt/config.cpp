@@ -39,6 +39,7 @@ void PanTiltScenarioConfig::validate() const {
   core::requireNonNegative(noise_fraction, "measurement_noise_fraction");
   unit.limits.validate();
   core::requireNonNegative(unit.latency, "unit.latency");
+  if (hardware_unit) hardware_unit->validate();
   if (!(processing_delay >= 0.5 * exposure)) throw core::InvalidInput("processing_delay must be >= exposure / 2");
   if (!(processing_delay < 1.0 / fps)) throw core::InvalidInput("processing_delay must be shorter than a frame period");
   detector.validate();
@@ -132,6 +133,18 @@ PanTiltScenarioConfig loadPanTiltScenarioConfig(const io::ConfigNode& root) {
     c.initial_offset = Vector2d(core::deg2rad(off(0)), core::deg2rad(off(1)));
   }
   c.processing_delay = root.get<double>("processing_delay");
+  if (root.has("robot")) {
+    const auto r = root.child("robot");
+    if (r.getChoice("kind", {"simulated", "flir_ptu"}) == "flir_ptu") {
+      robots::FlirPtuConfig h;
+      h.port = r.getOr<std::string>("port", "");
+      h.baud = r.getOr<int>("baud", h.baud);
+      h.tcp = r.getOr<std::string>("tcp", "");
+      h.reply_timeout = r.getOr<double>("reply_timeout", h.reply_timeout);
+      h.latency = r.getOr<double>("latency", c.unit.latency);
+      c.hardware_unit = h;
+    }
+  }
   {
     const auto d = root.child("detector");
     const auto crop = d.getOr<std::vector<int>>("crop", {0, 0, 0, 0});

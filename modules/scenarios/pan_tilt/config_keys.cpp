@@ -17,7 +17,13 @@ io::ConfigReferenceSection panTiltConfigReference() {
   // No shipped file has the inline camera (all name a rig): the camera given by its intrinsics.
   s.probes = {
       "path: {shape: circle, speed: 0.1}\nscreen: {distance: 1.3, center_height: 0.0, disc_radius: 0.03}\n"
-      "camera: {width: 640, height: 480, fx: 900, fy: 900, fps: 30}\n"};
+      "camera: {width: 640, height: 480, fx: 900, fy: 900, fps: 30}\n",
+      // The FLIR PTU branch of `robot` (no shipped file drives hardware).
+      "path: {shape: circle, speed: 0.1}\nscreen: {distance: 1.3, center_height: 0.0, disc_radius: 0.03}\n"
+      "camera: {width: 640, height: 480, fx: 900, fy: 900, fps: 30}\nmeasurement_noise_fraction: 0.1\n"
+      "unit: {pan_limits_deg: [-150, 150], tilt_limits_deg: [-47, 31], max_speed_deg: 300, max_acceleration_deg: 1200, "
+      "latency: 0.03}\nprocessing_delay: 0.01\n"
+      "robot: {kind: flir_ptu, port: /dev/ttyUSB0, baud: 9600, tcp: '127.0.0.1:4000', reply_timeout: 0.5, latency: 0.03}\n"};
   s.read = [](const io::ConfigNode& root) { loadPanTiltScenarioConfig(root); };
   s.keys = {
       {"path", "", "the target's path on the screen"},
@@ -52,6 +58,13 @@ io::ConfigReferenceSection panTiltConfigReference() {
       {"unit.latency", "s", "command to effect"},
       {"unit.initial_offset_deg", "deg", "start pointing this far (pan, tilt) from the path's start point"},
       {"processing_delay", "s", "image capture to command (>= exposure / 2, < one frame period)"},
+      {"robot", "", "the unit driven (absent: the simulated unit of `unit`)"},
+      {"robot.kind", "", "simulated, or flir_ptu: a FLIR PTU (or viewline_ptu_emulator) over its ASCII protocol; the run is paced to the wall clock"},
+      {"robot.port", "", "flir_ptu: serial device (e.g. /dev/ttyUSB0; or the emulator's pty); give port or tcp"},
+      {"robot.baud", "bit/s", "flir_ptu: serial baud rate (9600 .. 115200)"},
+      {"robot.tcp", "", "flir_ptu: host:port of an E-series unit or the emulator; give port or tcp"},
+      {"robot.reply_timeout", "s", "flir_ptu: time allowed for each reply before the run stops with a time-out (the unit is halted)"},
+      {"robot.latency", "s", "flir_ptu: command latency the controllers assume (default: unit.latency)"},
       {"detector", "", "the screen-target detector of [T] (vision::ScreenTargetDetector)"},
       {"detector.crop", "px", "margins removed [left, top, right, bottom]"},
       {"detector.scale", "", "image resize factor"},

@@ -63,10 +63,19 @@ Eigen::VectorXd vec(const Vector2d& v) { return Eigen::VectorXd(v); }
 PanTiltRunMetrics runPanTilt(const PanTiltScenarioConfig& cfg, std::uint64_t seed, PanTiltControllerKind kind,
                              const PanTiltRunIo& io) {
   cfg.validate();
-  const auto wall0 = std::chrono::steady_clock::now();
-  pan_tilt::World world(cfg, seed);
-  robots::SimulatedPanTiltUnit& unit = world.unit();
-  const robots::PanTiltLimits& limits = cfg.unit.limits;
+  auto wall0 = std::chrono::steady_clock::now();
+  // A FLIR PTU (or its emulator) replaces the simulated unit: the camera rides on it, the laws
+  // drive it, and the run is paced to the wall clock, the unit's time.
+  std::unique_ptr<robots::FlirPtu> hardware;
+  if (cfg.hardware_unit) hardware = std::make_unique<robots::FlirPtu>(*cfg.hardware_unit);
+  pan_tilt::World world(cfg, seed, hardware.get());
+  robots::PanTiltUnit& unit = world.actuator();
+  const robots::PanTiltLimits& limits = unit.limits();  // the unit owns its limits
+  if (hardware) {  // the simulated unit's start: pointing at the path's start plus the offset
+    hardware->moveTo(world.unit().params().q0.cwiseMax(limits.q_min).cwiseMin(limits.q_max), 0.5 * limits.qdot_max);
+    hardware->await(10.0);
+    wall0 = std::chrono::steady_clock::now();  // the time per frame is the loop's, as on the simulated unit
+  }
   const double latency = unit.commandLatency();  // the unit owns its latency; the laws ask it
   const robots::PanTiltKinematics& kin_model = world.modelKinematics();
   core::Camera model_cam = panTiltModelCamera(cfg);  // pose set per frame
@@ -179,7 +188,7 @@ PanTiltRunMetrics runPanTilt(const PanTiltScenarioConfig& cfg, std::uint64_t see
   };
 
   runtime::Scheduler sched;
-  sched.setPacing(io.pacing);
+  sched.setPacing(hardware && !io.pacing.paced() ? runtime::Pacing{1.0} : io.pacing);
   std::size_t grabbed = 0;
   // The camera's half of a frame: grab, detect, measure, and send the observation on.
   std::function<void(double)> capture = [&](double) {
@@ -237,12 +246,16 @@ PanTiltRunMetrics runPanTilt(const PanTiltScenarioConfig& cfg, std::uint64_t see
   if (const auto first = source.nextReadyTime()) sched.at(*first, runtime::priority::Capture, capture);
   while (!sched.stopRequested() && sched.step()) {
   }
-  unit.stop(unit.now().t);
-  unit.advanceTo(unit.now().t + 1.0);
+  if (hardware) {
+    hardware->halt();
+  } else {
+    world.unit().stop(world.unit().now().t);
+    world.unit().advanceTo(world.unit().now().t + 1.0);
+  }
 
   const double wall =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - wall0).count();
-  PanTiltRunMetrics m = score.finish(ours, unit, wall);
+  PanTiltRunMetrics m = score.finish(ours, world.unit(), wall);
   m.stopped = sched.stopRequested();
   return m;
 }

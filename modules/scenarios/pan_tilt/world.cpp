@@ -84,7 +84,7 @@ robots::SimulatedPanTiltParams unitParams(const PanTiltScenarioConfig& c, const 
   return up;
 }
 
-std::vector<sim::SimCamera> cameraOnUnit(const PanTiltScenarioConfig& c, robots::SimulatedPanTiltUnit& unit,
+std::vector<sim::SimCamera> cameraOnUnit(const PanTiltScenarioConfig& c, robots::PanTiltUnit& unit,
                                          const robots::PanTiltKinematics& kin) {
   sim::SimCamera sc;
   sc.camera = panTiltTrueCamera(c);
@@ -104,7 +104,7 @@ sim::RenderSettings renderSettings() {
 }
 }  // namespace
 
-World::World(const PanTiltScenarioConfig& c, std::uint64_t seed)
+World::World(const PanTiltScenarioConfig& c, std::uint64_t seed, robots::PanTiltUnit* hardware)
     : path_rng_(core::makeRng(core::deriveSeed(seed, 1))),
       render_rng_(core::makeRng(core::deriveSeed(seed, 2))),
       noise_rng_(core::makeRng(core::deriveSeed(seed, 3))),
@@ -119,7 +119,8 @@ World::World(const PanTiltScenarioConfig& c, std::uint64_t seed)
       kin_(c.true_e_M_c ? robots::PanTiltKinematics(*c.true_e_M_c) : robots::PanTiltKinematics()),
       kin_model_(c.calibrated_e_M_c ? robots::PanTiltKinematics(*c.calibrated_e_M_c) : robots::PanTiltKinematics()),
       unit_(unitParams(c, path_, f_M_screen_, kin_)),
-      rig_(cameraOnUnit(c, unit_, kin_), render_rng_, renderSettings()),
+      hardware_(hardware),
+      rig_(cameraOnUnit(c, actuator(), kin_), render_rng_, renderSettings()),
       exposure_(c.exposure) {
   rig_.reset(0.0);
   const core::Camera& cam = rig_.cameras().front().camera;

@@ -17,6 +17,7 @@
 #include "viewline/control/pan_tilt_servo.h"
 #include "viewline/core/camera.h"
 #include "viewline/io/config.h"
+#include "viewline/robots/flir_ptu.h"
 #include "viewline/robots/simulated_pan_tilt.h"
 #include "viewline/sim/physics.h"
 #include "viewline/vision/screen_target_detector.h"
@@ -58,6 +59,9 @@ struct PanTiltScenarioConfig {
   robots::SimulatedPanTiltParams unit;   ///< limits, latency (q0 set from initial_offset)
   Eigen::Vector2d initial_offset = Eigen::Vector2d::Zero();  ///< rad from pointing at the start point
   double processing_delay = 0.01;        ///< s from capture to command
+  /// `robot: {kind: flir_ptu, ...}`: drive this FLIR PTU (or its emulator) instead of the
+  /// simulated unit; the run is then paced to the wall clock. Unset: the simulated unit.
+  std::optional<robots::FlirPtuConfig> hardware_unit;
   // Detection
   vision::ScreenTargetDetectorConfig detector;  ///< [T]'s disc detector (crop, binarise, centroid)
   // Control (the baseline uses control.servo)

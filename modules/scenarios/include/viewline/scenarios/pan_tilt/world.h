@@ -55,8 +55,9 @@ struct FrameTruth {
 class World {
 public:
   /// Builds the world of `seed` (path, rendering and noise streams derived from it); config is not
-  /// kept.
-  World(const PanTiltScenarioConfig& config, std::uint64_t seed);
+  /// kept. With `hardware` (not owned, outliving the world) the camera rides on that unit: frames
+  /// are rendered at the joints it reads when they are captured.
+  World(const PanTiltScenarioConfig& config, std::uint64_t seed, robots::PanTiltUnit* hardware = nullptr);
   World(const World&) = delete;
   World& operator=(const World&) = delete;
 
@@ -72,6 +73,9 @@ public:
   Eigen::Vector2d drawNoise();
   /// The simulated unit (true mount; joints, limits, latency).
   robots::SimulatedPanTiltUnit& unit() { return unit_; }
+  /// The unit the loop drives and the camera rides on: the hardware unit given at construction,
+  /// else the simulated one.
+  robots::PanTiltUnit& actuator() { return hardware_ != nullptr ? *hardware_ : unit_; }
   /// The unit as the controllers know it (calibrated camera mount).
   const robots::PanTiltKinematics& modelKinematics() const { return kin_model_; }
   /// The camera rig on the unit (true camera; renders the frames).
@@ -110,6 +114,7 @@ private:
   Eigen::Matrix2d R_;
   robots::PanTiltKinematics kin_, kin_model_;
   robots::SimulatedPanTiltUnit unit_;
+  robots::PanTiltUnit* hardware_ = nullptr;  // not owned
   sim::CameraRig rig_;
   Eigen::Vector2d principal_;
   double exposure_;
