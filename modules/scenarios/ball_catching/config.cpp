@@ -116,6 +116,9 @@ void readRobot(const io::ConfigNode& r, BallCatchingConfig& c) {
   c.robot.kind = kind == "arm" ? robots::CartesianBackEnd::Arm : robots::CartesianBackEnd::Stage;
   c.robot.limits.v_max = Eigen::Vector3d::Constant(r.getOr<double>("v_max", 0.5));
   c.robot.limits.a_max = Eigen::Vector3d::Constant(r.getOr<double>("a_max", 13.0));
+  c.robot.limits.norm = r.getChoiceOr("limit_norm", {"euclidean", "per_axis"}, std::string("euclidean")) == "per_axis"
+                            ? robots::LimitNorm::PerAxis
+                            : robots::LimitNorm::Euclidean;
   c.robot.latency = r.getOr<double>("latency_s", c.robot.latency);
   c.control_period = r.getOr<double>("control_period_s", c.control_period);
   c.robot.home = r.getOr<Eigen::Vector3d>("home", Eigen::Vector3d(4.0, 0.0, 1.1));
@@ -192,7 +195,10 @@ void readRegistration(const io::ConfigNode& r, CatchRegistration& g) {
   g.max_rms_px = r.getOr<double>("max_rms_px", g.max_rms_px);
   g.max_shift_m = r.getOr<double>("max_shift_m", g.max_shift_m);
   g.max_rotation_rad = r.getAngleOr("max_rotation_deg", g.max_rotation_rad);
+  g.robot_position_error_m = r.getOr<double>("robot_position_error_m", g.robot_position_error_m);
   if (g.min_points < 6) r.fail("min_points", "at least 6 (a camera pose from its marker points)");
+  if (!(std::isfinite(g.robot_position_error_m) && g.robot_position_error_m >= 0.0))
+    r.fail("robot_position_error_m", "a finite std >= 0, m");
 }
 
 }  // namespace

@@ -93,6 +93,10 @@ struct CatchRegistration {
   double max_rms_px = 0.5;        ///< refuse a camera's registration above this reprojection RMS,
   double max_shift_m = 0.05;      ///< or moving its centre more than this,
   double max_rotation_rad = 0.0087;  ///< or rotating it more than this (0.5°)
+  /// m, std per axis of the robot's positioning error while it holds the marker (the marker is
+  /// rendered there; the registration believes the commanded position). 0: exact. Drawn from its
+  /// own stream (deriveSeed(registration seed, 0x905)), so the rest of the session is unchanged.
+  double robot_position_error_m = 0.0;
 };
 
 /// The whole ball-catching scenario: cameras, throws, box, robot, tracker, planner and rendering.
