@@ -252,6 +252,9 @@ void BallCatchingConfig::validate() const {
   if (!(pixel_noise_px >= 0.0 && std::isfinite(pixel_noise_px)))
     throw InvalidInput("detector.pixel_noise_px: expected a finite value >= 0");
   if (threads < 1) throw InvalidInput("threads: expected >= 1");
+  if (flight_fit.min_images < 6) throw InvalidInput("flight_fit.min_images: expected >= 6 (six unknowns)");
+  if (flight_fit.min_cameras < 1) throw InvalidInput("flight_fit.min_cameras: expected >= 1");
+  if (flight_fit.max_iterations < 1) throw InvalidInput("flight_fit.max_iterations: expected >= 1");
   robot.validate();
   tracker.validate();
   plannerConfig().validate();
@@ -297,6 +300,13 @@ BallCatchingConfig loadBallCatchingConfig(const io::ConfigNode& root) {
   c.tracker.model.gravity_w = sim::gravityWorld();
   if (root.has("planner")) readPlanner(root.child("planner"), c.planner);
   if (root.has("registration")) readRegistration(root.child("registration"), c.registration);
+  if (root.has("flight_fit")) {
+    const auto f = root.child("flight_fit");
+    c.flight_fit.enabled = f.getOr<bool>("enabled", c.flight_fit.enabled);
+    c.flight_fit.min_images = f.getOr<int>("min_images", c.flight_fit.min_images);
+    c.flight_fit.min_cameras = f.getOr<int>("min_cameras", c.flight_fit.min_cameras);
+    c.flight_fit.max_iterations = f.getOr<int>("max_iterations", c.flight_fit.max_iterations);
+  }
   if (root.has("render")) {
     const auto r = root.child("render");
     c.render.supersampling = r.getOr<int>("supersampling", c.render.supersampling);

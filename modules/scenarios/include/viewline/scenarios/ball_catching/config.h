@@ -17,6 +17,7 @@
 #include "viewline/io/config.h"
 #include "viewline/planning/catch_planner.h"
 #include "viewline/robots/cartesian_robot.h"
+#include "viewline/scenarios/ball_catching/flight_fit.h"
 #include "viewline/sim/physics.h"
 #include "viewline/sim/renderer.h"
 #include "viewline/sim/worlds.h"
@@ -127,7 +128,9 @@ struct BallCatchingConfig {
   /// The tracker is told: its σ is the detector's σ and this one added in quadrature. Drawn from
   /// its own stream (deriveSeed(throw seed, 0xD37)), so the rest of a throw is unchanged.
   double pixel_noise_px = 0.0;
-  tracking::TrackerConfig tracker;   ///< multi-camera ball tracker (world frame, drag model)
+  tracking::TrackerConfig tracker;   ///< multi-camera ball tracker (world frame, drag-free model + white acceleration)
+  /// Drag-model batch fit of the track's fused images (flight_fit.h): the state the planner predicts from.
+  FlightFitConfig flight_fit;
   /// The planner's own settings (model, thresholds). Home, limits and latency are the robot's and
   /// the plane normal is the box's: plannerConfig() and CatchPlanner(cfg, robot) ask their owners.
   planning::CatchPlannerConfig planner;
