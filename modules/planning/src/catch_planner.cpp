@@ -108,7 +108,15 @@ PlannerUpdate CatchPlanner::update(double now, const estimation::StateEstimate& 
     commit_time_ = now;
     phase_ = CatchPhase::Committed;
   }
-  if (commit_time_ && cfg_.give_up && (!in_workspace || out.arrival > c.t + cfg_.give_up_late)) {
+  // Give up only when even a lower bound of the arrival is late: under Euclidean limits the
+  // per-axis profile with the same numbers relaxes |v| <= V to |v_i| <= V (so it is never slower
+  // than any norm-limited motion), while the planner's own Euclidean family from a moving start is
+  // conservative; going home cannot catch anything, chasing might.
+  const double arrival_bound =
+      cfg_.limits.norm == robots::LimitNorm::Euclidean
+          ? now + cfg_.latency + SyncProfile::minimumDuration(s.p, s.v, c.p, cfg_.limits.v_max, cfg_.limits.a_max)
+          : out.arrival;
+  if (commit_time_ && cfg_.give_up && (!in_workspace || arrival_bound > c.t + cfg_.give_up_late)) {
     give_up_time_ = now;
     phase_ = CatchPhase::GaveUp;
     planTo(now, cfg_.home);

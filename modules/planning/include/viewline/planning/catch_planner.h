@@ -19,7 +19,9 @@
 //     the commitment, if the box cannot be there by the crossing time (arrival = now + profile
 //     duration + command latency > crossing time + give_up_late), or the point is outside the
 //     workspace, the throw is declared unreachable: the planner stops chasing it and goes home
-//     (the early decision);
+//     (the early decision). Under Euclidean limits the duration in that test is a lower bound of
+//     any norm-limited motion's (the per-axis profile with the same numbers, a relaxation): the
+//     planner's own profile from a moving start is conservative, and a wrong give-up is a sure miss;
 //  4. `home_delay` after the predicted crossing the planner goes home (from the current state).
 // The control loop calls setpoint(t) every control period and streams the result to the robot.
 
