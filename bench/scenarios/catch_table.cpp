@@ -93,7 +93,7 @@ int main(int argc, char** argv) {
         {"cameras", "Camera count (first N of right, behind, left, high, or behind alone; 50 Hz)"},
         {"rate", "Frame rate (every camera)"},
         {"noise", "Pixel noise (sensor noise in grey levels; extra Gaussian noise on each detection, told to the tracker)"},
-        {"limits", "Robot limits (per Cartesian axis; the oracle uses the same limits)"},
+        {"limits", "Robot limits (as robot.limit_norm measures them; the oracle uses the same limits)"},
         {"model", "Planner crossing model (the ball has drag, k = 0.0103 /m)"}};
     char base_label[160];
     std::snprintf(base_label, sizeof base_label, "baseline: %zu cameras, 50 Hz, 2 grey levels, %.2g m/s & %.3g m/s², drag",

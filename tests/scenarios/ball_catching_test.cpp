@@ -93,8 +93,7 @@ TEST(BallCatchingScenario, ShortSessionCatchesWithinLimitsIsTheSamePacedAndTelem
   EXPECT_GE(s.registration->cameras_registered, 2);
   EXPECT_LT(s.registration->reprojection_px_after, 0.5);
   EXPECT_LT(s.registration->reprojection_px_after, 0.5 * s.registration->reprojection_px_before);
-  EXPECT_GE(s.reachable_throws, 1);
-  EXPECT_GE(s.caught_reachable, 1);
+  EXPECT_GE(s.reachable_throws, 1);  // the catch rate itself: CatchRateGuardWithHalfPixelDetectionNoise
   const double gate = core::chiSquareQuantile(2.0, 1.0 - cfg.tracker.gate.mahalanobis_alpha);
   for (std::size_t i = 0; i < s.results.size(); ++i) expectEveryGateDecision(*sinks[i], s.results[i], gate);
   // Same seeds, one thread, paced: identical results.
@@ -175,4 +174,22 @@ TEST(BallCatchingScenario, RigRendersWithTheTruthAndEstimatesWithTheCalibration)
 TEST(BallCatchingScenario, UnknownConfigKeyIsAnError) {
   const auto node = io::ConfigNode::fromString("cameras: []\nrobot: {kind: stage}\nbogus: 1\n", "t.yaml");
   EXPECT_THROW(scenarios::loadBallCatchingConfig(node), core::InvalidInput);
+}
+
+// CI guard of the catch rate under the hardest shipped condition of the envelope: 0.5 px of extra
+// detection noise per axis (the tracker told). 24 seeded throws of the shipped scenario; the method
+// catches 0.95-1.0 of the reachable ones here (docs/results.md), so a regression of more than ~20 %
+// (below 0.8) fails, and so does any set point over the robot's Euclidean limits.
+TEST(BallCatchingScenario, CatchRateGuardWithHalfPixelDetectionNoise) {
+  auto cfg = shipped("config/ball_catching.yaml");
+  cfg.threads = 2;
+  cfg.pixel_noise_px = 0.5;
+  ASSERT_EQ(cfg.robot.limits.norm, robots::LimitNorm::Euclidean);
+  const auto s = scenarios::runBallCatching(cfg, 20, 11);
+  ASSERT_GE(s.reachable_throws, 10) << "too few reachable throws to guard the rate";
+  EXPECT_GE(s.catch_rate_reachable, 0.8) << s.caught_reachable << " of " << s.reachable_throws;
+  EXPECT_EQ(s.limit_violations, 0u);
+  EXPECT_LE(s.max_speed, 0.5 * (1 + 1e-6));
+  EXPECT_LE(s.max_acceleration, 13.0 * (1 + 1e-6));
+  EXPECT_EQ(s.refused_setpoints, 0u);
 }

@@ -8,6 +8,20 @@ namespace viewline::planning {
 
 using core::InvalidInput;
 
+SyncProfile planProfile(const robots::CartesianLimits& limits, double t0, const Eigen::Vector3d& p0,
+                        const Eigen::Vector3d& v0, const Eigen::Vector3d& pf) {
+  if (limits.norm == robots::LimitNorm::Euclidean)
+    return SyncProfile::planEuclidean(t0, p0, v0, pf, limits.v_max(0), limits.a_max(0));
+  return SyncProfile::plan(t0, p0, v0, pf, limits.v_max, limits.a_max);
+}
+
+double minimumDuration(const robots::CartesianLimits& limits, const Eigen::Vector3d& p0, const Eigen::Vector3d& v0,
+                       const Eigen::Vector3d& pf) {
+  if (limits.norm == robots::LimitNorm::Euclidean)
+    return SyncProfile::minimumDurationEuclidean(p0, v0, pf, limits.v_max(0), limits.a_max(0));
+  return SyncProfile::minimumDuration(p0, v0, pf, limits.v_max, limits.a_max);
+}
+
 const char* toString(CatchPhase p) {
   switch (p) {
     case CatchPhase::Idle: return "idle";
@@ -57,7 +71,7 @@ CatchPlanner::CatchPlanner(CatchPlannerConfig cfg, const robots::CartesianRobot&
 
 void CatchPlanner::reset(double t, const Eigen::Vector3d& p, const Eigen::Vector3d& v) {
   phase_ = CatchPhase::Idle;
-  profile_ = SyncProfile::plan(t, p, v, p, cfg_.limits.v_max, cfg_.limits.a_max);  // stop, return to p
+  profile_ = planProfile(cfg_.limits, t, p, v, p);  // stop, return to p
   last_t_ = t;
   target_.reset();
   first_update_.reset();
@@ -70,7 +84,7 @@ void CatchPlanner::reset(double t, const Eigen::Vector3d& p, const Eigen::Vector
 
 void CatchPlanner::planTo(double now, const Eigen::Vector3d& goal) {
   const CartesianSample s = profile_.at(now);
-  profile_ = SyncProfile::plan(now, s.p, s.v, goal, cfg_.limits.v_max, cfg_.limits.a_max);
+  profile_ = planProfile(cfg_.limits, now, s.p, s.v, goal);
   ++replans_;
 }
 
@@ -87,14 +101,22 @@ PlannerUpdate CatchPlanner::update(double now, const estimation::StateEstimate& 
   const double sigma = c.sigmaMax();
   const bool in_workspace = !workspace_ || workspace_(c.p);
   const CartesianSample s = profile_.at(now);
-  const double duration = SyncProfile::minimumDuration(s.p, s.v, c.p, cfg_.limits.v_max, cfg_.limits.a_max);
+  const double duration = minimumDuration(cfg_.limits, s.p, s.v, c.p);
   out.arrival = now + duration + cfg_.latency;
   out.feasible = in_workspace && out.arrival <= c.t;
   if (!commit_time_ && sigma <= cfg_.commit_sigma && updates_ >= cfg_.commit_min_updates) {
     commit_time_ = now;
     phase_ = CatchPhase::Committed;
   }
-  if (commit_time_ && cfg_.give_up && (!in_workspace || out.arrival > c.t + cfg_.give_up_late)) {
+  // Give up only when even a lower bound of the arrival is late: under Euclidean limits the
+  // per-axis profile with the same numbers relaxes |v| <= V to |v_i| <= V (so it is never slower
+  // than any norm-limited motion), while the planner's own Euclidean family from a moving start is
+  // conservative; going home cannot catch anything, chasing might.
+  const double arrival_bound =
+      cfg_.limits.norm == robots::LimitNorm::Euclidean
+          ? now + cfg_.latency + SyncProfile::minimumDuration(s.p, s.v, c.p, cfg_.limits.v_max, cfg_.limits.a_max)
+          : out.arrival;
+  if (commit_time_ && cfg_.give_up && (!in_workspace || arrival_bound > c.t + cfg_.give_up_late)) {
     give_up_time_ = now;
     phase_ = CatchPhase::GaveUp;
     planTo(now, cfg_.home);

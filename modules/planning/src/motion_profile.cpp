@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include "viewline/core/error.h"
@@ -159,8 +160,138 @@ SyncProfile SyncProfile::plan(double t0, const Eigen::Vector3d& p0, const Eigen:
   return s;
 }
 
+namespace {
+
+// One axis of the family can go from (p0, v0) to (pf, 0) in exactly T under (v_max, a_max).
+bool axisFeasible(double p0, double v0, double pf, double v_max, double a_max, double T) {
+  const double D = pf - p0;
+  const Range r = cruiseRange(v0, v_max, a_max, T);
+  if (!r.ok) return false;
+  const double tol = 1e-12 * (1.0 + std::abs(D));
+  return D >= profileDistance(v0, r.lo, a_max, T) - tol && D <= profileDistance(v0, r.hi, a_max, T) + tol;
+}
+
+// The Euclidean problem in its motion frame: axis k starts at 0 with speed v0k and ends at dk.
+struct NormProblem {
+  Eigen::Vector3d e1 = Eigen::Vector3d::UnitX(), e2 = Eigen::Vector3d::Zero();
+  double d[2] = {0.0, 0.0}, v0[2] = {0.0, 0.0}, lo[2] = {0.0, 0.0};
+  double V = 1.0, A = 1.0;
+
+  bool idle(int k) const { return d[k] == 0.0 && v0[k] == 0.0; }
+  // Smallest weight w in [lo_k, 1] with which axis k arrives at T (+inf: none).
+  double weightFor(int k, double T) const {
+    if (idle(k)) return 0.0;
+    auto ok = [&](double w) { return w > 0.0 && axisFeasible(0.0, v0[k], d[k], V * w, A * w, T); };
+    if (!ok(1.0)) return std::numeric_limits<double>::infinity();
+    if (ok(lo[k])) return lo[k];
+    double a = lo[k], b = 1.0;
+    for (int it = 0; it < 60 && b - a > 1e-14; ++it) {
+      const double m = 0.5 * (a + b);
+      if (ok(m)) b = m;
+      else a = m;
+    }
+    return b;
+  }
+  bool feasible(double T) const {
+    const double w0 = weightFor(0, T), w1 = weightFor(1, T);
+    return std::isfinite(w0) && std::isfinite(w1) && w0 * w0 + w1 * w1 <= 1.0 + 1e-12;
+  }
+  double minimumTime() const {
+    if (idle(0) && idle(1)) return 0.0;
+    double lo_t = 0.0, hi_t = 1e-3;
+    for (int k = 0; !feasible(hi_t); ++k) {
+      if (k > 60) throw core::NumericalError("SyncProfile::planEuclidean: no feasible arrival time");
+      lo_t = hi_t;
+      hi_t *= 2.0;
+    }
+    for (int it = 0; it < 200 && hi_t - lo_t > 1e-13 * (1.0 + hi_t); ++it) {
+      const double mid = 0.5 * (lo_t + hi_t);
+      if (feasible(mid)) hi_t = mid;
+      else lo_t = mid;
+    }
+    return hi_t;
+  }
+};
+
+NormProblem normProblem(const Eigen::Vector3d& p0, const Eigen::Vector3d& v0_in, const Eigen::Vector3d& pf,
+                        double v_max, double a_max) {
+  checkLimits(v_max, a_max);
+  if (!(p0.allFinite() && v0_in.allFinite() && pf.allFinite()))
+    throw InvalidInput("SyncProfile::planEuclidean: non-finite start or goal");
+  NormProblem np;
+  np.V = v_max;
+  np.A = a_max;
+  Eigen::Vector3d v0 = v0_in;
+  if (v0.norm() > v_max) v0 *= v_max / v0.norm();
+  const Eigen::Vector3d D = pf - p0;
+  const double dist = D.norm();
+  if (dist > 0.0) np.e1 = D / dist;
+  else if (v0.norm() > 0.0) np.e1 = v0.normalized();
+  np.d[0] = dist;
+  np.v0[0] = v0.dot(np.e1);
+  const Eigen::Vector3d across = v0 - np.v0[0] * np.e1;
+  if (across.norm() > 1e-12 * v_max) {
+    np.e2 = across.normalized();
+    np.v0[1] = across.norm();
+  }
+  np.lo[0] = std::abs(np.v0[0]) / v_max;
+  np.lo[1] = np.v0[1] / v_max;
+  const double l = std::hypot(np.lo[0], np.lo[1]);
+  if (l > 1.0) {  // |v0| = V up to rounding
+    np.lo[0] /= l;
+    np.lo[1] /= l;
+  }
+  return np;
+}
+
+}  // namespace
+
+double SyncProfile::minimumDurationEuclidean(const Eigen::Vector3d& p0, const Eigen::Vector3d& v0,
+                                             const Eigen::Vector3d& pf, double v_max, double a_max) {
+  return normProblem(p0, v0, pf, v_max, a_max).minimumTime();
+}
+
+SyncProfile SyncProfile::planEuclidean(double t0, const Eigen::Vector3d& p0, const Eigen::Vector3d& v0,
+                                       const Eigen::Vector3d& pf, double v_max, double a_max) {
+  if (!std::isfinite(t0)) throw InvalidInput("SyncProfile::planEuclidean: non-finite start time");
+  const NormProblem np = normProblem(p0, v0, pf, v_max, a_max);
+  SyncProfile s;
+  s.t0_ = t0;
+  s.pf_ = pf;
+  s.euclidean_ = true;
+  s.origin_ = p0;
+  s.e1_ = np.e1;
+  s.e2_ = np.e2;
+  s.T_ = np.minimumTime();
+  for (int k = 0; k < 2; ++k) {
+    if (np.idle(k)) continue;  // the default axis stays at 0, at rest
+    // Bisection tolerances can leave T a hair short for the critical axis: nudge it up (as plan()).
+    std::optional<AxisProfile> ax;
+    double T = s.T_;
+    for (int it = 0; it < 8 && !ax; ++it) {
+      const double w = np.weightFor(k, T);
+      if (std::isfinite(w)) ax = AxisProfile::forTime(0.0, np.v0[k], np.d[k], v_max * w, a_max * w, T);
+      T = T * (1.0 + 1e-12) + 1e-12;
+    }
+    if (!ax) throw core::NumericalError("SyncProfile::planEuclidean: axis " + std::to_string(k) + " infeasible");
+    s.axes_[k] = *ax;
+  }
+  return s;
+}
+
 CartesianSample SyncProfile::at(double t) const {
   CartesianSample c;
+  if (euclidean_) {
+    if (t - t0_ >= T_) {
+      c.p = pf_;  // exact goal, at rest
+      return c;
+    }
+    const AxisState a = axes_[0].at(t - t0_), b = axes_[1].at(t - t0_);
+    c.p = origin_ + a.p * e1_ + b.p * e2_;
+    c.v = a.v * e1_ + b.v * e2_;
+    c.a = a.a * e1_ + b.a * e2_;
+    return c;
+  }
   for (int i = 0; i < 3; ++i) {
     const AxisState a = axes_[i].at(t - t0_);
     c.p(i) = a.p;

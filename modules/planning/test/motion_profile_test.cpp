@@ -132,3 +132,100 @@ TEST(MotionProfile, RejectsBadInput) {
   EXPECT_THROW(AxisProfile::minimumTime(0, 0, 1, 0.5, -1), core::InvalidInput);
   EXPECT_THROW(AxisProfile::minimumTime(0, 0, NAN, 0.5, 13), core::InvalidInput);
 }
+
+namespace {
+
+// Samples a profile every 0.1 ms: |v| and the mean |Δv / Δt| under the Euclidean limits, and p' = v.
+void expectWithinNormLimits(const SyncProfile& pr, double vmax, double amax) {
+  const double dt = 1e-4;
+  auto prev = pr.at(pr.startTime());
+  for (double t = pr.startTime() + dt; t <= pr.arrivalTime() + 0.05; t += dt) {
+    const auto s = pr.at(t);
+    ASSERT_LE(s.v.norm(), vmax * (1 + 1e-9)) << "t " << t;
+    ASSERT_LE(s.a.norm(), amax * (1 + 1e-9)) << "t " << t;
+    ASSERT_LE((s.v - prev.v).norm() / dt, amax * (1 + 1e-6)) << "t " << t;
+    ASSERT_LE((s.p - prev.p - 0.5 * (s.v + prev.v) * dt).norm(), amax * dt * dt / 4 + 1e-12) << "t " << t;
+    prev = s;
+  }
+}
+
+}  // namespace
+
+// From rest the Euclidean profile is the straight bang-coast-bang line: its time is the 1-D
+// trapezoid time of the distance under (v_max, a_max), whatever the direction; the per-axis
+// profile of a diagonal move is faster (each axis gets the full limit), by up to √3.
+TEST(MotionProfile, EuclideanFromRestIsTheStraightTrapezoid) {
+  const Eigen::Vector3d p0(4.0, 0.0, 1.1);
+  for (const Eigen::Vector3d& d : {Eigen::Vector3d(0, 0.3, 0), Eigen::Vector3d(0, 0.3, -0.3),
+                                   Eigen::Vector3d(0.2, 0.2, 0.2), Eigen::Vector3d(0, 0.004, 0.003)}) {
+    const double T = SyncProfile::minimumDurationEuclidean(p0, Eigen::Vector3d::Zero(), p0 + d, 0.5, 13);
+    EXPECT_NEAR(T, AxisProfile::minimumTime(0, 0, d.norm(), 0.5, 13), 1e-9) << d.transpose();
+    const SyncProfile pr = SyncProfile::planEuclidean(0.0, p0, Eigen::Vector3d::Zero(), p0 + d, 0.5, 13);
+    EXPECT_NEAR(pr.duration(), T, 1e-12);
+    for (double f : {0.1, 0.37, 0.8}) {  // on the segment
+      const Eigen::Vector3d q = pr.at(f * T).p - p0;
+      EXPECT_LT((q - d * q.dot(d) / d.squaredNorm()).norm(), 1e-12);
+    }
+    expectWithinNormLimits(pr, 0.5, 13);
+  }
+  const Eigen::Vector3d diag(0.0, 0.4, 0.4);
+  const double per_axis = SyncProfile::minimumDuration(p0, Eigen::Vector3d::Zero(), p0 + diag,
+                                                       Eigen::Vector3d::Constant(0.5), Eigen::Vector3d::Constant(13));
+  const double norm = SyncProfile::minimumDurationEuclidean(p0, Eigen::Vector3d::Zero(), p0 + diag, 0.5, 13);
+  EXPECT_GT(norm, 1.3 * per_axis);  // 0.566 m at 0.5 m/s against 0.4 m per axis
+}
+
+// From random moving starts (|v0| up to the limit, including exactly at it), the Euclidean profile
+// starts at the given state, ends at the goal at rest at its duration, and never exceeds the norms.
+TEST(MotionProfile, EuclideanRandomProfilesRespectTheNormLimits) {
+  core::Rng rng = core::makeRng(17);
+  for (int k = 0; k < 150; ++k) {
+    Eigen::Vector3d p0, v0, pf;
+    for (int i = 0; i < 3; ++i) {
+      p0(i) = core::uniform(rng, -0.4, 0.4);
+      pf(i) = core::uniform(rng, -0.4, 0.4);
+      v0(i) = core::uniform(rng, -1, 1);
+    }
+    if (k % 5 == 0) pf = p0;  // already there, moving
+    v0 *= (k % 3 == 0 ? 0.5 : core::uniform(rng, 0.0, 0.5)) / v0.norm();  // every third exactly at |v| = V
+    const double t0 = core::uniform(rng, 0, 2);
+    const SyncProfile pr = SyncProfile::planEuclidean(t0, p0, v0, pf, 0.5, 13);
+    EXPECT_LT((pr.at(t0).p - p0).norm(), 1e-12);
+    EXPECT_LT((pr.at(t0).v - v0).norm(), 1e-9);
+    const auto end = pr.at(pr.arrivalTime());
+    EXPECT_LT((end.p - pf).norm(), 1e-9);  // t0 + T - t0 may round below T: the last phase's end
+    EXPECT_LT(end.v.norm(), 1e-9);
+    const auto after = pr.at(pr.arrivalTime() + 1e-6);  // then exactly at the goal, at rest
+    EXPECT_EQ((after.p - pf).norm(), 0.0);
+    EXPECT_EQ(after.v.norm(), 0.0);
+    EXPECT_LT((pr.at(pr.arrivalTime() - 1e-9).p - pf).norm(), 1e-6);  // continuous at the arrival
+    EXPECT_NEAR(pr.duration(), SyncProfile::minimumDurationEuclidean(p0, v0, pf, 0.5, 13), 1e-12);
+    // Never faster than the per-axis family (which is allowed up to √3 V along a diagonal).
+    EXPECT_GE(pr.duration() + 1e-9, SyncProfile::minimumDuration(p0, v0, pf, Eigen::Vector3d::Constant(0.5),
+                                                                  Eigen::Vector3d::Constant(13)));
+    expectWithinNormLimits(pr, 0.5, 13);
+  }
+}
+
+// Replanning every 20 ms to a new goal from the current commanded state (as the catch planner
+// does): no position jump, no velocity step above a_max dt, never above the norms.
+TEST(MotionProfile, EuclideanReplanningIsContinuousAndWithinTheNorms) {
+  core::Rng rng = core::makeRng(5);
+  SyncProfile pr = SyncProfile::planEuclidean(0, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(),
+                                              Eigen::Vector3d(0, 0.3, -0.2), 0.5, 13);
+  const double dt = 1e-3;
+  auto prev = pr.at(0);
+  for (int step = 1; step < 1500; ++step) {
+    const double t = step * dt;
+    if (step % 20 == 0) {
+      const auto s = pr.at(t);
+      pr = SyncProfile::planEuclidean(
+          t, s.p, s.v, Eigen::Vector3d(0, core::uniform(rng, -0.3, 0.3), core::uniform(rng, -0.3, 0.3)), 0.5, 13);
+    }
+    const auto s = pr.at(t);
+    ASSERT_LE(s.v.norm(), 0.5 * (1 + 1e-9)) << "t " << t;
+    ASSERT_LE((s.v - prev.v).norm(), 13 * dt * (1 + 1e-6)) << "velocity step at t " << t;
+    ASSERT_LE((s.p - prev.p).norm(), 0.5 * dt * (1 + 1e-6)) << "position jump at t " << t;
+    prev = s;
+  }
+}

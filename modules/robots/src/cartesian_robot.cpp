@@ -15,6 +15,8 @@ namespace viewline::robots {
 using core::InvalidInput;
 using Vector6 = Eigen::Matrix<double, 6, 1>;
 
+const char* toString(LimitNorm n) { return n == LimitNorm::Euclidean ? "euclidean" : "per_axis"; }
+
 void CartesianLimits::validate() const {
   for (int i = 0; i < 3; ++i) {
     if (!(std::isfinite(v_max(i)) && v_max(i) > 0.0))
@@ -23,6 +25,26 @@ void CartesianLimits::validate() const {
       throw InvalidInput("CartesianLimits.a_max[" + std::to_string(i) +
                          "]: expected a positive finite acceleration (m/s²)");
   }
+  if (norm == LimitNorm::Euclidean && (v_max.maxCoeff() != v_max.minCoeff() || a_max.maxCoeff() != a_max.minCoeff()))
+    throw InvalidInput("CartesianLimits: a Euclidean-norm limit is one number: expected equal v_max and a_max components");
+}
+
+double CartesianLimits::speedOf(const Eigen::Vector3d& v) const {
+  if (norm == LimitNorm::Euclidean) return v.norm();
+  return v.cwiseAbs().cwiseQuotient(v_max).maxCoeff() * v_max(0);
+}
+
+double CartesianLimits::accelerationOf(const Eigen::Vector3d& a) const {
+  if (norm == LimitNorm::Euclidean) return a.norm();
+  return a.cwiseAbs().cwiseQuotient(a_max).maxCoeff() * a_max(0);
+}
+
+bool CartesianLimits::speedWithin(const Eigen::Vector3d& v, double tol) const {
+  return speedOf(v) <= v_max(0) * (1.0 + tol) + 1e-12;
+}
+
+bool CartesianLimits::accelerationWithin(const Eigen::Vector3d& a, double tol) const {
+  return accelerationOf(a) <= a_max(0) * (1.0 + tol) + 1e-9;
 }
 
 const char* toString(CartesianBackEnd k) { return k == CartesianBackEnd::Stage ? "stage" : "arm"; }
@@ -162,22 +184,15 @@ void SimulatedCartesianRobot::command(const CartesianState& sp) {
   const CartesianState& last = hist_.back();
   if (sp.t < last.t) throw InvalidInput("SimulatedCartesianRobot::command: set point time goes backwards");
   ++setpoints_;
-  const double tol = 1.0 + cfg_.limit_tolerance;
-  bool ok = true;
-  for (int i = 0; i < 3; ++i) {
-    max_v_ = std::max(max_v_, std::abs(sp.v(i)));
-    if (std::abs(sp.v(i)) > cfg_.limits.v_max(i) * tol + 1e-12) ok = false;
-  }
-  if (!ok) ++v_violations_;
+  const CartesianLimits& lim = cfg_.limits;
+  max_v_ = std::max(max_v_, lim.speedOf(sp.v));
+  if (!lim.speedWithin(sp.v, cfg_.limit_tolerance)) ++v_violations_;
   const double dt = sp.t - last.t;
   if (dt > 1e-9) {
-    bool a_ok = true;
-    for (int i = 0; i < 3; ++i) {
-      const double a = std::abs(sp.v(i) - last.v(i)) / dt;
-      max_a_ = std::max(max_a_, a);
-      if (a > cfg_.limits.a_max(i) * tol + 1e-9) a_ok = false;
-    }
-    if (!a_ok) ++a_violations_;
+    // The mean acceleration over the interval (|Δv| / Δt <= a_max when |p̈| <= a_max throughout).
+    const Eigen::Vector3d a = (sp.v - last.v) / dt;
+    max_a_ = std::max(max_a_, lim.accelerationOf(a));
+    if (!lim.accelerationWithin(a, cfg_.limit_tolerance)) ++a_violations_;
   }
   if (!reachable(sp.p)) {
     ++refused_;

@@ -2,6 +2,7 @@
 // with latency, limit and workspace accounting.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "viewline/core/error.h"
@@ -78,6 +79,33 @@ TEST(CartesianRobot, FollowsSetPointsWithLatency) {
   }
 }
 
+// The same diagonal set-point stream (0.4 m/s on y and z, 0.57 m/s at the tool point) is counted
+// as over the limit by a robot limited in Euclidean norm, and is within a per-axis robot's limits.
+TEST(CartesianRobot, CountsDiagonalSpeedUnderTheEuclideanNormOnly) {
+  for (const auto norm : {robots::LimitNorm::Euclidean, robots::LimitNorm::PerAxis}) {
+    SimulatedCartesianConfig c;
+    c.limits.norm = norm;
+    SimulatedCartesianRobot r(c);
+    r.reset(0.0);
+    const Eigen::Vector3d v(0.0, 0.4, 0.4);
+    for (int k = 1; k <= 10; ++k) {
+      const double t = k * 0.004;
+      // From rest: 0.4 m/s in 4 ms would be 100 m/s² per axis, so ramp up over 40 ms (10 m/s² per axis).
+      const Eigen::Vector3d vk = v * std::min(1.0, k / 10.0);
+      r.command({t, c.home + vk * 0.001, vk});
+    }
+    if (norm == robots::LimitNorm::Euclidean) {
+      EXPECT_EQ(r.velocityViolations(), 2u);  // |v| > 0.5 once above 0.354 m/s per axis: the last two
+      EXPECT_EQ(r.accelerationViolations(), 10u);  // 14.1 m/s² > 13 at the tool point
+      EXPECT_NEAR(r.maxSpeedSeen(), 0.4 * std::sqrt(2.0), 1e-12);
+    } else {
+      EXPECT_EQ(r.velocityViolations(), 0u);
+      EXPECT_EQ(r.accelerationViolations(), 0u);
+      EXPECT_NEAR(r.maxSpeedSeen(), 0.4, 1e-12);
+    }
+  }
+}
+
 TEST(CartesianRobot, CountsLimitViolationsAndRefusesOutsideTheWorkspace) {
   SimulatedCartesianConfig c = armConfig();
   SimulatedCartesianRobot r(c);
@@ -95,6 +123,22 @@ TEST(CartesianRobot, LinderothLimits) {
   const auto l = robots::CartesianLimits::linderoth();
   EXPECT_EQ(l.v_max, Eigen::Vector3d::Constant(0.5));
   EXPECT_EQ(l.a_max, Eigen::Vector3d::Constant(13.0));
+  EXPECT_EQ(l.norm, robots::LimitNorm::Euclidean);
+  // A diagonal 0.4 m/s on two axes is 0.57 m/s at the tool point: over the Euclidean limit, within
+  // the per-axis one.
+  EXPECT_FALSE(l.speedWithin(Eigen::Vector3d(0, 0.4, 0.4)));
+  EXPECT_TRUE(l.speedWithin(Eigen::Vector3d(0, 0.3, 0.4)));
+  EXPECT_FALSE(l.accelerationWithin(Eigen::Vector3d(10, 10, 0)));
+  robots::CartesianLimits axis = l;
+  axis.norm = robots::LimitNorm::PerAxis;
+  EXPECT_TRUE(axis.speedWithin(Eigen::Vector3d(0, 0.4, 0.4)));
+  EXPECT_TRUE(axis.accelerationWithin(Eigen::Vector3d(10, 10, 0)));
+  EXPECT_FALSE(axis.speedWithin(Eigen::Vector3d(0, 0.51, 0)));
+  robots::CartesianLimits uneven = l;
+  uneven.v_max.z() = 0.3;  // a Euclidean limit is one number
+  EXPECT_THROW(uneven.validate(), core::InvalidInput);
+  uneven.norm = robots::LimitNorm::PerAxis;
+  EXPECT_NO_THROW(uneven.validate());
   robots::CartesianLimits bad;
   bad.a_max.y() = 0;
   EXPECT_THROW(bad.validate(), core::InvalidInput);

@@ -116,6 +116,9 @@ void readRobot(const io::ConfigNode& r, BallCatchingConfig& c) {
   c.robot.kind = kind == "arm" ? robots::CartesianBackEnd::Arm : robots::CartesianBackEnd::Stage;
   c.robot.limits.v_max = Eigen::Vector3d::Constant(r.getOr<double>("v_max", 0.5));
   c.robot.limits.a_max = Eigen::Vector3d::Constant(r.getOr<double>("a_max", 13.0));
+  c.robot.limits.norm = r.getChoiceOr("limit_norm", {"euclidean", "per_axis"}, std::string("euclidean")) == "per_axis"
+                            ? robots::LimitNorm::PerAxis
+                            : robots::LimitNorm::Euclidean;
   c.robot.latency = r.getOr<double>("latency_s", c.robot.latency);
   c.control_period = r.getOr<double>("control_period_s", c.control_period);
   c.robot.home = r.getOr<Eigen::Vector3d>("home", Eigen::Vector3d(4.0, 0.0, 1.1));
@@ -192,7 +195,10 @@ void readRegistration(const io::ConfigNode& r, CatchRegistration& g) {
   g.max_rms_px = r.getOr<double>("max_rms_px", g.max_rms_px);
   g.max_shift_m = r.getOr<double>("max_shift_m", g.max_shift_m);
   g.max_rotation_rad = r.getAngleOr("max_rotation_deg", g.max_rotation_rad);
+  g.robot_position_error_m = r.getOr<double>("robot_position_error_m", g.robot_position_error_m);
   if (g.min_points < 6) r.fail("min_points", "at least 6 (a camera pose from its marker points)");
+  if (!(std::isfinite(g.robot_position_error_m) && g.robot_position_error_m >= 0.0))
+    r.fail("robot_position_error_m", "a finite std >= 0, m");
 }
 
 }  // namespace
@@ -246,6 +252,9 @@ void BallCatchingConfig::validate() const {
   if (!(pixel_noise_px >= 0.0 && std::isfinite(pixel_noise_px)))
     throw InvalidInput("detector.pixel_noise_px: expected a finite value >= 0");
   if (threads < 1) throw InvalidInput("threads: expected >= 1");
+  if (flight_fit.min_images < 6) throw InvalidInput("flight_fit.min_images: expected >= 6 (six unknowns)");
+  if (flight_fit.min_cameras < 1) throw InvalidInput("flight_fit.min_cameras: expected >= 1");
+  if (flight_fit.max_iterations < 1) throw InvalidInput("flight_fit.max_iterations: expected >= 1");
   robot.validate();
   tracker.validate();
   plannerConfig().validate();
@@ -291,6 +300,13 @@ BallCatchingConfig loadBallCatchingConfig(const io::ConfigNode& root) {
   c.tracker.model.gravity_w = sim::gravityWorld();
   if (root.has("planner")) readPlanner(root.child("planner"), c.planner);
   if (root.has("registration")) readRegistration(root.child("registration"), c.registration);
+  if (root.has("flight_fit")) {
+    const auto f = root.child("flight_fit");
+    c.flight_fit.enabled = f.getOr<bool>("enabled", c.flight_fit.enabled);
+    c.flight_fit.min_images = f.getOr<int>("min_images", c.flight_fit.min_images);
+    c.flight_fit.min_cameras = f.getOr<int>("min_cameras", c.flight_fit.min_cameras);
+    c.flight_fit.max_iterations = f.getOr<int>("max_iterations", c.flight_fit.max_iterations);
+  }
   if (root.has("render")) {
     const auto r = root.child("render");
     c.render.supersampling = r.getOr<int>("supersampling", c.render.supersampling);

@@ -8,7 +8,7 @@
 
 #include "viewline/core/error.h"
 #include "viewline/core/statistics.h"
-#include "viewline/planning/motion_profile.h"
+#include "viewline/planning/catch_planner.h"
 
 namespace viewline::scenarios {
 
@@ -31,9 +31,10 @@ void scoreThrow(ThrowResult& res, const BallCatchingConfig& cfg, const robots::S
   res.caught = res.miss_distance <= clearance;
   res.limit_violations = robot.velocityViolations() + robot.accelerationViolations();
   res.refused_setpoints = robot.refusedSetpoints();
+  res.max_speed = robot.maxSpeedSeen();
+  res.max_acceleration = robot.maxAccelerationSeen();
   // Oracle.
-  res.oracle_time = planning::SyncProfile::minimumDuration(home, Eigen::Vector3d::Zero(), res.cross_true,
-                                                           robot.limits().v_max, robot.limits().a_max);
+  res.oracle_time = planning::minimumDuration(robot.limits(), home, Eigen::Vector3d::Zero(), res.cross_true);
   res.reachable = res.t_first_visible >= 0.0 && robot.reachable(res.cross_true) &&
                   res.t_first_visible + robot.commandLatency() + res.oracle_time <= res.t_cross;
   // Planner.
@@ -84,6 +85,8 @@ CatchSummary summarise(std::vector<ThrowResult> results, std::uint64_t seed,
     if (r.reachable) miss_reach.push_back(1e3 * r.miss_distance);
     s.limit_violations += r.limit_violations;
     s.refused_setpoints += r.refused_setpoints;
+    s.max_speed = std::max(s.max_speed, r.max_speed);
+    s.max_acceleration = std::max(s.max_acceleration, r.max_acceleration);
     s.frames += r.frames;
     s.detections += r.detections;
     speeds.push_back(r.launch_speed);
@@ -147,7 +150,10 @@ nlohmann::json summaryJson(const CatchSummary& s, const BallCatchingConfig& cfg)
                 {"v_max", cfg.robot.limits.v_max.x()},
                 {"a_max", cfg.robot.limits.a_max.x()},
                 {"latency_s", cfg.robot.latency},
+                {"limit_norm", robots::toString(cfg.robot.limits.norm)},
                 {"limit_violations", s.limit_violations},
+                {"max_speed", s.max_speed},
+                {"max_acceleration", s.max_acceleration},
                 {"refused_setpoints", s.refused_setpoints}};
   j["cameras"] = cfg.activeCameras();
   j["rate_hz"] = cfg.rate_override_hz > 0.0 ? cfg.rate_override_hz : cfg.cameras.front().rate_hz;
@@ -202,9 +208,10 @@ void writeThrowsCsv(io::LogDirectory& log, const std::vector<ThrowResult>& resul
 std::string summaryText(const CatchSummary& s, const BallCatchingConfig& cfg) {
   std::string out;
   char line[512];
-  std::snprintf(line, sizeof line, "ball_catching: %d throws, seed %llu, %zu cameras, %s robot (%.2f m/s, %.1f m/s²), planner %s, %.1f s wall\n",
+  std::snprintf(line, sizeof line, "ball_catching: %d throws, seed %llu, %zu cameras, %s robot (%.2f m/s, %.1f m/s², %s), planner %s, %.1f s wall\n",
                 s.throws, static_cast<unsigned long long>(s.seed), cfg.activeCameras(), robots::toString(cfg.robot.kind),
-                cfg.robot.limits.v_max.x(), cfg.robot.limits.a_max.x(), planning::toString(cfg.planner.model.kind), s.wall_s);
+                cfg.robot.limits.v_max.x(), cfg.robot.limits.a_max.x(), robots::toString(cfg.robot.limits.norm),
+                planning::toString(cfg.planner.model.kind), s.wall_s);
   out += line;
   if (s.reachable_throws > 0) {
     std::snprintf(line, sizeof line, "  caught %d: catch rate %.3f of all, %.3f of the %d reachable throws\n", s.caught,

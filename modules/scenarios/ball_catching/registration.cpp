@@ -18,6 +18,7 @@ namespace viewline::scenarios {
 RegistrationResult registerCamerasToRobot(BallCatchingConfig& cfg, const sim::Scene& room, std::uint64_t seed) {
   const CatchRegistration& rg = cfg.registration;
   core::Rng rng = core::makeRng(seed);
+  core::Rng pos_rng = core::makeRng(core::deriveSeed(seed, 0x905));  // robot positioning error only
   std::vector<sim::SimCamera> sims;
   std::vector<core::Camera> est;
   std::vector<vision::BallDetector> detectors;
@@ -43,9 +44,14 @@ RegistrationResult registerCamerasToRobot(BallCatchingConfig& cfg, const sim::Sc
     for (double dy : rg.offsets_y)
       for (double dz : rg.offsets_z) {
         const Eigen::Vector3d hole = cfg.robot.home + Eigen::Vector3d(dx, dy, dz);
-        const Eigen::Vector3d marker = hole + rg.marker_offset;
+        const Eigen::Vector3d marker = hole + rg.marker_offset;  // where the robot believes it is
         ++out.poses;
-        StaticBoxWorld world(room, cfg, hole);
+        // The robot holds the box where it is commanded up to its positioning error: the marker
+        // is rendered there, the PnP below uses the commanded position.
+        Eigen::Vector3d held = hole;
+        if (rg.robot_position_error_m > 0.0)
+          for (int k = 0; k < 3; ++k) held(k) += rg.robot_position_error_m * core::gaussian(pos_rng);
+        StaticBoxWorld world(room, cfg, held);
         rig.reset(0.0);
         std::vector<bool> seen(sims.size(), false);
         for (std::size_t got = 0; got < sims.size();) {

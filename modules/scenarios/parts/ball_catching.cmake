@@ -3,10 +3,11 @@
 # live view is in modules/viz (ball_catching_display).
 list(APPEND scenarios_sources
   ball_catching/config.cpp
+  ball_catching/flight_fit.cpp
   ball_catching/loop.cpp
   ball_catching/metrics.cpp
   ball_catching/registration.cpp
   ball_catching/world.cpp)
-list(APPEND scenarios_tests test/summary_text_test.cpp)
+list(APPEND scenarios_tests test/summary_text_test.cpp test/flight_fit_test.cpp)
 # Unit and meaning of every key its config reader reads (docs/config_reference.md is generated from it).
 list(APPEND scenarios_sources ball_catching/config_keys.cpp)

@@ -19,7 +19,9 @@
 //     the commitment, if the box cannot be there by the crossing time (arrival = now + profile
 //     duration + command latency > crossing time + give_up_late), or the point is outside the
 //     workspace, the throw is declared unreachable: the planner stops chasing it and goes home
-//     (the early decision);
+//     (the early decision). Under Euclidean limits the duration in that test is a lower bound of
+//     any norm-limited motion's (the per-axis profile with the same numbers, a relaxation): the
+//     planner's own profile from a moving start is conservative, and a wrong give-up is a sure miss;
 //  4. `home_delay` after the predicted crossing the planner goes home (from the current state).
 // The control loop calls setpoint(t) every control period and streams the result to the robot.
 
@@ -34,12 +36,20 @@
 
 namespace viewline::planning {
 
+/// Time-optimal profile from (p0, v0) at t0 to (pf, 0) under the robot's limits: the Euclidean
+/// family (SyncProfile::planEuclidean) or the per-axis one (SyncProfile::plan), as limits.norm says.
+SyncProfile planProfile(const robots::CartesianLimits& limits, double t0, const Eigen::Vector3d& p0,
+                        const Eigen::Vector3d& v0, const Eigen::Vector3d& pf);
+/// Duration (s) of planProfile()'s profile from (p0, v0) to (pf, 0), without building it.
+double minimumDuration(const robots::CartesianLimits& limits, const Eigen::Vector3d& p0, const Eigen::Vector3d& v0,
+                       const Eigen::Vector3d& pf);
+
 /// Configuration of the ball-catching interception planner ([L] §VI.C).
 struct CatchPlannerConfig {
   CrossingModel model;  ///< flight model used to predict the crossing (ballistic or drag)
   Eigen::Vector3d home = Eigen::Vector3d(0.0, 0.0, 1.2);   ///< hole centre at rest, world, m
   Eigen::Vector3d normal = Eigen::Vector3d::UnitX();         ///< box-front normal (unit, towards the thrower)
-  robots::CartesianLimits limits;                            ///< per-axis limits of the hole (robot's, see below)
+  robots::CartesianLimits limits;                            ///< limits of the hole, Euclidean or per axis (robot's, see below)
   double latency = 0.0;           ///< robot command latency, s (the box follows set points this late; robot's)
   double start_sigma = 0.15;      ///< m, start moving below this crossing-point std
   double commit_sigma = 0.01;     ///< m, commit the target below this std

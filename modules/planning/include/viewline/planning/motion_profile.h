@@ -28,6 +28,19 @@
 // Replanning without jerks: a new profile starts from the current commanded position and
 // velocity, so position and velocity are continuous across replans (the acceleration may step,
 // as in any bang-bang profile).
+//
+// Euclidean-norm limits (|v| <= V, |a| <= A: an arm's tool-point limit; planEuclidean). The same
+// one-axis family runs on two orthogonal axes of the motion's own frame: e1 along the
+// displacement pf − p0 and e2 along the part of v0 across it (the third direction neither moves
+// nor has a velocity). Axis k gets the scaled limits (V w_k, A w_k) with w1² + w2² <= 1, so by
+// Cauchy-Schwarz |v| <= V |w| <= V and |a| <= A at every instant; w_k >= |v0·e_k| / V keeps the
+// start velocity (no step). The arrival time T is the smallest for which the weights each axis
+// needs to arrive at T (bisection, monotone in w) fit in the unit disc, found by bisection on T.
+// From rest this is the straight bang-coast-bang line, the exact time-optimal motion under norm
+// limits; from a moving start it is the best of this family (the velocity across the
+// displacement is stopped while the motion along it proceeds), never faster than the true optimum.
+// When |v0| = V exactly the weights are forced to w_k = |v0·e_k| / V, which is still feasible:
+// axis 1 keeps at most its current speed and axis 2 only has to stop and come back.
 
 #include <Eigen/Core>
 #include <optional>
@@ -84,6 +97,14 @@ public:
   /// Minimum synchronised duration (max over axes of T_min), without building the profile.
   static double minimumDuration(const Eigen::Vector3d& p0, const Eigen::Vector3d& v0, const Eigen::Vector3d& pf,
                                 const Eigen::Vector3d& v_max, const Eigen::Vector3d& a_max);
+  /// Profile from (p0, v0) at t0 to (pf, 0) under Euclidean-norm limits |v| <= v_max (m/s) and
+  /// |a| <= a_max (m/s²) (file comment). |v0| above v_max is scaled down to it. Throws InvalidInput
+  /// for non-finite input or bad limits.
+  static SyncProfile planEuclidean(double t0, const Eigen::Vector3d& p0, const Eigen::Vector3d& v0,
+                                   const Eigen::Vector3d& pf, double v_max, double a_max);
+  /// Duration (s) of planEuclidean's profile, without building it.
+  static double minimumDurationEuclidean(const Eigen::Vector3d& p0, const Eigen::Vector3d& v0,
+                                         const Eigen::Vector3d& pf, double v_max, double a_max);
   /// Sample at absolute time t (before t0: the start state; after arrival: at rest at pf).
   CartesianSample at(double t) const;
   /// Start time t0 (s, absolute).
@@ -99,6 +120,9 @@ private:
   double t0_ = 0.0, T_ = 0.0;
   AxisProfile axes_[3];
   Eigen::Vector3d pf_ = Eigen::Vector3d::Zero();
+  bool euclidean_ = false;                             ///< axes_[0..1] run along e1_, e2_ from origin_
+  Eigen::Vector3d origin_ = Eigen::Vector3d::Zero();  ///< start point (Euclidean profiles)
+  Eigen::Vector3d e1_ = Eigen::Vector3d::Zero(), e2_ = Eigen::Vector3d::Zero();  ///< motion frame
 };
 
 }  // namespace viewline::planning

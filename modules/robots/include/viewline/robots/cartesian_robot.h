@@ -8,9 +8,12 @@
 // the box's front face; its orientation is fixed (the box front faces the thrower) and not part
 // of the command. A command is a set point (position and velocity of the tool point) stamped
 // with its issue time; a real controller streams one every control period and applies it after
-// the command latency. The limits are Cartesian and per axis ([L]: 0.5 m/s and 13 m/s²): the
-// planner (planning/motion_profile.h) produces set points that respect them; the simulated back
-// end counts every set point that does not (tests assert none does) instead of silently fixing it.
+// the command latency. The limits bound the tool point's speed and acceleration ([L]: 0.5 m/s
+// and 13 m/s²), by default in Euclidean norm (|ṗ| <= v_max, |p̈| <= a_max: an arm's tool-point
+// limit, the same in every direction) or, as an option, per Cartesian axis (a gantry whose axes
+// have their own drives: a diagonal move then gets up to √3 times the limit). The planner
+// (planning/motion_profile.h) produces set points that respect them; the simulated back end
+// counts every set point that does not (tests assert none does) instead of silently fixing it.
 //
 // Two kinematic back ends, chosen in the scenario config:
 //  - Stage: a Cartesian (gantry) stage; the workspace is an axis-aligned box.
@@ -29,14 +32,31 @@
 
 namespace viewline::robots {
 
-/// Per-axis Cartesian limits of the tool point.
+/// How the tool point's speed and acceleration limits are measured.
+enum class LimitNorm {
+  Euclidean,  ///< |ṗ| <= v_max and |p̈| <= a_max (2-norm; an arm's tool-point limit)
+  PerAxis     ///< |ṗ_i| <= v_max_i and |p̈_i| <= a_max_i on every world axis (a gantry)
+};
+/// Lower-case name of a limit norm ("euclidean", "per_axis").
+const char* toString(LimitNorm n);
+
+/// Cartesian limits of the tool point (Euclidean norm by default, per axis as an option).
 struct CartesianLimits {
-  Eigen::Vector3d v_max = Eigen::Vector3d::Constant(0.5);   ///< |ṗ_i| m/s
-  Eigen::Vector3d a_max = Eigen::Vector3d::Constant(13.0);  ///< |p̈_i| m/s²
-  /// [L]'s ball catcher (ABB IRB 140): 0.5 m/s and 13 m/s² on every axis.
+  Eigen::Vector3d v_max = Eigen::Vector3d::Constant(0.5);   ///< m/s: |ṗ| (Euclidean: all three equal) or |ṗ_i|
+  Eigen::Vector3d a_max = Eigen::Vector3d::Constant(13.0);  ///< m/s²: |p̈| (Euclidean: all three equal) or |p̈_i|
+  LimitNorm norm = LimitNorm::Euclidean;                     ///< how v_max and a_max are measured
+  /// [L]'s ball catcher (ABB IRB 140): 0.5 m/s and 13 m/s² at the tool point (Euclidean norm).
   static CartesianLimits linderoth() { return {}; }
-  /// Throws core::InvalidInput naming the field (positive and finite).
+  /// Throws core::InvalidInput naming the field (positive and finite; equal components when Euclidean).
   void validate() const;
+  /// True when velocity v (m/s) is within the limit, with relative tolerance `tol`.
+  bool speedWithin(const Eigen::Vector3d& v, double tol = 0.0) const;
+  /// True when acceleration a (m/s²) is within the limit, with relative tolerance `tol`.
+  bool accelerationWithin(const Eigen::Vector3d& a, double tol = 0.0) const;
+  /// The measure the limit applies to: |v| (Euclidean) or max_i |v_i| / v_max_i · v_max_0 (per axis), m/s.
+  double speedOf(const Eigen::Vector3d& v) const;
+  /// The same measure for an acceleration a, m/s².
+  double accelerationOf(const Eigen::Vector3d& a) const;
 };
 
 /// Tool point position and velocity at time t.
@@ -52,7 +72,7 @@ public:
   virtual ~CartesianRobot() = default;
   /// Short name for logs and summaries.
   virtual std::string name() const = 0;
-  /// Per-axis Cartesian limits of the tool point (the planner asks the robot, their owner).
+  /// Cartesian limits of the tool point (the planner asks the robot, their owner).
   virtual const CartesianLimits& limits() const = 0;
   /// Delay between a set point's issue and its effect (s).
   virtual double commandLatency() const = 0;
@@ -108,7 +128,7 @@ const char* toString(CartesianBackEnd k);
 /// Configuration of the simulated Cartesian robot (limits, latency, workspace; arm mounting).
 struct SimulatedCartesianConfig {
   CartesianBackEnd kind = CartesianBackEnd::Stage;  ///< stage or arm
-  CartesianLimits limits;  ///< per-axis velocity and acceleration limits of the tool point
+  CartesianLimits limits;  ///< velocity and acceleration limits of the tool point (Euclidean or per axis)
   double latency = 0.008;          ///< s between a set point's issue and its effect
   Eigen::Vector3d home = Eigen::Vector3d(0.0, 0.0, 1.2);      ///< tool point at rest, world
   Eigen::Vector3d workspace_min = Eigen::Vector3d(-0.1, -0.6, 0.7);  ///< stage box (and arm bounds)
@@ -155,8 +175,8 @@ public:
   std::size_t accelerationViolations() const { return a_violations_; }
   /// Set points refused (no IK solution within the joint limits, or outside the workspace).
   std::size_t refusedSetpoints() const { return refused_; }
-  double maxSpeedSeen() const { return max_v_; }       ///< max |v_i| over set points
-  double maxAccelerationSeen() const { return max_a_; } ///< max |Δv_i / Δt|
+  double maxSpeedSeen() const { return max_v_; }       ///< max speed over set points, m/s (limits().speedOf)
+  double maxAccelerationSeen() const { return max_a_; } ///< max |Δv / Δt| over set points, m/s² (limits().accelerationOf)
   /// Last joint solution (arm back end), zeros for the stage.
   const Eigen::Matrix<double, 6, 1>& joints() const { return q_; }
   /// The arm's kinematics (nullptr for the stage).

@@ -9,6 +9,7 @@
 //   metrics.h       outcome of a throw (caught, oracle, miss reason), session summary, JSON
 
 #include "viewline/scenarios/ball_catching/config.h"
+#include "viewline/scenarios/ball_catching/flight_fit.h"
 #include "viewline/scenarios/ball_catching/loop.h"
 #include "viewline/scenarios/ball_catching/metrics.h"
 #include "viewline/scenarios/ball_catching/registration.h"

@@ -17,6 +17,7 @@
 #include "viewline/io/config.h"
 #include "viewline/planning/catch_planner.h"
 #include "viewline/robots/cartesian_robot.h"
+#include "viewline/scenarios/ball_catching/flight_fit.h"
 #include "viewline/sim/physics.h"
 #include "viewline/sim/renderer.h"
 #include "viewline/sim/worlds.h"
@@ -93,6 +94,10 @@ struct CatchRegistration {
   double max_rms_px = 0.5;        ///< refuse a camera's registration above this reprojection RMS,
   double max_shift_m = 0.05;      ///< or moving its centre more than this,
   double max_rotation_rad = 0.0087;  ///< or rotating it more than this (0.5°)
+  /// m, std per axis of the robot's positioning error while it holds the marker (the marker is
+  /// rendered there; the registration believes the commanded position). 0: exact. Drawn from its
+  /// own stream (deriveSeed(registration seed, 0x905)), so the rest of the session is unchanged.
+  double robot_position_error_m = 0.0;
 };
 
 /// The whole ball-catching scenario: cameras, throws, box, robot, tracker, planner and rendering.
@@ -123,7 +128,9 @@ struct BallCatchingConfig {
   /// The tracker is told: its σ is the detector's σ and this one added in quadrature. Drawn from
   /// its own stream (deriveSeed(throw seed, 0xD37)), so the rest of a throw is unchanged.
   double pixel_noise_px = 0.0;
-  tracking::TrackerConfig tracker;   ///< multi-camera ball tracker (world frame, drag model)
+  tracking::TrackerConfig tracker;   ///< multi-camera ball tracker (world frame, drag-free model + white acceleration)
+  /// Drag-model batch fit of the track's fused images (flight_fit.h): the state the planner predicts from.
+  FlightFitConfig flight_fit;
   /// The planner's own settings (model, thresholds). Home, limits and latency are the robot's and
   /// the plane normal is the box's: plannerConfig() and CatchPlanner(cfg, robot) ask their owners.
   planning::CatchPlannerConfig planner;

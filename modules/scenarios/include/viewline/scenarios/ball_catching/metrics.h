@@ -10,7 +10,8 @@
 // rendered frame), starting at home at rest with the same limits and command latency, could put
 // the hole exactly on the true crossing point by the crossing time:
 //     t_first_visible + latency + T_min(home -> crossing) <= t_cross
-// (T_min from the same synchronised profile generator; no processing latency).
+// (T_min from the planner's own profile generator under the robot's limits, Euclidean or per axis
+// (planning::minimumDuration): from rest, the straight bang-coast-bang line; no processing latency).
 //
 // Miss reasons (each missed throw gets exactly one):
 //   not_reachable  the oracle could not have caught it;
@@ -74,6 +75,8 @@ struct ThrowResult {
   std::string miss_reason;                              ///< "" when caught
   std::size_t limit_violations = 0,  ///< set points over the velocity or acceleration limits
               refused_setpoints = 0;  ///< set points refused (no IK solution, or outside the workspace)
+  double max_speed = 0.0,  ///< largest set-point speed, m/s (measured as robot.limit_norm says)
+         max_acceleration = 0.0;  ///< largest set-point acceleration |Δv| / Δt, m/s² (same measure)
   double wall_s = 0.0;  ///< wall-clock time the throw took to simulate, s
 };
 
@@ -101,6 +104,8 @@ struct CatchSummary {
   double miss_distance_mm_median_reachable = 0.0;  ///< median in-plane miss of reachable throws, mm
   std::size_t limit_violations = 0,   ///< sum over the throws
               refused_setpoints = 0;  ///< sum over the throws
+  double max_speed = 0.0,         ///< largest set-point speed over the throws, m/s
+         max_acceleration = 0.0;  ///< largest set-point acceleration over the throws, m/s²
   int frames = 0,      ///< images over all throws and cameras
       detections = 0;  ///< of which the ball was detected in
   double detection_rate = 0.0;  ///< detections / frames
