@@ -18,6 +18,7 @@ io::ConfigReferenceSection panTiltConfigReference() {
   s.probes = {
       "path: {shape: circle, speed: 0.1}\nscreen: {distance: 1.3, center_height: 0.0, disc_radius: 0.03}\n"
       "camera: {width: 640, height: 480, fx: 900, fy: 900, fps: 30}\n"};
+  for (const std::string& p : runtime::sourceConfigProbes("")) s.probes.push_back(p);
   s.read = [](const io::ConfigNode& root) { loadPanTiltScenarioConfig(root); };
   s.keys = {
       {"path", "", "the target's path on the screen"},
@@ -111,6 +112,7 @@ io::ConfigReferenceSection panTiltConfigReference() {
       {"run.occlusion_duration", "s", "length of the occlusion"},
       {"run.baseline", "", "also run ViSP's law on the same seed"},
   };
+  for (const io::ConfigKeyDoc& k : runtime::sourceConfigKeys()) s.keys.push_back(k);
   return s;
 }
 
