@@ -13,3 +13,5 @@ list(APPEND scenarios_sources
 list(APPEND scenarios_sources pan_tilt/config_keys.cpp)
 # Real footage (ViSP's mire-2) through the pan-tilt perception, against ViSP's vpDot2.
 list(APPEND scenarios_tests test/pan_tilt_footage_test.cpp)
+# The loop on other frame sources: record and replay bit for bit, footage not scored.
+list(APPEND scenarios_tests test/pan_tilt_sources_test.cpp)
