@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <opencv2/imgproc.hpp>
+#include <visp3/blob/vpDot2.h>
+#include <visp3/core/vpImageConvert.h>
 #include <utility>
 
 #include "viewline/core/error.h"
@@ -109,6 +111,64 @@ FootageStep FootageTracker::track(const runtime::Frame& frame) {
   }
   step.filtered_px = filter_.initialized() ? filter_.at(frame.stamp).p : last_px_;
   return step;
+}
+
+FootageReport trackFootage(runtime::FrameSource& source, const FootageTrackerConfig& config, bool vpdot2) {
+  FootageTracker tracker(config);
+  FootageReport r;
+  vpDot2 dot;
+  dot.setGraphics(false);
+  vpImage<unsigned char> I;
+  double sum_d2 = 0.0, max_d = 0.0, sum_pred2 = 0.0, sum_hold2 = 0.0;
+  bool has_previous = false;
+  Eigen::Vector2d previous = Eigen::Vector2d::Zero();
+  while (source.nextReadyTime()) {
+    const auto frame = source.grab();
+    ++r.frames;
+    if (!frame) {
+      ++r.lost;
+      has_previous = false;
+      continue;
+    }
+    if (vpdot2) {
+      cv::Mat grey = frame->image;
+      if (grey.channels() == 3) cv::cvtColor(frame->image, grey, cv::COLOR_BGR2GRAY);
+      vpImageConvert::convert(grey, I);
+      if (r.frames == 1)
+        dot.initTracking(I, vpImagePoint(config.initial_px.y(), config.initial_px.x()));  // (v, u)
+      else
+        dot.track(I);
+    }
+    const FootageStep step = tracker.track(*frame);
+    r.steps.push_back(step);
+    if (!step.detected) {
+      ++r.lost;
+      has_previous = false;
+      continue;
+    }
+    if (vpdot2) {
+      const double d = (step.measured_px - Eigen::Vector2d(dot.getCog().get_u(), dot.getCog().get_v())).norm();
+      sum_d2 += d * d;
+      max_d = std::max(max_d, d);
+      ++r.compared;
+    }
+    if (step.has_prediction && has_previous) {
+      sum_pred2 += (step.predicted_px - step.measured_px).squaredNorm();
+      sum_hold2 += (previous - step.measured_px).squaredNorm();
+      ++r.predicted;
+    }
+    previous = step.measured_px;
+    has_previous = true;
+  }
+  if (r.compared > 0) {
+    r.vpdot2_rms_px = std::sqrt(sum_d2 / static_cast<double>(r.compared));
+    r.vpdot2_max_px = max_d;
+  }
+  if (r.predicted > 0) {
+    r.predicted_rms_px = std::sqrt(sum_pred2 / static_cast<double>(r.predicted));
+    r.hold_rms_px = std::sqrt(sum_hold2 / static_cast<double>(r.predicted));
+  }
+  return r;
 }
 
 }  // namespace viewline::scenarios::pan_tilt

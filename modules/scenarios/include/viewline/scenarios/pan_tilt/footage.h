@@ -18,7 +18,9 @@
 
 #include <Eigen/Core>
 #include <opencv2/core/types.hpp>
+#include <cmath>
 #include <optional>
+#include <vector>
 
 #include "viewline/runtime/frame_source.h"
 #include "viewline/tracking/planar_target/filter.h"
@@ -71,5 +73,23 @@ private:
   Eigen::Vector2d half_size_;  ///< the last blob's half-size, px
   Eigen::Vector2d last_px_;    ///< the last measured centre (before the filter has a track), px
 };
+
+/// Figures of a FootageTracker run over a whole source, optionally against ViSP's vpDot2.
+struct FootageReport {
+  std::size_t frames = 0;     ///< frames grabbed
+  std::size_t lost = 0;       ///< frames the tracker did not detect the disc in (or the source lost)
+  std::size_t compared = 0;   ///< frames detected by both trackers
+  double vpdot2_rms_px = std::nan("");  ///< RMS distance between our centre and vpDot2's centre of gravity, px
+  double vpdot2_max_px = std::nan("");  ///< its maximum, px
+  std::size_t predicted = 0;  ///< frames with a one-frame-ahead prediction and a detection on this and the previous frame
+  double predicted_rms_px = std::nan("");  ///< RMS of (filter prediction at the stamp − measured centre), px
+  double hold_rms_px = std::nan("");       ///< RMS of (previous measured centre − measured centre), px
+  std::vector<FootageStep> steps;          ///< every frame's step
+};
+
+/// Runs `tracker` on every frame of `source` (until it ends). With `vpdot2`, also runs ViSP's
+/// vpDot2 blob tracker (initTracking at config.initial_px, then track()) on the same grey frames
+/// and compares the centres.
+FootageReport trackFootage(runtime::FrameSource& source, const FootageTrackerConfig& config, bool vpdot2);
 
 }  // namespace viewline::scenarios::pan_tilt
