@@ -91,8 +91,8 @@ std::vector<RecordingEntry> parseRecordingIndex(const std::string& text, const s
     if (!out.empty() && e.ready_time < out.back().ready_time)
       fail(file, n, "ready_time " + f[0] + " is before the previous row's (grabs are in time order)");
     e.file = f[5];
-    if (e.file.empty()) {  // a lost grab: the other fields are not used
-      out.push_back(e);
+    if (e.file.empty() && f[1].empty() && f[2].empty() && f[3].empty() && f[4].empty()) {
+      out.push_back(e);  // a lost grab the source knew nothing about
       continue;
     }
     const std::int64_t cam = csv::parseInt(f[1], "camera", file, n);
@@ -108,7 +108,7 @@ std::vector<RecordingEntry> parseRecordingIndex(const std::string& text, const s
     last_sequence[e.camera] = e.sequence;
     e.capture_time = csv::parseDouble(f[3], "capture_time", file, n);
     e.stamp = csv::parseDouble(f[4], "stamp", file, n);
-    if (e.file.front() == '/' || e.file.find("..") != std::string::npos)
+    if (!e.file.empty() && (e.file.front() == '/' || e.file.find("..") != std::string::npos))
       fail(file, n, "file '" + e.file + "' must be a path inside the recording folder");
     out.push_back(e);
   }
@@ -212,6 +212,19 @@ void RecordingWriter::lost(double ready_time) {
   entries_.push_back(e);
 }
 
+void RecordingWriter::lost(double ready_time, const Frame& f) {
+  if (finished_) throw core::InvalidInput("recording " + dir_ + ": a grab after finish()");
+  RecordingEntry e;
+  e.ready_time = ready_time;
+  e.camera = f.camera;
+  e.sequence = f.sequence;
+  e.capture_time = f.capture_time;
+  e.stamp = f.stamp;
+  e.file.clear();
+  known_lost_.push_back(entries_.size());
+  entries_.push_back(e);
+}
+
 void RecordingWriter::truth(std::size_t camera, std::uint64_t sequence, const std::vector<double>& values) {
   if (values.size() != truth_columns_.size())
     throw core::InvalidInput("recording " + dir_ + ": " + std::to_string(values.size()) + " truth values for " +
@@ -229,8 +242,12 @@ void RecordingWriter::finish() {
     io::writeTextFileAtomic((fs::path(dir_) / "truth.csv").string(), text + "\n" + truth_text_);
   }
   std::string index = std::string(kIndexHeader) + "\n";
-  for (const RecordingEntry& e : entries_) {
-    if (e.file.empty()) {
+  std::size_t k = 0;
+  for (std::size_t i = 0; i < entries_.size(); ++i) {
+    const RecordingEntry& e = entries_[i];
+    const bool known = k < known_lost_.size() && known_lost_[k] == i;
+    if (known) ++k;
+    if (e.file.empty() && !known) {
       index += exact(e.ready_time) + ",,,,,\n";
       continue;
     }

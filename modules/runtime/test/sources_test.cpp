@@ -221,6 +221,11 @@ TEST(Recording, WritesAndReadsBackBitForBit) {
     f.stamp = 0.2 / 3.0;
     f.image = bgr;
     w.frame(0.12, f);
+    Frame known;  // a lost frame whose times the source knew
+    known.sequence = 3;
+    known.capture_time = 0.3;
+    known.stamp = 0.31;
+    w.lost(0.15, known);
     w.finish();
     EXPECT_NE(errorOf([&] { RecordingWriter again((d / "r").string()); }).find("already holds a recording"), std::string::npos);
   }
@@ -240,6 +245,11 @@ TEST(Recording, WritesAndReadsBackBitForBit) {
   EXPECT_EQ(b->sequence, 2u);
   EXPECT_EQ(b->image.type(), CV_8UC3);
   EXPECT_EQ(cv::norm(b->image, bgr, cv::NORM_INF), 0.0);
+  EXPECT_FALSE(r.grab());
+  EXPECT_TRUE(r.lastEntry() == &r.entries().back());
+  EXPECT_EQ(r.entries().back().sequence, 3u);
+  EXPECT_EQ(r.entries().back().stamp, 0.31);
+  EXPECT_TRUE(r.entries().back().file.empty());
   EXPECT_FALSE(r.nextReadyTime());
   const auto cam = r.camera(0);
   ASSERT_TRUE(cam);

@@ -7,7 +7,8 @@
 //   recording.csv        the index, one row per grab in grab order:
 //                        ready_time,camera,sequence,capture_time,stamp,file
 //                        (times in s, written with 17 significant digits so they read back bit for
-//                        bit; file is relative to DIR; a grab that lost its frame has an empty file)
+//                        bit; file is relative to DIR; a grab that lost its frame has an empty file,
+//                        and empty camera..stamp fields unless the source knew them)
 //   cam<k>/<sequence>.png  the images, PNG (lossless for 8-bit grey and BGR)
 //   camera<k>.xml        camera k's calibration, ViSP XML (vpXmlParserCamera), camera name "camera<k>"
 //   config.yaml          the scenario config as run (after --set edits)
@@ -71,6 +72,9 @@ public:
   void frame(double ready_time, const Frame& frame);
   /// Records a grab at ready_time that lost its frame.
   void lost(double ready_time);
+  /// Records a grab at ready_time that lost frame `sequence` of `camera`, whose capture time and
+  /// stamp the source still knows (a driver's sequence gap); `frame.image` is not used.
+  void lost(double ready_time, const Frame& frame);
   /// The truth of (camera, sequence): one value per truth column.
   void truth(std::size_t camera, std::uint64_t sequence, const std::vector<double>& values);
   /// Writes recording.csv and truth.csv (atomically). Further frames are refused.
@@ -83,6 +87,7 @@ public:
 private:
   std::string dir_;
   std::vector<RecordingEntry> entries_;
+  std::vector<std::size_t> known_lost_;  ///< entries_ indices of lost frames with known fields
   std::vector<std::string> truth_columns_;
   std::string truth_text_;
   bool finished_ = false;
@@ -128,6 +133,8 @@ public:
   std::string configText() const;
   /// The index rows.
   const std::vector<RecordingEntry>& entries() const { return entries_; }
+  /// The row of the last grab (lost or not), null before the first grab.
+  const RecordingEntry* lastEntry() const { return next_ > 0 ? &entries_[next_ - 1] : nullptr; }
   /// The folder.
   const std::string& dir() const { return dir_; }
 
