@@ -92,7 +92,8 @@ std::vector<RecordingEntry> parseRecordingIndex(const std::string& text, const s
       fail(file, n, "ready_time " + f[0] + " is before the previous row's (grabs are in time order)");
     e.file = f[5];
     if (e.file.empty() && f[1].empty() && f[2].empty() && f[3].empty() && f[4].empty()) {
-      out.push_back(e);  // a lost grab the source knew nothing about
+      e.capture_time = e.stamp = std::nan("");  // a lost grab the source knew nothing about
+      out.push_back(e);
       continue;
     }
     const std::int64_t cam = csv::parseInt(f[1], "camera", file, n);

@@ -38,8 +38,8 @@ struct RecordingEntry {
   double ready_time = 0.0;     ///< when the grab was made (the source's nextReadyTime), s
   std::size_t camera = 0;      ///< camera index
   std::uint64_t sequence = 0;  ///< the frame's per-camera counter
-  double capture_time = 0.0;   ///< mid-exposure, s
-  double stamp = 0.0;          ///< the driver's stamp, s
+  double capture_time = 0.0;   ///< mid-exposure, s (NaN: a lost grab whose source did not know it)
+  double stamp = 0.0;          ///< the driver's stamp, s (NaN: as capture_time)
   std::string file;            ///< image file relative to the folder; empty: the grab lost its frame
 };
 
