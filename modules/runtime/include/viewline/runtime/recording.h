@@ -53,7 +53,7 @@ struct RecordingTruth {
   std::vector<std::string> columns;  ///< the scenario's truth columns (after camera,sequence)
   std::map<std::pair<std::size_t, std::uint64_t>, std::vector<double>> rows;  ///< (camera, sequence) -> values
 };
-/// Parses truth.csv text (header camera,sequence,<columns>; numeric rows; no duplicate frame).
+/// Parses truth.csv text (header `camera,sequence,` then the truth columns; numeric rows; no duplicate frame).
 RecordingTruth parseRecordingTruth(const std::string& text, const std::string& file);
 
 /// Writes a recording folder (see the file comment). Not thread-safe; one writer per folder.

@@ -54,10 +54,10 @@ struct PanTiltRunIo {
   pan_tilt::FrameSink* frames = nullptr;        ///< per-frame records; null: none
   runtime::Pacing pacing;                       ///< as fast as possible by default
   std::function<void(double)> progress;         ///< fraction of the run done
-  /// Record each run's frames, truth and camera to <record_dir>/<controller> (runtime::RecordingWriter;
-  /// "" : none).
+  /// Record each run's frames, truth and camera to record_dir/CONTROLLER, CONTROLLER the law's name
+  /// (runtime::RecordingWriter; "" : none).
   std::string record_dir;
-  /// Run on the frames recorded in <replay_dir>/<controller> instead of the config's source: with the
+  /// Run on the frames recorded in replay_dir/CONTROLLER instead of the config's source: with the
   /// same config and seed the run, and its summary, are those of the recorded run ("" : none).
   std::string replay_dir;
   std::string config_text;  ///< the config as run (YAML), written into a recording
