@@ -77,7 +77,7 @@ std::vector<io::ConfigKeyDoc> sourceConfigKeys() {
       {"source.device", "", "v4l2: the device node"},
       {"source.width", "px", "v4l2: requested width (0: the driver's)"},
       {"source.height", "px", "v4l2: requested height (0: the driver's)"},
-      {"source.exposure", "100 µs", "v4l2: manual exposure (V4L2 exposure_absolute units; -1: auto)"},
+      {"source.exposure", "100 µs", "v4l2: manual exposure (V4L2 exposure_absolute units; -1: the driver's setting)"},
   };
 }
 

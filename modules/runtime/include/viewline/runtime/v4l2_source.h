@@ -37,7 +37,7 @@ struct V4l2Options {
   int width = 0;                       ///< requested image width, px (0: the driver's)
   int height = 0;                      ///< requested image height, px (0: the driver's)
   double rate = 0.0;                   ///< requested frame rate, Hz (0: the driver's)
-  double exposure = -1.0;              ///< manual exposure in the driver's units (V4L2 exposure_absolute: 100 µs); < 0: auto
+  double exposure = -1.0;              ///< manual exposure in the driver's units (V4L2 exposure_absolute: 100 µs); < 0: the driver's setting
   std::int64_t count = -1;             ///< stop after this many frames (< 0: never)
 };
 
