@@ -7,7 +7,7 @@ endif()
 
 find_package(Eigen3 3.3 REQUIRED NO_MODULE)
 find_package(VISP 3.5 REQUIRED COMPONENTS visp_core visp_vision visp_detection visp_vs visp_robot visp_io visp_gui)
-find_package(OpenCV 4 REQUIRED COMPONENTS core imgproc calib3d video imgcodecs aruco)
+find_package(OpenCV 4 REQUIRED COMPONENTS core imgproc calib3d video videoio imgcodecs aruco)
 find_package(yaml-cpp REQUIRED)
 find_package(nlohmann_json 3 REQUIRED)
 find_package(CLI11 QUIET CONFIG)

@@ -53,6 +53,18 @@ void addCommonOptions(CLI::App& cli, CommonOptions& opt) {
   cli.set_version_flag("--version", std::string("viewline ") + core::kVersion);
 }
 
+void addRecordOption(CLI::App& cli, CommonOptions& opt) {
+  cli.add_option("--record", opt.record_dir,
+                 "record the frames (PNG), their stamps, the truth, the camera (ViSP XML) and the config as run "
+                 "into this new folder, to run again with --replay");
+}
+
+void addReplayOption(CLI::App& cli, CommonOptions& opt) {
+  cli.add_option("--replay", opt.replay_dir,
+                 "run on the frames of a folder written by --record (same config and --seed: the same run)")
+      ->check(CLI::ExistingDirectory);
+}
+
 std::optional<int> parseCommandLine(CLI::App& cli, int argc, char** argv) {
   try {
     cli.parse(argc, argv);

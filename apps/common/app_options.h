@@ -1,7 +1,8 @@
 #pragma once
 // The command line every scenario app shares, so that the same flag means the same thing in
 // each of them (DESIGN "Running"): --config, --set KEY=VALUE, --seed, --headless / --display,
-// --realtime [FACTOR], --log DIR, --summary FILE, --quiet, --version.
+// --realtime [FACTOR], --log DIR, --summary FILE, --quiet, --version; and, for apps whose loop
+// runs on a runtime::FrameSource, --record DIR / --replay DIR (addRecordOption, addReplayOption).
 //
 //   int main(int argc, char** argv) {
 //     CLI::App cli{"..."};
@@ -35,6 +36,8 @@ struct CommonOptions {
   std::string log_dir;            ///< --log DIR
   std::string summary_path;       ///< --summary FILE
   bool quiet = false;             ///< --quiet: no progress lines
+  std::string record_dir;         ///< --record DIR: the run's frames, truth, camera and config (runtime/recording.h)
+  std::string replay_dir;         ///< --replay DIR: run on a recording written by --record instead of the config's source
 
   /// The pacing the flags ask for: --realtime F paces at F; --display alone paces at 1;
   /// otherwise as fast as possible. Call after parsing.
@@ -45,6 +48,12 @@ struct CommonOptions {
 
 /// Adds the common flags to `cli` (with --headless/--display excluding each other).
 void addCommonOptions(CLI::App& cli, CommonOptions& opt);
+
+/// Adds --record DIR (every app that runs a scenario loop can record its frames).
+void addRecordOption(CLI::App& cli, CommonOptions& opt);
+/// Adds --replay DIR: the loop on a recording written by --record (apps whose --replay already
+/// means something else add only --record and accept a recording folder there).
+void addReplayOption(CLI::App& cli, CommonOptions& opt);
 
 /// Parses the command line. nullopt: go on; otherwise the exit status to return at once: 0 after
 /// --help, 2 for a usage error (unknown flag, bad value, excluded pair), with CLI11's message.

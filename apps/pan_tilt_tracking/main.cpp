@@ -4,8 +4,10 @@
 // (viewline/scenarios/pan_tilt/command.h), which runs, logs and prints.
 //
 //   pan_tilt_tracking --config config/pan_tilt_circle.yaml --set run.duration=60 --seed 1 --summary out.json
+//   pan_tilt_tracking --config config/pan_tilt_circle.yaml --seed 1 --record rec; ... --replay rec
 //   pan_tilt_tracking --config <variant>.yaml --seed 1 --replay <log>/predictive_frames.csv [--oracle-corners | --particles]
 #include <CLI/CLI.hpp>
+#include <filesystem>
 #include <iostream>
 #include <memory>
 #include <string>
@@ -25,8 +27,10 @@ int main(int argc, char** argv) {
   bool no_baseline = false, oracle_corners = false, particles = false;
   cli.add_option("--duration", duration, "simulated seconds: shorthand for --set run.duration=S");
   cli.add_flag("--no-baseline", no_baseline, "ours only: shorthand for --set run.baseline=false");
+  apps::addRecordOption(cli, opt);
   cli.add_option("--replay", run.replay,
-                 "filter only: re-run this config's target filter on the measurements of a --log run "
+                 "a folder written by --record: the loop on its frames (same config and --seed: the same run); "
+                 "or filter only: re-run this config's target filter on the measurements of a --log run "
                  "(<log>/predictive_frames.csv, same --seed and run.duration) instead of simulating");
   cli.add_flag("--oracle-corners", oracle_corners,
                "with --replay (rectangle, random): a bound instead of the config's filter, constant-speed legs "
@@ -53,11 +57,13 @@ int main(int argc, char** argv) {
     run.log_dir = opt.log_dir;
     run.summary_path = opt.summary_path;
     run.quiet = opt.quiet;
+    run.record = opt.record_dir;
     run.estimator = oracle_corners ? scenarios::PanTiltReplayEstimator::OracleCorners
                     : particles    ? scenarios::PanTiltReplayEstimator::WaypointParticles
                                    : scenarios::PanTiltReplayEstimator::Filter;
     std::unique_ptr<viz::PanTiltDisplay> view;
-    if (run.replay.empty() && opt.wantDisplay("pan_tilt_tracking")) view = std::make_unique<viz::PanTiltDisplay>();
+    const bool filter_replay = !run.replay.empty() && !std::filesystem::is_directory(run.replay);
+    if (!filter_replay && opt.wantDisplay("pan_tilt_tracking")) view = std::make_unique<viz::PanTiltDisplay>();
     run.pacing = view || opt.realtime >= 0.0 ? opt.pacing() : runtime::Pacing{};  // no window: no reason to wait
     const int status = scenarios::pan_tilt::runCommand(run, view.get());
     if (view) view->close();

@@ -25,17 +25,27 @@ int main(int argc, char** argv) {
   apps::CommonOptions opt;
   opt.config_path = "config/table_ball.yaml";
   apps::addCommonOptions(cli, opt);
+  apps::addRecordOption(cli, opt);
+  apps::addReplayOption(cli, opt);
   double duration = 0.0;
   cli.add_option("--duration", duration, "simulated seconds (default: the config's duration)")->check(CLI::PositiveNumber);
   if (const auto code = apps::parseCommandLine(cli, argc, argv)) return *code;
   return apps::runGuarded("table_ball_balancing", [&] {
-    scenarios::TableBallConfig cfg = scenarios::tableBallConfigFromYaml(io::loadConfigWithValues(opt.config_path, opt.sets));
+    const io::ConfigNode root = io::loadConfigWithValues(opt.config_path, opt.sets);
+    scenarios::TableBallConfig cfg = scenarios::tableBallConfigFromYaml(root);
     if (duration > 0.0) cfg.duration = duration;  // > 0 checked by CLI11: the config stays valid
     io::LogDirectory log(opt.log_dir);
     runtime::CsvSink csv(log);
     scenarios::TableBallHooks hooks;
     if (log.enabled()) hooks.telemetry = &csv;
     hooks.pacing = opt.pacing();
+    hooks.record_dir = opt.record_dir;
+    hooks.replay_dir = opt.replay_dir;
+    if (!opt.record_dir.empty()) {
+      YAML::Emitter yaml;
+      yaml << root.yaml();
+      hooks.config_text = std::string(yaml.c_str()) + "\n";
+    }
     std::unique_ptr<viz::TableBallDisplay> view;
     if (opt.wantDisplay("table_ball_balancing")) {
       view = std::make_unique<viz::TableBallDisplay>(cfg.table_side, cfg.ball_radius);

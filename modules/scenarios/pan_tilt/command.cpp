@@ -1,6 +1,7 @@
 #include "viewline/scenarios/pan_tilt/command.h"
 
 #include <cmath>
+#include <filesystem>
 #include <memory>
 
 #include "viewline/io/config_edit.h"
@@ -69,20 +70,26 @@ void printSummary(const PanTiltScenarioConfig& cfg, const PanTiltComparison& res
   if (!cfg.rig_folder.empty())
     std::fprintf(out, "  rig %s: renders with truth.yaml, controls with rig.yaml + e_M_c.yaml\n", cfg.rig_folder.c_str());
   std::fprintf(out, "  [T] noise sigma (cm)        x %.3f  y %.3f\n", o.noise_sigma_cm.x(), o.noise_sigma_cm.y());
-  std::fprintf(out, "  rmse measured (cm)          x %.4f  y %.4f\n", o.rmse_measured_cm.x(), o.rmse_measured_cm.y());
-  std::fprintf(out, "  rmse filtered (cm)          x %.4f  y %.4f\n", o.rmse_filtered_cm.x(), o.rmse_filtered_cm.y());
+  if (!o.scored)
+    std::fprintf(out, "  source %s has no truth: rmse, Table 1 and image error not scored\n",
+                 runtime::toString(cfg.source.kind));
+  else
+    std::fprintf(out, "  rmse measured (cm)          x %.4f  y %.4f\n", o.rmse_measured_cm.x(), o.rmse_measured_cm.y());
+  if (o.scored)
+    std::fprintf(out, "  rmse filtered (cm)          x %.4f  y %.4f\n", o.rmse_filtered_cm.x(), o.rmse_filtered_cm.y());
   const TTable1Row t = tTable1(cfg.path.shape);
-  if (t.available) {
+  if (t.available && o.scored) {
     const bool met = o.rmse_filtered_cm.x() <= 0.5 * t.kalman.x() && o.rmse_filtered_cm.y() <= 0.5 * t.kalman.y();
     std::fprintf(out, "  [T] Table 1 measured / KF   x %.4f / %.4f  y %.4f / %.4f  (target: filtered <= %.4f, %.4f): %s\n",
                  t.measured.x(), t.kalman.x(), t.measured.y(), t.kalman.y(), 0.5 * t.kalman.x(), 0.5 * t.kalman.y(),
                  metText(met));
   }
-  std::fprintf(out, "  image error rms (px)        ours %.2f", o.image_error_rms_px);
-  if (result.has_baseline)
+  if (o.scored) std::fprintf(out, "  image error rms (px)        ours %.2f", o.image_error_rms_px);
+  if (result.has_baseline && o.scored)
     std::fprintf(out, "  baseline %.2f  ratio %.3f", result.baseline.image_error_rms_px,
                  o.image_error_rms_px / result.baseline.image_error_rms_px);
-  std::fprintf(out, "\n  limits: unsafe commands %zu, rate violations %zu, hard-stop hits %zu (ours)", o.unsafe_commands,
+  if (o.scored) std::fprintf(out, "\n");
+  std::fprintf(out, "  limits: unsafe commands %zu, rate violations %zu, hard-stop hits %zu (ours)", o.unsafe_commands,
                o.rate_violations, o.limit_hits);
   std::size_t outside = o.unsafe_commands + o.rate_violations + o.limit_hits;
   if (result.has_baseline) {
@@ -113,8 +120,10 @@ void printSummary(const PanTiltScenarioConfig& cfg, const PanTiltComparison& res
 int runCommand(const CommandOptions& o, FrameSink* view, std::FILE* out) {
   std::vector<std::string> edits = o.sets;
   edits.insert(edits.end(), o.shorthands.begin(), o.shorthands.end());
-  const PanTiltScenarioConfig cfg = loadPanTiltScenarioConfig(io::loadConfigWithValues(o.config_path, edits));
-  if (!o.replay.empty()) return runReplay(o, cfg, out);
+  const io::ConfigNode root = io::loadConfigWithValues(o.config_path, edits);
+  const PanTiltScenarioConfig cfg = loadPanTiltScenarioConfig(root);
+  const bool replay_recording = !o.replay.empty() && std::filesystem::is_directory(o.replay);
+  if (!o.replay.empty() && !replay_recording) return runReplay(o, cfg, out);
 
   io::LogDirectory log(o.log_dir);
   runtime::CsvSink csv(log);        // measurements, innovations, estimates, commands
@@ -130,6 +139,13 @@ int runCommand(const CommandOptions& o, FrameSink* view, std::FILE* out) {
   io.frames = frames.empty() ? nullptr : &frames;
   io.pacing = o.pacing;
   io.progress = [&](double f) { progress.update(std::lround(f * static_cast<double>(total))); };
+  io.record_dir = o.record;
+  if (replay_recording) io.replay_dir = o.replay;
+  if (!o.record.empty()) {
+    YAML::Emitter yaml;
+    yaml << root.yaml();
+    io.config_text = std::string(yaml.c_str()) + "\n";
+  }
   const PanTiltComparison result = runPanTiltComparison(cfg, o.seed, io);
   progress.finish();
   csv.flush();

@@ -57,7 +57,10 @@ void PanTiltScenarioConfig::validate() const {
 }
 
 PanTiltScenarioConfig loadPanTiltScenarioConfig(const io::ConfigNode& root) {
+  // First, so that the config reference's probe of each source kind reaches it (a probe is read up to
+  // its first missing required key).
   PanTiltScenarioConfig c;
+  c.source = runtime::readSourceConfig(root);
   {
     const auto p = root.child("path");
     const std::string shape = p.getChoice("shape", {"rectangle", "circle", "random"});

@@ -24,6 +24,7 @@ io::ConfigReferenceSection panTiltConfigReference() {
       "unit: {pan_limits_deg: [-150, 150], tilt_limits_deg: [-47, 31], max_speed_deg: 300, max_acceleration_deg: 1200, "
       "latency: 0.03}\nprocessing_delay: 0.01\n"
       "robot: {kind: flir_ptu, port: /dev/ttyUSB0, baud: 9600, tcp: '127.0.0.1:4000', reply_timeout: 0.5, latency: 0.03}\n"};
+  for (const std::string& p : runtime::sourceConfigProbes("")) s.probes.push_back(p);
   s.read = [](const io::ConfigNode& root) { loadPanTiltScenarioConfig(root); };
   s.keys = {
       {"path", "", "the target's path on the screen"},
@@ -124,6 +125,7 @@ io::ConfigReferenceSection panTiltConfigReference() {
       {"run.occlusion_duration", "s", "length of the occlusion"},
       {"run.baseline", "", "also run ViSP's law on the same seed"},
   };
+  for (const io::ConfigKeyDoc& k : runtime::sourceConfigKeys()) s.keys.push_back(k);
   return s;
 }
 

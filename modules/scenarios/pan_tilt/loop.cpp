@@ -7,8 +7,10 @@
 #include <utility>
 #include <vector>
 
+#include "viewline/core/error.h"
 #include "viewline/core/random.h"
 #include "viewline/runtime/delay_line.h"
+#include "viewline/runtime/recording.h"
 #include "viewline/scenarios/pan_tilt/world.h"
 
 namespace viewline::scenarios {
@@ -58,6 +60,24 @@ tracking::GateDecision decisionOf(const tracking::PlanarTargetFilter::Update& u,
 
 Eigen::VectorXd vec(const Vector2d& v) { return Eigen::VectorXd(v); }
 
+/// The truth columns of a pan-tilt recording (FrameTruth: plane m, pixel px, image error px).
+const std::vector<std::string> kTruthColumns = {"plane_x", "plane_y", "px_u", "px_v", "error_px"};
+
+pan_tilt::FrameTruth truthFromValues(const std::vector<double>& v) {
+  pan_tilt::FrameTruth t;
+  t.plane = Vector2d(v[0], v[1]);
+  t.px = Vector2d(v[2], v[3]);
+  t.error_px = v[4];
+  return t;
+}
+
+pan_tilt::FrameTruth noTruth() {
+  pan_tilt::FrameTruth t;
+  t.plane = t.px = Vector2d::Constant(std::nan(""));
+  t.error_px = std::nan("");
+  return t;
+}
+
 }  // namespace
 
 PanTiltRunMetrics runPanTilt(const PanTiltScenarioConfig& cfg, std::uint64_t seed, PanTiltControllerKind kind,
@@ -97,7 +117,31 @@ PanTiltRunMetrics runPanTilt(const PanTiltScenarioConfig& cfg, std::uint64_t see
   pan_tilt::Scorer score(cfg, world.occlusionStart(), world.occlusionEnd(), world.sigma(), name);
   const double period = 1.0 / cfg.fps;
   const auto n_frames = static_cast<std::size_t>(std::floor(cfg.duration * cfg.fps));
-  pan_tilt::RendererSource source(world, n_frames);
+  // The frame source: the renderer, or the config's source, or a recording of this controller's run.
+  pan_tilt::RendererSource renderer(world, n_frames);
+  std::unique_ptr<runtime::FrameSource> external;
+  const runtime::RecordingSource* recorded = nullptr;
+  if (!io.replay_dir.empty()) {
+    auto r = std::make_unique<runtime::RecordingSource>(io.replay_dir + "/" + name);
+    recorded = r.get();
+    external = std::move(r);
+  } else if (!cfg.source.simulated()) {
+    external = runtime::makeFrameSource(cfg.source);
+    recorded = dynamic_cast<const runtime::RecordingSource*>(external.get());
+  }
+  const bool has_truth = !external || (recorded != nullptr && recorded->truthColumns() == kTruthColumns);
+  runtime::FrameSource* grabber = external ? external.get() : &renderer;
+  std::unique_ptr<runtime::RecordingWriter> writer;
+  std::unique_ptr<runtime::RecordingFrameSource> recorder;
+  if (!io.record_dir.empty()) {
+    writer = std::make_unique<runtime::RecordingWriter>(io.record_dir + "/" + name);
+    writer->setCamera(0, panTiltModelCamera(cfg));  // the calibration the controllers use
+    if (!io.config_text.empty()) writer->setConfig(io.config_text);
+    if (has_truth) writer->setTruthColumns(kTruthColumns);
+    recorder = std::make_unique<runtime::RecordingFrameSource>(*grabber, *writer);
+    grabber = recorder.get();
+  }
+  runtime::FrameSource& source = *grabber;
   CommandsInFlight recent(latency, period);
   runtime::DelayLine<Processed> to_controller;  // the processing delay
   runtime::TelemetrySink* tel = io.telemetry;
@@ -199,7 +243,19 @@ PanTiltRunMetrics runPanTilt(const PanTiltScenarioConfig& cfg, std::uint64_t see
       p.index = k;
       const double tc = frame->capture_time;
       score.frameCaptured();
-      p.truth = world.truth(source.lastCamera(), tc);
+      if (!external) {
+        p.truth = world.truth(renderer.lastCamera(), tc);
+      } else if (has_truth) {
+        const auto values = recorded->truth(frame->camera, frame->sequence);
+        if (!values)
+          throw core::InvalidInput("recording " + recorded->dir() + ": no truth for frame " + std::to_string(frame->sequence));
+        p.truth = truthFromValues(*values);
+      } else {
+        p.truth = noTruth();
+      }
+      if (writer && has_truth)
+        writer->truth(frame->camera, frame->sequence,
+                      {p.truth.plane.x(), p.truth.plane.y(), p.truth.px.x(), p.truth.px.y(), p.truth.error_px});
       // [T] noise draws happen every frame (same sequence for both controllers).
       const Vector2d n = world.drawNoise();
       control::TargetObservation& obs = p.obs;
@@ -241,6 +297,7 @@ PanTiltRunMetrics runPanTilt(const PanTiltScenarioConfig& cfg, std::uint64_t see
         if (io.frames != nullptr && io.frames->quitRequested()) sched.requestStop();
       });
     }
+    if (grabbed >= n_frames) return;  // the run's duration (the renderer ends there by itself)
     if (const auto next = source.nextReadyTime()) sched.at(*next, runtime::priority::Capture, capture);
   };
   if (const auto first = source.nextReadyTime()) sched.at(*first, runtime::priority::Capture, capture);
@@ -255,8 +312,10 @@ PanTiltRunMetrics runPanTilt(const PanTiltScenarioConfig& cfg, std::uint64_t see
 
   const double wall =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - wall0).count();
+  if (writer) writer->finish();
   PanTiltRunMetrics m = score.finish(ours, world.unit(), wall);
   m.stopped = sched.stopRequested();
+  m.scored = has_truth;
   return m;
 }
 

@@ -31,7 +31,7 @@ nlohmann::json PanTiltRunMetrics::toJson() const {
                           {"y", std::isfinite(v.y()) ? nlohmann::json(v.y()) : nlohmann::json()}};
   };
   auto num = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); };
-  return {{"controller", controller},
+  nlohmann::json j = {{"controller", controller},
           {"frames", frames},
           {"detections", detections},
           {"metric_frames", metric_frames},
@@ -60,6 +60,8 @@ nlohmann::json PanTiltRunMetrics::toJson() const {
           {"filter_region_dropped", filter_region_dropped},
           {"filter_corner_settings", {{"min_samples", filter_min_samples}, {"corner_sigma_m", filter_corner_sigma}}},
           {"wall_ms_per_frame", wall_ms_per_frame}};
+  if (!scored) j["truth"] = "not scored (the frame source has no truth)";  // only then: reference summaries unchanged
+  return j;
 }
 
 nlohmann::json PanTiltComparison::toJson(const PanTiltScenarioConfig& cfg) const {
@@ -94,6 +96,7 @@ nlohmann::json PanTiltComparison::toJson(const PanTiltScenarioConfig& cfg) const
         ours.rmse_filtered_cm.x() <= 0.5 * t.kalman.x() && ours.rmse_filtered_cm.y() <= 0.5 * t.kalman.y();
   }
   j["image_error_rms_px"] = ours.image_error_rms_px;
+  if (!ours.scored) j["truth"] = "not scored (the frame source has no truth)";
   if (has_baseline) {
     j["baseline_image_error_rms_px"] = baseline.image_error_rms_px;
     j["image_error_ratio_to_baseline"] = ours.image_error_rms_px / baseline.image_error_rms_px;

@@ -3,6 +3,7 @@
 list(APPEND scenarios_sources
   pan_tilt/command.cpp
   pan_tilt/config.cpp
+  pan_tilt/footage.cpp
   pan_tilt/loop.cpp
   pan_tilt/metrics.cpp
   pan_tilt/replay.cpp
@@ -10,3 +11,7 @@ list(APPEND scenarios_sources
   pan_tilt/world.cpp)
 # Unit and meaning of every key its config reader reads (docs/config_reference.md is generated from it).
 list(APPEND scenarios_sources pan_tilt/config_keys.cpp)
+# Real footage (ViSP's mire-2) through the pan-tilt perception, against ViSP's vpDot2.
+list(APPEND scenarios_tests test/pan_tilt_footage_test.cpp)
+# The loop on other frame sources: record and replay bit for bit, footage not scored.
+list(APPEND scenarios_tests test/pan_tilt_sources_test.cpp)

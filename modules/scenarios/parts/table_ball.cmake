@@ -5,3 +5,5 @@ list(APPEND scenarios_sources table_ball/observer.cpp
 list(APPEND scenarios_tests test/table_ball_observer_test.cpp)
 # Unit and meaning of every key its config reader reads (docs/config_reference.md is generated from it).
 list(APPEND scenarios_sources table_ball/config_keys.cpp)
+# The loop on a recording of its head camera (--record / --replay).
+list(APPEND scenarios_tests test/table_ball_sources_test.cpp)

@@ -15,7 +15,8 @@ io::ConfigReferenceSection tableBallConfigReference() {
       " observer, controller, events and metrics.";
   s.shipped = {"table_ball.yaml", "table_ball_apriltag.yaml"};
   // No shipped file has the inline camera (both name a rig): the camera given by its geometry.
-  s.probes = {"table: {}\nwrist: {}\ncamera: {cx: 320, cy: 240, position: [0.5, 0.0, 1.5], look_at: [0.0, 0.0, 0.9]}\n"};
+  s.probes = {"table: {}\nwrist: {}\ncamera: {cx: 320, cy: 240, position: [0.5, 0.0, 1.5], look_at: [0.0, 0.0, 0.9]}\n",
+              "source: {kind: recording, path: rec}\n"};
   s.read = [](const io::ConfigNode& root) { tableBallConfigFromYaml(root); };
   s.keys = {
       {"duration", "s", "simulated time (--duration overrides it)"},
@@ -89,6 +90,9 @@ io::ConfigReferenceSection tableBallConfigReference() {
       {"metrics.push_band", "m", "recovered from a push when back within this distance for good"},
       {"metrics.compare_tunings", "", "run [M]'s two tunings and the stationary gain beside the loop"},
       {"metrics.time_reference", "", "time the plain OpenCV reference of [M]'s steps on every frame"},
+      {"source", "", "where the frames come from (absent: the rendered head camera)"},
+      {"source.kind", "", "sim (the rendered head camera) or recording (a folder written by --record); other kinds are refused"},
+      {"source.path", "", "recording: the folder written by --record"},
   };
   return s;
 }

@@ -9,7 +9,9 @@
 #include <optional>
 
 #include "viewline/control/table_balancer.h"
+#include "viewline/core/error.h"
 #include "viewline/runtime/delay_line.h"
+#include "viewline/runtime/recording.h"
 #include "viewline/scenarios/table_ball/world.h"
 #include "viewline/vision/table_detector.h"
 
@@ -120,7 +122,21 @@ TableBallResult runTableBall(const TableBallConfig& cfg, std::uint64_t seed, con
   const auto wall0 = std::chrono::steady_clock::now();
   const double period = cfg.framePeriod();
   TableBallWorld world(cfg, seed);
-  RenderedHeadCamera camera(world, cfg.exposure, cfg.duration);
+  // The frame source: the rendered head camera, or a recording of a simulated run (config.source or
+  // hooks.replay_dir). The table, its physics and the truth stay simulated either way.
+  RenderedHeadCamera renderer(world, cfg.exposure, cfg.duration);
+  std::unique_ptr<runtime::RecordingSource> recorded;
+  if (!hooks.replay_dir.empty())
+    recorded = std::make_unique<runtime::RecordingSource>(hooks.replay_dir);
+  else if (cfg.source.kind == runtime::SourceKind::Recording)
+    recorded = std::make_unique<runtime::RecordingSource>(cfg.source.recording);
+  runtime::FrameSource& camera = recorded ? static_cast<runtime::FrameSource&>(*recorded) : renderer;
+  std::unique_ptr<runtime::RecordingWriter> writer;
+  if (!hooks.record_dir.empty()) {
+    writer = std::make_unique<runtime::RecordingWriter>(hooks.record_dir);
+    writer->setCamera(0, world.observerCamera());  // the calibration the observer uses
+    if (!hooks.config_text.empty()) writer->setConfig(hooks.config_text);
+  }
   const core::Camera& obs_camera = world.observerCamera();
   const TableBallObserverConfig ocfg = world.observerConfig();
   TableBallObserver observer(obs_camera, ocfg);
@@ -165,8 +181,28 @@ TableBallResult runTableBall(const TableBallConfig& cfg, std::uint64_t seed, con
     if (ready) sched.at(std::max(sched.now(), *ready - kTimeTolerance), kFramePriority, on_frame);
   };
   on_frame = [&](double) {
+    const double ready = camera.nextReadyTime().value_or(sched.now());
     std::optional<runtime::Frame> frame = camera.grab();
-    const sim::Capture& cap = camera.lastCapture();
+    sim::Capture cap;  // the grab's times, known for a lost frame too (the driver's sequence gap)
+    if (recorded) {
+      const runtime::RecordingEntry* e = recorded->lastEntry();
+      if (e == nullptr || !std::isfinite(e->stamp) || !std::isfinite(e->capture_time))
+        throw core::InvalidInput("recording " + recorded->dir() + ": a lost frame without its times");
+      cap.capture_time = e->capture_time;
+      cap.stamp = e->stamp;
+    } else {
+      cap = renderer.lastCapture();
+    }
+    if (writer) {
+      runtime::Frame meta;
+      meta.capture_time = cap.capture_time;
+      meta.stamp = cap.stamp;
+      meta.sequence = frame ? frame->sequence : cap.sequence;
+      if (frame)
+        writer->frame(ready, *frame);
+      else
+        writer->lost(ready, meta);
+    }
     const double t = cap.stamp;
     const sim::TiltTableState truth = world.stateAt(cap.capture_time);
     const Eigen::Vector2d ref = cfg.setpointAt(t);
@@ -234,6 +270,7 @@ TableBallResult runTableBall(const TableBallConfig& cfg, std::uint64_t seed, con
   sched.at(world.time(), kTickPriority, tick);
   sched.runUntil(std::numeric_limits<double>::infinity());
 
+  if (writer) writer->finish();
   TableBallResult res = metrics.result(seed);
   res.stopped_early = stopped;
   if (sink != nullptr) sink->flush();

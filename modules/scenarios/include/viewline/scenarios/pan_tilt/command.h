@@ -5,6 +5,8 @@
 // a short human summary with "met" / "not met" on each line that states a target.
 //
 //   pan_tilt_tracking --config config/pan_tilt_circle.yaml --seed 1 --summary out.json
+//   pan_tilt_tracking --config config/pan_tilt_circle.yaml --seed 1 --record rec   (frames to rec/<controller>)
+//   pan_tilt_tracking --config config/pan_tilt_circle.yaml --seed 1 --replay rec   (the loop on those frames)
 //   pan_tilt_tracking --config <variant>.yaml --seed 1 --replay <log>/predictive_frames.csv   (filter only)
 //   ... --replay <log>/predictive_frames.csv --oracle-corners   (a bound: the true corner times and speed)
 //   ... --replay <log>/predictive_frames.csv --particles        (the random path's Bayes reference)
@@ -30,7 +32,10 @@ struct CommandOptions {
               summary_path;             ///< --summary JSON file ("" : none)
   bool quiet = false;                   ///< no progress lines
   runtime::Pacing pacing;               ///< wall-clock pacing of the loop (default: as fast as possible)
-  std::string replay;                   ///< frames CSV of a logged run: filter-only replay instead of the loop
+  /// A recording folder (written by --record): the loop on the recorded frames (scored with the
+  /// recorded truth); or a frames CSV of a logged run: filter-only replay instead of the loop.
+  std::string replay;
+  std::string record;                   ///< record each run's frames, truth, camera and config to this folder ("" : none)
   PanTiltReplayEstimator estimator = PanTiltReplayEstimator::Filter;  ///< the replay's estimator
   std::size_t particles = 20000;        ///< of PanTiltReplayEstimator::WaypointParticles
 };

@@ -19,6 +19,7 @@
 #include "viewline/io/config.h"
 #include "viewline/robots/flir_ptu.h"
 #include "viewline/robots/simulated_pan_tilt.h"
+#include "viewline/runtime/source_config.h"
 #include "viewline/sim/physics.h"
 #include "viewline/vision/screen_target_detector.h"
 
@@ -72,6 +73,9 @@ struct PanTiltScenarioConfig {
   double occlusion_start = -1.0;         ///< s (< 0: none)
   double occlusion_duration = 1.0;       ///< s
   bool run_baseline = true;              ///< also run ViSP's law on the same seed for comparison
+  /// Where the frames come from (`source:`; default: the renderer over the simulated world). A
+  /// recording with truth is scored; other sources are not (the unit stays simulated).
+  runtime::SourceConfig source;
 
   void validate() const;  ///< throws core::InvalidInput naming the field
 };

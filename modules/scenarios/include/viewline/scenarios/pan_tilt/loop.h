@@ -21,6 +21,11 @@
 // processing_delay < 1/fps (validated), so every frame's command precedes the next capture: the
 // order of all stateful calls is that of one frame after the other.
 //
+// Frames: the renderer over the simulated world by default; config.source (or PanTiltRunIo::
+// replay_dir) selects another runtime::FrameSource. The simulated unit, the [T] noise draws and the
+// controllers are the same whatever the source. Truth comes from the renderer or from a
+// recording's truth.csv; without it the truth figures are NaN and the metrics say "not scored".
+//
 // Reports: generic telemetry records (measurement and truth per frame, the innovation with the
 // filter's NIS and gate decision, the estimate, the command) to a runtime::TelemetrySink, and one
 // pan_tilt::FrameRecord per frame (display, frames CSV) to a pan_tilt::FrameSink.
@@ -49,6 +54,13 @@ struct PanTiltRunIo {
   pan_tilt::FrameSink* frames = nullptr;        ///< per-frame records; null: none
   runtime::Pacing pacing;                       ///< as fast as possible by default
   std::function<void(double)> progress;         ///< fraction of the run done
+  /// Record each run's frames, truth and camera to record_dir/CONTROLLER, CONTROLLER the law's name
+  /// (runtime::RecordingWriter; "" : none).
+  std::string record_dir;
+  /// Run on the frames recorded in replay_dir/CONTROLLER instead of the config's source: with the
+  /// same config and seed the run, and its summary, are those of the recorded run ("" : none).
+  std::string replay_dir;
+  std::string config_text;  ///< the config as run (YAML), written into a recording
 };
 
 /// Telemetry channels of a run of `controller`: the target's measurements, innovations, estimates

@@ -65,8 +65,11 @@ struct PanTiltRunMetrics {
   /// telemetry's innovation records report them. (Not in the JSON summary.)
   tracking::GateCounts gate;
   bool stopped = false;  ///< the run ended early (a display's quit key)
+  /// The frames came with truth (the simulator, or a recording of it): false for footage, where
+  /// every figure that needs the true target is NaN ("not scored" in the summary).
+  bool scored = true;
 
-  /// Every figure above but the gate counts, as JSON (NaN as null).
+  /// Every figure above but the gate counts, as JSON (NaN as null; "truth": "not scored" when not scored).
   nlohmann::json toJson() const;
 };
 

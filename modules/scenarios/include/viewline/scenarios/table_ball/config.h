@@ -12,6 +12,7 @@
 #include "viewline/core/camera.h"
 #include "viewline/io/config.h"
 #include "viewline/robots/table_tilt.h"
+#include "viewline/runtime/source_config.h"
 #include "viewline/scenarios/table_ball/observer.h"
 
 namespace viewline::scenarios {
@@ -83,6 +84,9 @@ struct TableBallConfig {
   double steady_window = 1.0;                                  ///< s
   double push_band = 0.005;                                    ///< m
   bool compare_tunings = true;                                 ///< run the side filters
+  /// Where the frames come from (`source:`): sim (the rendered head camera, the default) or a
+  /// recording of a simulated run (its truth is the simulated world's, which a replay reproduces).
+  runtime::SourceConfig source;
   bool time_reference = true;                                  ///< time the plain OpenCV reference
 
   /// Throws core::InvalidInput naming the field. tableBallConfigFromYaml calls it; code that

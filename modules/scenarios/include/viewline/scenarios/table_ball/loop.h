@@ -12,6 +12,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <string>
 
 #include "viewline/core/camera.h"
 #include "viewline/runtime/scheduler.h"
@@ -47,6 +48,13 @@ struct TableBallHooks {
   runtime::TelemetrySink* telemetry = nullptr;
   /// Wall-clock pacing (0: as fast as possible); results do not depend on it.
   runtime::Pacing pacing;
+  /// Record the head camera's frames (lost ones with their times) and the config to this folder
+  /// (runtime::RecordingWriter; "" : none).
+  std::string record_dir;
+  /// Run on the frames recorded in this folder instead of config.source (same config and seed:
+  /// the same run; the truth is the simulated table's, which the replay reproduces).
+  std::string replay_dir;
+  std::string config_text;  ///< the config as run (YAML), written into a recording
 };
 
 /// Runs the closed loop for `config.duration` seconds with all randomness from `seed`. The

@@ -1,0 +1,149 @@
+#pragma once
+// viewline's own recordings: every frame of every camera, lossless, with its clock, the camera
+// calibration, the config as run and (from a simulator) the truth, so that a replay feeds the
+// loop exactly the frames it saw and can still be scored.
+//
+// Layout of a recording folder DIR:
+//   recording.csv        the index, one row per grab in grab order:
+//                        ready_time,camera,sequence,capture_time,stamp,file
+//                        (times in s, written with 17 significant digits so they read back bit for
+//                        bit; file is relative to DIR; a grab that lost its frame has an empty file,
+//                        and empty camera..stamp fields unless the source knew them)
+//   cam<k>/<sequence>.png  the images, PNG (lossless for 8-bit grey and BGR)
+//   camera<k>.xml        camera k's calibration, ViSP XML (vpXmlParserCamera), camera name "camera<k>"
+//   config.yaml          the scenario config as run (after --set edits)
+//   truth.csv            optional: camera,sequence,<the scenario's truth columns>
+// Text files are written atomically (io::writeTextFileAtomic), images through a temporary file
+// renamed into place; the index is written by finish(), so an interrupted recording that never
+// reached finish() has no recording.csv and is not mistaken for a complete one.
+//
+// RecordingSource reads it back as a FrameSource: the same frames with the same stamps, sequence
+// numbers, lost grabs and ready times, so a deterministic loop given the replay reproduces its
+// live run. The index and truth parsers refuse bad files with "<file>:<line>: ..." messages.
+
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "viewline/core/camera.h"
+#include "viewline/runtime/frame_source.h"
+
+namespace viewline::runtime {
+
+/// One row of a recording's index.
+struct RecordingEntry {
+  double ready_time = 0.0;     ///< when the grab was made (the source's nextReadyTime), s
+  std::size_t camera = 0;      ///< camera index
+  std::uint64_t sequence = 0;  ///< the frame's per-camera counter
+  double capture_time = 0.0;   ///< mid-exposure, s (NaN: a lost grab whose source did not know it)
+  double stamp = 0.0;          ///< the driver's stamp, s (NaN: as capture_time)
+  std::string file;            ///< image file relative to the folder; empty: the grab lost its frame
+};
+
+/// Parses a recording index (recording.csv text); `file` names it in messages. Refuses a wrong
+/// header, a malformed or non-finite field, ready times that decrease, a sequence that does not
+/// increase per camera, and image paths that are absolute or leave the folder ("..").
+std::vector<RecordingEntry> parseRecordingIndex(const std::string& text, const std::string& file);
+
+/// Per-frame truth of a recording: column names and rows keyed by (camera, sequence).
+struct RecordingTruth {
+  std::vector<std::string> columns;  ///< the scenario's truth columns (after camera,sequence)
+  std::map<std::pair<std::size_t, std::uint64_t>, std::vector<double>> rows;  ///< (camera, sequence) -> values
+};
+/// Parses truth.csv text (header `camera,sequence,` then the truth columns; numeric rows; no duplicate frame).
+RecordingTruth parseRecordingTruth(const std::string& text, const std::string& file);
+
+/// Writes a recording folder (see the file comment). Not thread-safe; one writer per folder.
+class RecordingWriter {
+public:
+  /// Creates `dir` (and parents). Throws core::InvalidInput when it already holds a recording
+  /// (recording.csv): a recording is never overwritten frame by frame.
+  explicit RecordingWriter(std::string dir);
+  /// Writes camera<k>.xml (ViSP XML; with its distortion model when the camera has one).
+  void setCamera(std::size_t camera, const core::Camera& calibration);
+  /// Writes config.yaml: the scenario config as run.
+  void setConfig(const std::string& yaml_text);
+  /// Names the truth columns (before the first truth()); none: no truth.csv.
+  void setTruthColumns(std::vector<std::string> columns);
+  /// Records a frame grabbed at ready_time (the image written now, PNG).
+  void frame(double ready_time, const Frame& frame);
+  /// Records a grab at ready_time that lost its frame.
+  void lost(double ready_time);
+  /// Records a grab at ready_time that lost frame `sequence` of `camera`, whose capture time and
+  /// stamp the source still knows (a driver's sequence gap); `frame.image` is not used.
+  void lost(double ready_time, const Frame& frame);
+  /// The truth of (camera, sequence): one value per truth column.
+  void truth(std::size_t camera, std::uint64_t sequence, const std::vector<double>& values);
+  /// Writes recording.csv and truth.csv (atomically). Further frames are refused.
+  void finish();
+  /// The folder.
+  const std::string& dir() const { return dir_; }
+  /// Grabs recorded so far (lost ones included).
+  std::size_t grabs() const { return entries_.size(); }
+
+private:
+  std::string dir_;
+  std::vector<RecordingEntry> entries_;
+  std::vector<std::size_t> known_lost_;  ///< entries_ indices of lost frames with known fields
+  std::vector<std::string> truth_columns_;
+  std::string truth_text_;
+  bool finished_ = false;
+};
+
+/// A frame source that records every grab of another source into a RecordingWriter.
+class RecordingFrameSource : public FrameSource {
+public:
+  /// Records the grabs of `inner` (both outlive this object).
+  RecordingFrameSource(FrameSource& inner, RecordingWriter& writer) : inner_(inner), writer_(writer) {}
+  std::size_t cameraCount() const override { return inner_.cameraCount(); }
+  /// The inner source's ready time.
+  std::optional<core::Timestamp> nextReadyTime() const override { return inner_.nextReadyTime(); }
+  /// The inner source's grab, recorded (a lost frame too).
+  std::optional<Frame> grab() override;
+
+private:
+  FrameSource& inner_;
+  RecordingWriter& writer_;
+};
+
+/// A recording folder read back as a frame source (same frames, stamps, lost grabs and ready times).
+class RecordingSource : public FrameSource {
+public:
+  /// Reads the index, the truth (when present) and checks that the first image exists; throws
+  /// core::InvalidInput naming the file.
+  explicit RecordingSource(std::string dir);
+  std::size_t cameraCount() const override { return cameras_; }
+  /// The recorded ready time of the next grab, s; nullopt after the last.
+  std::optional<core::Timestamp> nextReadyTime() const override;
+  /// The next recorded frame (nullopt where the live run lost it); throws InvalidInput naming an
+  /// image that is missing or cannot be decoded.
+  std::optional<Frame> grab() override;
+  /// Whether the recording has truth (truth.csv).
+  bool hasTruth() const { return !truth_.columns.empty(); }
+  /// The truth columns (empty without truth).
+  const std::vector<std::string>& truthColumns() const { return truth_.columns; }
+  /// The truth of (camera, sequence), nullopt when the recording has none for it.
+  std::optional<std::vector<double>> truth(std::size_t camera, std::uint64_t sequence) const;
+  /// The calibration of camera k from camera<k>.xml (ViSP XML), nullopt when the file is absent.
+  std::optional<core::Camera> camera(std::size_t k) const;
+  /// The config as run (config.yaml), "" when absent.
+  std::string configText() const;
+  /// The index rows.
+  const std::vector<RecordingEntry>& entries() const { return entries_; }
+  /// The row of the last grab (lost or not), null before the first grab.
+  const RecordingEntry* lastEntry() const { return next_ > 0 ? &entries_[next_ - 1] : nullptr; }
+  /// The folder.
+  const std::string& dir() const { return dir_; }
+
+private:
+  std::string dir_;
+  std::vector<RecordingEntry> entries_;
+  RecordingTruth truth_;
+  std::size_t next_ = 0;
+  std::size_t cameras_ = 1;
+};
+
+}  // namespace viewline::runtime

@@ -1,0 +1,73 @@
+// The pan-tilt loop on other frame sources: a recording of a simulated run replays to the same
+// summary bit for bit; footage without truth runs the loop but is not scored.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <string>
+
+#include "viewline/io/config_edit.h"
+#include "viewline/scenarios/pan_tilt/loop.h"
+
+namespace fs = std::filesystem;
+using namespace viewline;
+
+namespace {
+
+/// A short run (0.7 s, ours only): the loop, not the figures, is under test.
+scenarios::PanTiltScenarioConfig shortRun(std::vector<std::string> edits = {}) {
+  edits.insert(edits.end(), {"run.duration=0.7", "run.metrics_start=0.2", "run.baseline=false"});
+  return scenarios::loadPanTiltScenarioConfig(io::loadConfigWithValues("config/pan_tilt_circle.yaml", edits));
+}
+
+fs::path scratch(const std::string& name) {
+  const fs::path p = fs::path(testing::TempDir()) / ("viewline_pt_" + std::to_string(::getpid()) + "_" + name);
+  fs::remove_all(p);
+  return p;
+}
+
+/// The summary without its wall-clock figure (the only value a replay may change).
+nlohmann::json withoutWallClock(nlohmann::json j) {
+  j["ours"].erase("wall_ms_per_frame");
+  return j;
+}
+
+}  // namespace
+
+TEST(PanTiltSources, ReplayOfARecordingGivesTheLiveSummaryBitForBit) {
+  const auto cfg = shortRun();
+  const fs::path dir = scratch("rec");
+  scenarios::PanTiltRunIo record;
+  record.record_dir = dir.string();
+  record.config_text = "recorded: true\n";
+  const auto live = scenarios::runPanTiltComparison(cfg, 7, record);
+  ASSERT_TRUE(fs::exists(dir / "predictive" / "recording.csv"));
+  ASSERT_TRUE(fs::exists(dir / "predictive" / "truth.csv"));
+  ASSERT_TRUE(fs::exists(dir / "predictive" / "camera0.xml"));
+
+  scenarios::PanTiltRunIo replay;
+  replay.replay_dir = dir.string();
+  const auto again = scenarios::runPanTiltComparison(cfg, 7, replay);
+  EXPECT_TRUE(again.ours.scored);
+  EXPECT_GT(live.ours.detections, 15u);
+  EXPECT_EQ(withoutWallClock(again.toJson(cfg)).dump(), withoutWallClock(live.toJson(cfg)).dump());
+
+  // The same recording named in the config (source: kind recording) replays alike.
+  const auto by_config = shortRun({"source.kind=recording", "source.path=" + (dir / "predictive").string()});
+  const auto third = scenarios::runPanTiltComparison(by_config, 7);
+  EXPECT_EQ(third.ours.image_error_rms_px, live.ours.image_error_rms_px);
+  EXPECT_EQ(third.ours.rmse_filtered_cm, live.ours.rmse_filtered_cm);
+}
+
+TEST(PanTiltSources, FootageWithoutTruthIsNotScored) {
+  const std::string mire = "/usr/share/visp-images-data/ViSP-images/mire-2/image.%04d.pgm";
+  if (!fs::exists("/usr/share/visp-images-data/ViSP-images/mire-2/image.0001.pgm")) GTEST_SKIP() << "visp-images-data missing";
+  const auto cfg = shortRun({"source.kind=images", "source.pattern=" + mire, "source.first=1", "source.rate_hz=30"});
+  const auto r = scenarios::runPanTiltComparison(cfg, 1);
+  EXPECT_FALSE(r.ours.scored);
+  EXPECT_EQ(r.ours.frames, 21u);  // run.duration x the camera's 30 fps, from the sequence's first 21 files
+  EXPECT_TRUE(std::isnan(r.ours.image_error_rms_px));
+  const nlohmann::json j = r.toJson(cfg);
+  EXPECT_EQ(j["truth"], "not scored (the frame source has no truth)");
+  EXPECT_TRUE(j["ours"]["rmse_measured_cm"]["x"].is_null());
+}
