@@ -94,6 +94,8 @@ std::string dartSummaryText(const DartSummary& s) {
           s.late_vs_inorder_max_diff, s.late_inserted, s.late_outcome_mismatches);
   appendf(o, "  single camera, prior <= 70 m off: converged after p95 %.0f (median %.0f) measurements\n",
           s.single_camera_convergence_p95, s.single_camera_convergence_median);
+  appendf(o, "    information limit (ideal filters, true depth): p95 %.0f (median %.0f)\n",
+          s.single_camera_convergence_bound_p95, s.single_camera_convergence_bound_median);
   appendf(o, "  runtime %.1f s\n", s.runtime_s);
   return o;
 }
@@ -145,6 +147,8 @@ nlohmann::json summaryToJson(const DartSummary& s, const DartScenarioConfig& cfg
   j["single_camera_convergence_p95"] = s.single_camera_convergence_p95;
   j["single_camera_convergence_median"] = s.single_camera_convergence_median;
   j["single_camera_not_converged"] = s.single_camera_not_converged;
+  j["single_camera_convergence_bound_p95"] = s.single_camera_convergence_bound_p95;
+  j["single_camera_convergence_bound_median"] = s.single_camera_convergence_bound_median;
   j["runtime_s"] = s.runtime_s;
   return j;
 }

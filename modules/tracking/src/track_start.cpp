@@ -44,72 +44,79 @@ namespace {
 /// The fit of one subset of a tentative track's images.
 struct SubsetFit {
   estimation::StateEstimate est;  ///< at the newest image's sample time
-  double cost = 0.0;              ///< Σ NIS of the second pass (batch LS cost)
+  double cost = 0.0;              ///< Σ NIS of the last pass (the batch LS cost)
   bool feasible = true;           ///< in front of every camera at every used capture time
 };
-
-}  // namespace
-
-namespace detail_start {
-
-// Forward fit over the images with use[i], then the same fit with every row's E[Z²] from the
-// forward fit moved back to the capture time (noise-free, as the refit does).
-SubsetFit fitSubset(const std::vector<core::Camera>& cams, const TrackerConfig& cfg,
-                    const std::vector<MeasurementOutcome>& items, const std::vector<char>& use,
-                    core::Timestamp t0, core::Timestamp t_end, double (*sample)(const TrackerConfig&, double)) {
-  auto pass = [&](const estimation::StateEstimate* depth_from, SubsetFit& out) {
-    estimation::StateEstimate s(cfg.prior_mean, cfg.prior_cov, t0);
-    for (std::size_t i = 0; i < items.size(); ++i) {
-      if (!use[i]) continue;
-      const ImageMeasurement& m = items[i].m;
-      const core::Timestamp st = sample(cfg, m.t);
-      if (st > s.t()) {
-        estimation::predict(s, cfg.model.transition(st - s.t()));
-        s.setTime(st);
-      }
-      const double dt_offset = (cfg.time_mode == TimeMode::Exact) ? 0.0 : m.t - s.t();
-      const core::Camera& cam = cams[m.camera];
-      ViewlineRows rows;
-      if (depth_from == nullptr) {
-        rows = viewlineRows(cam, m.uv, m.sigma_px, s.x(), s.P(), dt_offset, cfg.model, cfg.min_depth,
-                            cfg.depth_variance_in_noise);
-      } else {
-        const double tau = m.t - depth_from->t();
-        const Vector6 xi = cfg.model.propagate(depth_from->x(), tau);
-        Matrix6 Phi = Matrix6::Identity();
-        Phi.topRightCorner<3, 3>() = tau * Eigen::Matrix3d::Identity();
-        const Matrix6 Pi = Phi * depth_from->P() * Phi.transpose();
-        if (cam.toCamera(xi.head<3>()).z() <= cfg.min_depth) out.feasible = false;
-        const double depth_sq =
-            expectedSquaredDepth(cam, xi, Pi, 0.0, cfg.model, cfg.min_depth, cfg.depth_variance_in_noise);
-        rows = viewlineRowsWithDepth(cam, m.uv, m.sigma_px, dt_offset, cfg.model, depth_sq);
-        const Eigen::Vector2d d = rows.y - rows.C * s.x();
-        const Eigen::Matrix2d S = rows.C * s.P() * rows.C.transpose() + rows.R;
-        out.cost += d.dot(S.ldlt().solve(d));
-      }
-      estimation::update(s, estimation::LinearMeasurement{rows.C, rows.y, rows.R});
-    }
-    if (t_end > s.t()) {
-      estimation::predict(s, cfg.model.transition(t_end - s.t()));
-      s.setTime(t_end);
-    }
-    return s;
-  };
-  SubsetFit first{estimation::StateEstimate(cfg.prior_mean, cfg.prior_cov, t0)};
-  const estimation::StateEstimate forward = pass(nullptr, first);
-  SubsetFit out{forward};
-  out.est = pass(&forward, out);
-  return out;
-}
-
-}  // namespace detail_start
-
-namespace {
 
 double sampleOf(const TrackerConfig& cfg, double t) {
   if (cfg.time_mode == TimeMode::Exact) return t;
   return std::floor(t / cfg.sample_period + 1e-9) * cfg.sample_period;
 }
+
+// One filter pass from the prior over the images with use[i]. Row noise: E[Z²] from `depth_from`
+// moved (noise-free, as the young-track refit does) to each capture time, or, without it, from
+// the pass's own prediction. With `out`, sums the NIS and checks the depth of `depth_from`.
+estimation::StateEstimate fitPass(const std::vector<core::Camera>& cams, const TrackerConfig& cfg,
+                                  const std::vector<MeasurementOutcome>& items, const std::vector<char>& use,
+                                  core::Timestamp t0, core::Timestamp t_end,
+                                  const estimation::StateEstimate* depth_from, SubsetFit* out) {
+  estimation::StateEstimate s(cfg.prior_mean, cfg.prior_cov, t0);
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    if (!use[i]) continue;
+    const ImageMeasurement& m = items[i].m;
+    const core::Timestamp st = sampleOf(cfg, m.t);
+    if (st > s.t()) {
+      estimation::predict(s, cfg.model.transition(st - s.t()));
+      s.setTime(st);
+    }
+    const double dt_offset = (cfg.time_mode == TimeMode::Exact) ? 0.0 : m.t - s.t();
+    const core::Camera& cam = cams[m.camera];
+    ViewlineRows rows;
+    if (depth_from == nullptr) {
+      rows = viewlineRows(cam, m.uv, m.sigma_px, s.x(), s.P(), dt_offset, cfg.model, cfg.min_depth,
+                          cfg.depth_variance_in_noise);
+    } else {
+      const double tau = m.t - depth_from->t();
+      const Vector6 xi = cfg.model.propagate(depth_from->x(), tau);
+      Matrix6 Phi = Matrix6::Identity();
+      Phi.topRightCorner<3, 3>() = tau * Eigen::Matrix3d::Identity();
+      const Matrix6 Pi = Phi * depth_from->P() * Phi.transpose();
+      const double depth_sq =
+          expectedSquaredDepth(cam, xi, Pi, 0.0, cfg.model, cfg.min_depth, cfg.depth_variance_in_noise);
+      rows = viewlineRowsWithDepth(cam, m.uv, m.sigma_px, dt_offset, cfg.model, depth_sq);
+      if (out != nullptr && cam.toCamera(xi.head<3>()).z() <= cfg.min_depth) out->feasible = false;
+    }
+    if (out != nullptr) {
+      const Eigen::Vector2d d = rows.y - rows.C * s.x();
+      const Eigen::Matrix2d S = rows.C * s.P() * rows.C.transpose() + rows.R;
+      out->cost += d.dot(S.ldlt().solve(d));
+    }
+    estimation::update(s, estimation::LinearMeasurement{rows.C, rows.y, rows.R});
+  }
+  if (t_end > s.t()) {
+    estimation::predict(s, cfg.model.transition(t_end - s.t()));
+    s.setTime(t_end);
+  }
+  return s;
+}
+
+// The subset's fit: a first pass with the depths of `guess` (the tentative estimate before this
+// image, when there is one: it already holds what the earlier images said) or of the pass's own
+// predictions, then passes with the depths of the previous pass (a fixed-point iteration on the
+// depth-dependent row noise); the last one is tested.
+SubsetFit fitSubset(const std::vector<core::Camera>& cams, const TrackerConfig& cfg,
+                    const std::vector<MeasurementOutcome>& items, const std::vector<char>& use,
+                    core::Timestamp t0, core::Timestamp t_end, const estimation::StateEstimate* guess,
+                    int passes) {
+  estimation::StateEstimate prev = fitPass(cams, cfg, items, use, t0, t_end, guess, nullptr);
+  for (int p = 1; p < passes; ++p) prev = fitPass(cams, cfg, items, use, t0, t_end, &prev, nullptr);
+  SubsetFit out{prev};
+  out.est = fitPass(cams, cfg, items, use, t0, t_end, &prev, &out);
+  return out;
+}
+
+// Passes before the tested one (see fitSubset): one from the guess, one from its own depths.
+constexpr int kDepthPasses = 2;
 
 // Calls f(use) for every mask over n items that sets aside exactly k of them (lexicographic).
 template <class F>
@@ -183,6 +190,8 @@ void ViewlineTracker::stepTentative(TrackState& ts, const ImageMeasurement& m, I
   }
 
   // Maximum-consensus search, fewest set-aside images first.
+  const estimation::StateEstimate before = ts.est;  // the tentative estimate before this image
+  const estimation::StateEstimate* guess = ts.history.size() > 1 ? &before : nullptr;
   const std::size_t n = ts.history.size();
   const core::Timestamp t_end = sampleTime(ts.history.back().m.t);
   const auto max_k = static_cast<std::size_t>(std::max(0, cfg_.start.max_outliers));
@@ -197,7 +206,7 @@ void ViewlineTracker::stepTentative(TrackState& ts, const ImageMeasurement& m, I
     const double threshold =
         dof > 0.0 ? core::chiSquareQuantile(dof, cfg_.start.probability) : std::numeric_limits<double>::infinity();
     forEachExclusion(n, k, [&](const std::vector<char>& use) {
-      SubsetFit f = detail_start::fitSubset(cameras_, cfg_, ts.history, use, ts.track_start_t, t_end, &sampleOf);
+      SubsetFit f = fitSubset(cameras_, cfg_, ts.history, use, ts.track_start_t, t_end, guess, kDepthPasses);
       const bool ok = f.feasible && f.cost <= threshold;
       if (ok) {
         ++consistent_at_level;
@@ -226,6 +235,16 @@ void ViewlineTracker::stepTentative(TrackState& ts, const ImageMeasurement& m, I
     ts.confirmed = true;
     ++ts.confirmations;
   }
+}
+
+void ViewlineTracker::refitConfirmed(TrackState& ts) const {
+  // The young-track refit of a confirmed track (tracker.h) with the start's fixed-point passes:
+  // the fused images of the window, depths first from the current estimate.
+  if (ts.history.empty() || sampleTime(ts.history.front().m.t) != ts.track_start_t) return;
+  std::vector<char> use(ts.history.size());
+  for (std::size_t i = 0; i < use.size(); ++i) use[i] = ts.history[i].fate == Fate::Fused ? 1 : 0;
+  const estimation::StateEstimate current = ts.est;
+  ts.est = fitSubset(cameras_, cfg_, ts.history, use, ts.track_start_t, current.t(), &current, kDepthPasses).est;
 }
 
 void ViewlineTracker::restartTentative(TrackState& ts) {

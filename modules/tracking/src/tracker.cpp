@@ -200,7 +200,12 @@ void ViewlineTracker::step(TrackState& ts, const ImageMeasurement& m, ImageUpdat
   if (fused) ++ts.fused_in_track;
   const GateDecision decision = o.decision;
   ts.history.push_back(std::move(o));
-  if (fused && ts.fused_in_track >= 2 && ts.fused_in_track <= cfg_.refit_young_tracks) refit(ts);
+  if (fused && ts.fused_in_track >= 2 && ts.fused_in_track <= cfg_.refit_young_tracks) {
+    if (cfg_.start.confirm_images > 0)
+      refitConfirmed(ts);
+    else
+      refit(ts);
+  }
   if (ts.history.size() > cfg_.history_capacity) {
     evict(ts.history.front());
     ts.history.erase(ts.history.begin());

@@ -253,6 +253,8 @@ private:
   void refit(TrackState& ts) const;
   /// One image of a tentative track (robust start, track_start.cpp).
   void stepTentative(TrackState& ts, const ImageMeasurement& m, ImageUpdate* update, bool seed);
+  /// Young-track refit of a confirmed track under the robust start (the start's fixed-point fit).
+  void refitConfirmed(TrackState& ts) const;
   /// Restart of a confirmed track under the robust start: tentative again over its newest images.
   void restartTentative(TrackState& ts);
   void evict(const MeasurementOutcome& o) { final_[o.m.id] = o; }

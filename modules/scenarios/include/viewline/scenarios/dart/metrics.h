@@ -76,6 +76,10 @@ struct DartSummary {
   double single_camera_convergence_p95 = 0.0;
   double single_camera_convergence_median = 0.0;  ///< median of the same count
   std::size_t single_camera_not_converged = 0;    ///< runs still off at their last measurement
+  /// The same p95 for two ideal linear Kalman filters (rows with the true depth, same priors,
+  /// no gate): the information limit of the criterion (loop.cpp, idealConvergence).
+  double single_camera_convergence_bound_p95 = 0.0;
+  double single_camera_convergence_bound_median = 0.0;  ///< median of the ideal filters' count
   double runtime_s = 0.0;  ///< wall-clock time of all experiments, s
 };
 
