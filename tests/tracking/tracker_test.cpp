@@ -6,6 +6,7 @@
 #include <map>
 
 // The viewline tracker on generated dart flights (the dart scenario's world is the fixture).
+#include "viewline/core/error.h"
 #include "viewline/core/random.h"
 #include "viewline/scenarios/dart/world.h"
 #include "viewline/tracking/image_ekf.h"
@@ -233,4 +234,55 @@ TEST(Tracker, ResetForgetsTheTrackAndTheLastUpdate) {
     b.submit(d.m);
   }
   EXPECT_EQ((a.state().x() - b.state().x()).cwiseAbs().maxCoeff(), 0.0);  // a reset tracker is a new one
+}
+
+TEST(Tracker, RobustStartSetsAsideAnOutlierSeedAndReportsOnlyAConfirmedTrack) {
+  Fixture f;
+  core::Rng rng = core::makeRng(9);
+  const scenarios::DartFlight fl = simulateFlight(f.cfg, f.cams, DartClockMode::Alternating, 0.0, rng);
+  TrackerConfig tc = f.cfg.tracker;
+  tc.start.confirm_images = 5;
+  ViewlineTracker tr(f.cams, tc);
+  ImageMeasurement seed = fl.detections.front().m;
+  seed.id = 999;
+  seed.t -= 0.005;
+  seed.uv = {600.0, 40.0};  // far from the dart
+  ASSERT_EQ(tr.submit(seed), Refusal::None);
+  EXPECT_TRUE(tr.initialised());
+  EXPECT_FALSE(tr.confirmed());  // one image: nothing to test it against
+  std::size_t confirmed_at = 0;
+  for (std::size_t i = 0; i < fl.detections.size(); ++i) {
+    tr.submit(fl.detections[i].m);
+    if (tr.confirmed() && confirmed_at == 0) {
+      confirmed_at = i + 1;
+      // Confirmed on the inliers alone: the estimate is already on the flight.
+      EXPECT_LT((tr.state().x().head<3>() - fl.detections[i].truth.head<3>()).norm(), 0.05);
+    }
+  }
+  EXPECT_EQ(confirmed_at, 5u);  // the 5 consistent inliers, the outlier set aside
+  EXPECT_EQ(tr.trackState().restarts, 0);
+  ASSERT_TRUE(tr.outcome(999).has_value());
+  EXPECT_NE(tr.outcome(999)->fate, Fate::Fused);
+  for (const scenarios::DartDetection& d : fl.detections) EXPECT_EQ(tr.outcome(d.m.id)->fate, Fate::Fused);
+  EXPECT_LT((tr.state().x().head<3>() - fl.detections.back().truth.head<3>()).norm(), 0.02);
+}
+
+TEST(Tracker, WithoutTheRobustStartTheFirstImageGivesAConfirmedTrack) {
+  Fixture f;
+  core::Rng rng = core::makeRng(9);
+  const scenarios::DartFlight fl = simulateFlight(f.cfg, f.cams, DartClockMode::Alternating, 0.0, rng);
+  ViewlineTracker tr(f.cams, f.cfg.tracker);
+  ASSERT_EQ(f.cfg.tracker.start.confirm_images, 0);
+  tr.submit(fl.detections.front().m);
+  EXPECT_TRUE(tr.confirmed());
+}
+
+TEST(TrackerConfig, RobustStartNeedsAWindowForItsSubsets) {
+  TrackerConfig tc;
+  tc.start.confirm_images = 5;
+  tc.start.max_outliers = 2;
+  tc.start.window = 6;
+  EXPECT_THROW(tc.validate(), core::InvalidInput);
+  tc.start.window = 7;
+  EXPECT_NO_THROW(tc.validate());
 }

@@ -113,6 +113,14 @@ void readTracker(const io::ConfigNode& t, DartScenarioConfig& cfg) {
   tc.max_forward_gap = t.getOr<double>("max_forward_gap_s", tc.max_forward_gap);
   tc.image_margin_px = t.getOr<double>("image_margin_px", tc.image_margin_px);
   cfg.dt_offset_period = t.getOr<double>("dt_offset_period_s", cfg.dt_offset_period);
+  if (t.has("start")) {
+    const io::ConfigNode st = t.child("start");
+    tracking::TrackStartConfig& sc = tc.start;
+    sc.confirm_images = st.getOr<int>("confirm_images", sc.confirm_images);
+    sc.max_outliers = st.getOr<int>("max_outliers", sc.max_outliers);
+    sc.window = st.getOr<unsigned>("window", static_cast<unsigned>(sc.window));
+    sc.probability = st.getOr<double>("probability", sc.probability);
+  }
 }
 
 void readExperiments(const io::ConfigNode& e, DartScenarioConfig& cfg) {

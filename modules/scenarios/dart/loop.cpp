@@ -74,7 +74,7 @@ struct Pools {
   PooledError a_settled, a_final, b_dir, b_mah, b_ekf, c_exact, c_offset, c_ekf, d_scenario;
   double update_time = 0.0;
   std::size_t update_count = 0, measurements = 0;
-  std::vector<double> convergence;
+  std::vector<double> convergence, convergence_bound;
 };
 
 /// One run's experiments; the tracker configurations are derived once per call of the loop.
@@ -94,8 +94,15 @@ public:
   }
 
 private:
-  void settled(PooledError& p, std::size_t i, const estimation::StateEstimate& s, const DartDetection& d) const {
-    if (i >= cfg_.settled_index) p.add(s, d.truth);
+  // A settled measurement counts in the RMSE when the tracker reports an estimate (a confirmed
+  // track, tracker.h's robust start); otherwise it is counted as unreported.
+  void settled(PooledError& p, std::size_t i, const estimation::StateEstimate& s, const DartDetection& d,
+               bool reported = true) const {
+    if (i < cfg_.settled_index) return;
+    if (reported)
+      p.add(s, d.truth);
+    else
+      ++p.unreported;
   }
   void log(const char* exp, const DartDetection& d, Fate fate, const estimation::StateEstimate& s) const {
     if (!cb_.log || s.dim() != 6) return;
@@ -115,6 +122,8 @@ private:
       const auto& s = tr.state();
       log("A_alternating", d, tr.outcome(d.m.id) ? tr.outcome(d.m.id)->fate : Fate::Gated, s);
       const double se = (s.x().head<3>() - d.truth.head<3>()).squaredNorm();
+      if (i >= cfg_.settled_index && !tr.confirmed()) ++p_.a_settled.unreported;
+      if (!tr.confirmed()) continue;
       if (i >= cfg_.settled_index) {
         p_.a_settled.se += se;
         p_.a_settled.bound += bound[i];
@@ -143,8 +152,10 @@ private:
       PooledError& p = kind == GateKind::Directional ? p_.b_dir : p_.b_mah;
       for (std::size_t i = 0; i < f.detections.size(); ++i) {
         tr.submit(f.detections[i].m);
-        settled(p, i, tr.state(), f.detections[i]);
+        settled(p, i, tr.state(), f.detections[i], tr.confirmed());
       }
+      (kind == GateKind::Directional ? sum_.gate_directional : sum_.gate_mahalanobis).restarts +=
+          static_cast<std::size_t>(tr.trackState().restarts);
       countGate(kind == GateKind::Directional ? sum_.gate_directional : sum_.gate_mahalanobis, tr, f);
     }
     tracking::ImageSpaceEkf ekf(cams_, exact_);
@@ -168,9 +179,9 @@ private:
       ++p_.update_count;
       tr_offset.submit(d.m);
       ekf.submit(d.m);
-      settled(p_.c_exact, i, tr_exact.state(), d);
+      settled(p_.c_exact, i, tr_exact.state(), d, tr_exact.confirmed());
       // The Δt-offset estimate lives at a grid instant: compare with the truth at the capture time.
-      settled(p_.c_offset, i, tr_offset.predictAt(d.m.t), d);
+      settled(p_.c_offset, i, tr_offset.predictAt(d.m.t), d, tr_offset.confirmed());
       settled(p_.c_ekf, i, ekf.state(), d);
     }
   }
@@ -184,11 +195,12 @@ private:
     for (std::size_t i = 0; i < f.detections.size(); ++i) {
       const DartDetection& d = f.detections[i];
       tr_exact.submit(d.m);
-      settled(p_.d_scenario, i, tr_exact.state(), d);
+      settled(p_.d_scenario, i, tr_exact.state(), d, tr_exact.confirmed());
       const auto o = tr_exact.outcome(d.m.id);
       log("D_scenario", d, o ? o->fate : Fate::Gated, tr_exact.state());
       if (cb_.telemetry != nullptr) publish(*cb_.telemetry, tr_exact, d);
     }
+    sum_.scenario_gate.restarts += static_cast<std::size_t>(tr_exact.trackState().restarts);
     countGate(sum_.scenario_gate, tr_exact, f);
     // The same detections as a network delivers them: each arrives U(0, late_max_delay) after its
     // capture, and the clock hands them to the tracker in arrival order (ties: capture order).
@@ -246,7 +258,37 @@ private:
       if (diff > cfg_.single_tolerance) converged_after = i + 2;
     }
     if (converged_after > f.detections.size()) ++sum_.single_camera_not_converged;
+    p_.convergence_bound.push_back(static_cast<double>(std::max<std::size_t>(idealConvergence(f, ref, off), 1)));
     p_.convergence.push_back(static_cast<double>(std::max<std::size_t>(converged_after, 1)));
+  }
+
+  // The information limit of experiment E's criterion. Two Bayes filters given the same images
+  // and priors N(x0, P0), N(x0 + Δx0, P0) differ, for a linear-Gaussian model, by exactly
+  // M_n Δx0 with M_n = Π (I − K_k C_k) Φ_k: the prior's remaining weight, whatever the images
+  // say. Here both filters take every row's E[Z²] from the TRUE depth (the one part of the
+  // viewline model that is not linear), so the count below is what the information in the
+  // images allows, without gates, restarts or depth guesses: the tracker cannot do better
+  // without under-weighting its prior.
+  std::size_t idealConvergence(const DartFlight& f, const TrackerConfig& ref, const TrackerConfig& off) const {
+    const double t0 = f.detections.front().m.t;
+    estimation::StateEstimate a(ref.prior_mean, ref.prior_cov, t0), b(off.prior_mean, off.prior_cov, t0);
+    std::size_t converged_after = 0;
+    for (std::size_t i = 0; i < f.detections.size(); ++i) {
+      const DartDetection& d = f.detections[i];
+      const core::Camera& cam = cams_[d.m.camera];
+      const double z = cam.toCamera(d.truth.head<3>()).z();
+      const tracking::ViewlineRows rows =
+          tracking::viewlineRowsWithDepth(cam, d.m.uv, d.m.sigma_px, 0.0, ref.model, z * z);
+      for (estimation::StateEstimate* s : {&a, &b}) {
+        if (d.m.t > s->t()) {
+          estimation::predict(*s, ref.model.transition(d.m.t - s->t()));
+          s->setTime(d.m.t);
+        }
+        estimation::update(*s, estimation::LinearMeasurement{rows.C, rows.y, rows.R});
+      }
+      if ((a.x().head<3>() - b.x().head<3>()).norm() > cfg_.single_tolerance) converged_after = i + 2;
+    }
+    return converged_after;
   }
 
   const DartScenarioConfig& cfg_;
@@ -270,6 +312,8 @@ void finish(DartSummary& sum, const Pools& p, const DartScenarioConfig& cfg, int
     sum.nees_position_bounds = p.nees3.bounds(cfg.confidence);
   }
   sum.rmse_position = p.a_settled.rmse();
+  const std::size_t a_settled = p.a_settled.n + p.a_settled.unreported;
+  sum.reported_fraction = a_settled ? static_cast<double>(p.a_settled.n) / static_cast<double>(a_settled) : 1.0;
   sum.pcrlb_position = sqrtMean(p.a_settled.bound, p.a_settled.n);
   sum.rmse_to_pcrlb = sum.pcrlb_position > 0 ? sum.rmse_position / sum.pcrlb_position : 0.0;
   const double final_bound = sqrtMean(p.a_final.bound, p.a_final.n);
@@ -285,6 +329,7 @@ void finish(DartSummary& sum, const Pools& p, const DartScenarioConfig& cfg, int
   sum.outlier_rejected_fraction = better.outlier_rejected_fraction;
   sum.inlier_rejected_fraction = better.inlier_rejected_fraction;
   sum.rmse_image_ekf_alternating = p.b_ekf.rmse();
+  sum.rmse_outliers_to_outlier_free = sum.rmse_position > 0 ? better.rmse_position / sum.rmse_position : 0.0;
   sum.rmse_async_exact = p.c_exact.rmse();
   sum.rmse_async_dt_offset = p.c_offset.rmse();
   sum.rmse_async_image_ekf = p.c_ekf.rmse();
@@ -296,6 +341,8 @@ void finish(DartSummary& sum, const Pools& p, const DartScenarioConfig& cfg, int
   const bool any = !p.convergence.empty();
   sum.single_camera_convergence_p95 = any ? core::percentileNearestRank(p.convergence, 0.95) : 0.0;
   sum.single_camera_convergence_median = any ? core::percentileNearestRank(p.convergence, 0.5) : 0.0;
+  sum.single_camera_convergence_bound_p95 = any ? core::percentileNearestRank(p.convergence_bound, 0.95) : 0.0;
+  sum.single_camera_convergence_bound_median = any ? core::percentileNearestRank(p.convergence_bound, 0.5) : 0.0;
 }
 
 }  // namespace

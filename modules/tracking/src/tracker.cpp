@@ -51,6 +51,14 @@ void TrackerConfig::validate() const {
   if (history_capacity < 1) throw core::InvalidInput("tracker.history_capacity: expected >= 1");
   core::requirePositive(min_depth, "tracker.min_depth");
   if (!(image_margin_px >= 0.0)) throw core::InvalidInput("tracker.image_margin_px: expected >= 0");
+  if (start.confirm_images < 0) throw core::InvalidInput("tracker.start.confirm_images: expected >= 0");
+  if (start.confirm_images > 0) {
+    if (start.max_outliers < 0) throw core::InvalidInput("tracker.start.max_outliers: expected >= 0");
+    if (start.window < static_cast<std::size_t>(start.confirm_images) + static_cast<std::size_t>(start.max_outliers))
+      throw core::InvalidInput("tracker.start.window: expected >= confirm_images + max_outliers");
+    if (!(start.probability > 0.0 && start.probability < 1.0))
+      throw core::InvalidInput("tracker.start.probability: expected in (0, 1)");
+  }
   if (!(gate.directional_p > 0.0)) throw core::InvalidInput("tracker.gate.directional_p: expected > 0");
   if (!(gate.mahalanobis_alpha > 0.0 && gate.mahalanobis_alpha < 1.0))
     throw core::InvalidInput("tracker.gate.mahalanobis_alpha: expected in (0, 1)");
@@ -166,6 +174,10 @@ void ViewlineTracker::step(TrackState& ts, const ImageMeasurement& m, ImageUpdat
   // prior (the test TrackGate::decide makes below, where it answers Start).
   const TrackGate& life = ts.gate;
   const bool seed = !life.active() || m.t - life.lastUsedTime() > life.config().max_coast_s;
+  if (cfg_.start.confirm_images > 0 && (seed || !ts.confirmed)) {
+    stepTentative(ts, m, update, seed);  // robust start (track_start.cpp)
+    return;
+  }
   if (seed) startTrack(ts, m.t);
   const int fused_before = ts.fused_in_track;
   const core::Timestamp ts_time = sampleTime(m.t);
@@ -188,17 +200,31 @@ void ViewlineTracker::step(TrackState& ts, const ImageMeasurement& m, ImageUpdat
   if (fused) ++ts.fused_in_track;
   const GateDecision decision = o.decision;
   ts.history.push_back(std::move(o));
-  if (fused && ts.fused_in_track >= 2 && ts.fused_in_track <= cfg_.refit_young_tracks) refit(ts);
+  if (fused && ts.fused_in_track >= 2 && ts.fused_in_track <= cfg_.refit_young_tracks) {
+    if (cfg_.start.confirm_images > 0)
+      refitConfirmed(ts);
+    else
+      refit(ts);
+  }
   if (ts.history.size() > cfg_.history_capacity) {
     evict(ts.history.front());
     ts.history.erase(ts.history.begin());
   }
-  if (decision == GateDecision::Restart) restart(ts);
+  if (decision == GateDecision::Restart) {
+    if (cfg_.start.confirm_images > 0)
+      restartTentative(ts);
+    else
+      restart(ts);
+  }
 }
 
 void ViewlineTracker::refit(TrackState& ts) const {
   // Only when the whole track is in the history (not capped), else nothing to refit from.
-  if (ts.history.empty() || !ts.history.front().seed) return;
+  // (A robust start's sliding window moves the track's prior to its oldest image: also whole.)
+  if (ts.history.empty()) return;
+  const bool whole = ts.history.front().seed ||
+                     (cfg_.start.confirm_images > 0 && sampleTime(ts.history.front().m.t) == ts.track_start_t);
+  if (!whole) return;
   const Vector6 xk = ts.est.x();
   const Matrix6 Pk = ts.est.P();
   const core::Timestamp tk = ts.est.t();

@@ -40,6 +40,13 @@
 // rest of the history and the current image (gated as usual). The state therefore depends only
 // on past measurements (causal), which keeps the late-data replay exact.
 //
+// Robust start (TrackerConfig::start, off by default; track_start.cpp). With confirm_images > 0 a
+// new track is TENTATIVE: it keeps its newest images and, after each, searches the largest subset
+// of them that one ballistic flight explains (joint chi-square test, up to max_outliers images set
+// aside); it is confirmed (confirmed() true: trusted, reported) once that subset is unique and has
+// confirm_images images. A restart makes the track tentative again over its newest images, so
+// neither a start nor a restart can be seeded by one outlier.
+//
 // Each processed image reports what happened to it: its outcome carries the track gate's
 // decision (Start, Accept, Reject, Restart), and lastUpdate() gives the submitted image's
 // innovation, S and NIS as the tracker formed them, so a telemetry sink or a tuning tool reads
@@ -120,6 +127,17 @@ struct ImageUpdate {
   int fused_before = 0;  ///< fused images of the track the image was tested against (0 for Start)
 };
 
+/// Robust track start (track_start.cpp): a new track stays tentative until `confirm_images` images
+/// of its window are jointly consistent with the ballistic model, setting aside up to `max_outliers`
+/// of them; only a confirmed track is trusted (confirmed()). 0 images: the first image seeds the
+/// track untested and the track counts as confirmed at once (the life cycle described above).
+struct TrackStartConfig {
+  int confirm_images = 0;      ///< M, consistent images a tentative track needs; 0 disables the robust start
+  int max_outliers = 2;        ///< images of the window the start may set aside (the subsets it searches)
+  std::size_t window = 10;     ///< newest images a tentative track keeps (older ones are dropped)
+  double probability = 0.999;  ///< chi-square probability of the joint consistency test of a subset
+};
+
 /// Configuration of the viewline tracker: model, prior, gate, time handling, late-data horizon, restarts and
 /// noise model.
 struct TrackerConfig {
@@ -145,6 +163,7 @@ struct TrackerConfig {
   /// convergence). 0 disables it. Causal (uses only the track history), so late replay stays exact.
   int refit_young_tracks = 8;
   double image_margin_px = 0.5;       ///< pixels this far outside the image are still accepted
+  TrackStartConfig start;             ///< robust start (off by default: the first image seeds the track)
   /// Throws core::InvalidInput naming the field.
   void validate() const;
 };
@@ -161,6 +180,10 @@ struct TrackState {
   std::vector<MeasurementOutcome> history;  ///< since the track's seed (capped)
   int tracks_started = 0;  ///< tracks started so far (seeds)
   int restarts = 0;  ///< restarts after rejections in a row
+  /// False while a robust start (TrackStartConfig) has not yet found a consistent subset of
+  /// confirm_images images; always true without the robust start.
+  bool confirmed = true;
+  int confirmations = 0;  ///< tentative tracks confirmed so far (robust start)
 };
 
 /// One image fused into an estimate at the estimate's time + dt_offset: builds the rows, gates
@@ -182,6 +205,8 @@ public:
 
   /// True while a track is live.
   bool initialised() const { return state_.gate.active(); }
+  /// True while a live track is confirmed (trusted): always, once live, without the robust start.
+  bool confirmed() const { return state_.gate.active() && state_.confirmed; }
   /// The estimate after the newest processed measurement (time = its capture time, or its grid
   /// instant in DtOffset mode).
   const estimation::StateEstimate& state() const { return state_.est; }
@@ -226,6 +251,12 @@ private:
   void startTrack(TrackState& ts, core::Timestamp t);
   void restart(TrackState& ts);
   void refit(TrackState& ts) const;
+  /// One image of a tentative track (robust start, track_start.cpp).
+  void stepTentative(TrackState& ts, const ImageMeasurement& m, ImageUpdate* update, bool seed);
+  /// Young-track refit of a confirmed track under the robust start (the start's fixed-point fit).
+  void refitConfirmed(TrackState& ts) const;
+  /// Restart of a confirmed track under the robust start: tentative again over its newest images.
+  void restartTentative(TrackState& ts);
   void evict(const MeasurementOutcome& o) { final_[o.m.id] = o; }
   core::Timestamp sampleTime(core::Timestamp t) const;
 

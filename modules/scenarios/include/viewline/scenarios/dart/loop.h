@@ -15,7 +15,11 @@
 //                 by the scenario clock, runtime::Scheduler): maximum difference of the final
 //                 states and of the per-measurement decisions.
 //  E single cam   one camera, priors up to `single_offset_max` off (position and velocity),
-//                 P0 = std² I, vs a filter started at the truth.
+//                 P0 = std² I, vs a filter started at the truth; and the same criterion for two
+//                 ideal linear filters with the true depth (its information limit).
+//
+// With the tracker's robust start (tracker.start) the RMSE, NEES and PCRLB pool only the
+// estimates the tracker reports (a confirmed track); the share is each figure's reported_fraction.
 //
 //   const auto cfg = scenarios::loadDartScenario("config/dart_tracking.yaml");
 //   const scenarios::DartSummary s = scenarios::runDartExperiments(cfg, seed, 500);

@@ -25,6 +25,10 @@ struct GateFigures {
   double outlier_rejected_fraction = 0.0;  ///< outliers_rejected / outliers
   double inlier_rejected_fraction = 0.0;   ///< inliers_rejected / inliers
   double rmse_position = 0.0;  ///< pooled over settled measurements, m
+  /// Settled measurements after which the tracker reported an estimate (a confirmed track) /
+  /// all settled measurements; the RMSE pools only the reported ones.
+  double reported_fraction = 1.0;
+  std::size_t restarts = 0;  ///< track restarts (rejections in a row) summed over the runs
 };
 
 /// The figures of experiments A-E over all runs (see loop.h for what each experiment does).
@@ -41,6 +45,7 @@ struct DartSummary {
   double pcrlb_position = 0.0;        ///< m (A, settled)
   double rmse_to_pcrlb = 0.0;         ///< rmse_position / pcrlb_position (1: efficient)
   double rmse_to_pcrlb_final = 0.0;   ///< at the last measurement of each flight
+  double reported_fraction = 1.0;     ///< settled measurements of A with a confirmed track / all
   double measurements_per_flight = 0.0;  ///< mean in-image detections per flight (A)
   // B
   GateFigures gate_directional,   ///< the directional gate on B's data
@@ -49,6 +54,8 @@ struct DartSummary {
   double outlier_rejected_fraction = 0.0;  ///< better gate
   double inlier_rejected_fraction = 0.0;   ///< better gate
   double rmse_image_ekf_alternating = 0.0;  ///< image-space EKF baseline on B's data, m
+  /// The better gate's RMSE (B, outliers) / the outlier-free RMSE of A (1: outliers cost nothing).
+  double rmse_outliers_to_outlier_free = 0.0;
   // C
   double rmse_async_exact = 0.0,      ///< exact propagation to each stamp, m
          rmse_async_dt_offset = 0.0,  ///< Δt-offset rows on a fixed grid, m
@@ -69,6 +76,10 @@ struct DartSummary {
   double single_camera_convergence_p95 = 0.0;
   double single_camera_convergence_median = 0.0;  ///< median of the same count
   std::size_t single_camera_not_converged = 0;    ///< runs still off at their last measurement
+  /// The same p95 for two ideal linear Kalman filters (rows with the true depth, same priors,
+  /// no gate): the information limit of the criterion (loop.cpp, idealConvergence).
+  double single_camera_convergence_bound_p95 = 0.0;
+  double single_camera_convergence_bound_median = 0.0;  ///< median of the ideal filters' count
   double runtime_s = 0.0;  ///< wall-clock time of all experiments, s
 };
 
@@ -79,6 +90,7 @@ struct PooledError {
   double bound = 0.0;  ///< sum of the position PCRLB traces, m²
   double nees = 0.0;   ///< sum of the position NEES
   std::size_t n = 0;   ///< measurements pooled
+  std::size_t unreported = 0;  ///< settled measurements without a reported (confirmed) estimate
   /// √(se / n); 0 when nothing was pooled.
   double rmse() const;
   /// Adds the estimate's error against the truth (and its position NEES).
