@@ -277,7 +277,8 @@ private:
                       have ? S(0, 1) : std::nan(""), have ? S(1, 1) : std::nan(""), have ? nis : std::nan(""),
                       fused ? 1.0 : 0.0, have && fused ? 1.0 : 0.0});
       }
-      if (!tracker.initialised()) continue;
+      // Only the estimates the tracker reports (a confirmed track), as the dart scenario scores them.
+      if (!tracker.confirmed()) continue;
       const estimation::StateEstimate& s = tracker.state();
       if (fl.has_truth) {
         const double e = (s.x().head<3>() - det.truth.head<3>()).norm();
