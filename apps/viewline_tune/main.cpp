@@ -24,7 +24,7 @@ std::atomic<int> g_signal{0};     // the signal that set it
 
 // First SIGINT (Ctrl-C) or SIGTERM: stop launching runs and write what is done; a second one ends
 // the program (the default action).
-extern "C" void onStopSignal(int sig) {
+extern "C" void onTuneStopSignal(int sig) {
   g_signal.store(sig);
   g_stop.store(true);
   std::signal(sig, SIG_DFL);
@@ -45,8 +45,8 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string("viewline ") + viewline::core::kVersion);
   tuning::TuneCommandLine command_line(app);
   if (const auto code = apps::parseCommandLine(app, argc, argv)) return *code;
-  std::signal(SIGINT, onStopSignal);
-  std::signal(SIGTERM, onStopSignal);
+  std::signal(SIGINT, onTuneStopSignal);
+  std::signal(SIGTERM, onTuneStopSignal);
   // Bad input (a sweep file's key, a scenario refusing a value) is a usage error here: exit 2, as
   // tutorials/tune_tracking_loop documents; anything else (a full disk, a numerical failure) is a
   // runtime error (1). A session stopped by a signal exits 128 + its number (130, 143).
