@@ -41,22 +41,26 @@ function(viewline_add_module name)
   set_property(GLOBAL APPEND PROPERTY VIEWLINE_MODULES ${name})
 endfunction()
 
-# viewline_add_test(<name> SOURCES ... DEPENDS ... [LABELS ...] [TIMEOUT s])
+# viewline_add_test(<name> SOURCES ... DEPENDS ... [LABELS ...] [TIMEOUT s] [RUN_SERIAL])
 # One GoogleTest executable; every TEST() becomes a ctest test.
 function(viewline_add_test name)
   if(NOT VIEWLINE_BUILD_TESTS)
     return()
   endif()
-  cmake_parse_arguments(ARG "" "TIMEOUT" "SOURCES;DEPENDS;LABELS" ${ARGN})
+  cmake_parse_arguments(ARG "RUN_SERIAL" "TIMEOUT" "SOURCES;DEPENDS;LABELS" ${ARGN})
   if(NOT ARG_TIMEOUT)
     set(ARG_TIMEOUT 300)
+  endif()
+  set(serial FALSE)
+  if(ARG_RUN_SERIAL)  # tests that time several processes (e.g. DDS nodes): alone on the machine
+    set(serial TRUE)
   endif()
   add_executable(${name} ${ARG_SOURCES})
   target_link_libraries(${name} PRIVATE ${ARG_DEPENDS} GTest::gtest GTest::gtest_main viewline::warnings)
   set_target_properties(${name} PROPERTIES CXX_EXTENSIONS OFF)
   gtest_discover_tests(${name}
     WORKING_DIRECTORY ${PROJECT_SOURCE_DIR}
-    PROPERTIES LABELS "${ARG_LABELS}" TIMEOUT ${ARG_TIMEOUT}
+    PROPERTIES LABELS "${ARG_LABELS}" TIMEOUT ${ARG_TIMEOUT} RUN_SERIAL ${serial}
     DISCOVERY_TIMEOUT 60)
 endfunction()
 

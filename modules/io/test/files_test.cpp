@@ -14,6 +14,7 @@
 
 using namespace viewline::io;
 using viewline::core::InvalidInput;
+using viewline::core::IoError;
 using viewline::io::test::TempDir;
 
 namespace {
@@ -133,7 +134,7 @@ TEST(Files, AFullDiskNamesTheFileAndLeavesTheOldContent) {
     try {
       writeTextFileAtomic(path, std::string(100000, 'x'));
       FAIL() << "a write past the limit succeeded";
-    } catch (const InvalidInput& e) {
+    } catch (const IoError& e) {  // the system refused: a runtime error, not bad input
       const std::string msg = e.what();
       EXPECT_NE(msg.find(path), std::string::npos) << msg;
       EXPECT_NE(msg.find("cannot write"), std::string::npos) << msg;
@@ -189,7 +190,7 @@ TEST(Log, AFullDiskThrowsNamingTheLogAndLeavesNoPartialFile) {
       for (int i = 0; i < 100000; ++i) s.row({1.0 * i, 2.0 * i, 3.0 * i});
       log.flush();
       FAIL() << "no error past the file size limit";
-    } catch (const InvalidInput& e) {
+    } catch (const IoError& e) {
       EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
     }
     EXPECT_FALSE(s.enabled());  // the log ended at the error
