@@ -46,6 +46,8 @@ int main(int argc, char** argv) {
       ->capture_default_str()->check(CLI::PositiveNumber);
   cli.add_option("--max-wall", opt.max_wall_s, "end after this much wall time, s")->capture_default_str();
   cli.add_option("--summary", opt.summary_path, "write the node's JSON summary here");
+  cli.add_option("--track-log", opt.track_log_path,
+                 "tracker: CSV of every fused detection (update time, camera, stamp, delay, position, sigma)");
   if (const auto code = apps::parseCommandLine(cli, argc, argv)) return *code;
   return apps::runGuarded("viewline_node " + role, [&] {
     const auto cfg = scenarios::loadBallCatchingConfig(io::loadConfigWithValues(config_path, sets));

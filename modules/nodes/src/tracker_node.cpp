@@ -1,7 +1,12 @@
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <memory>
 #include <set>
 
 #include "node_common.h"
 #include "viewline/core/error.h"
+#include "viewline/io/files.h"
 #include "viewline/nodes/simulation.h"
 #include "viewline/planning/catch_planner.h"
 #include "viewline/robots/cartesian_robot.h"
@@ -72,6 +77,23 @@ nlohmann::json runTrackerNode(const scenarios::BallCatchingConfig& cfg, const No
     ++track_msgs;
   };
 
+  // Optional per-detection log (opt.track_log_path), a row as each detection is fused; closed (and
+  // its errors reported) when the node ends, also on SIGINT/SIGTERM.
+  std::unique_ptr<std::FILE, int (*)(std::FILE*)> track_log(nullptr, &std::fclose);
+  if (!opt.track_log_path.empty()) {
+    track_log.reset(std::fopen(opt.track_log_path.c_str(), "w"));
+    if (!track_log) io::throwFileError("tracker: track log " + opt.track_log_path, errno);
+    std::fprintf(track_log.get(), "t,camera,stamp,delay_s,x,y,z,sigma_m\n");
+  }
+  auto logTrack = [&](std::size_t c, double t_update, double stamp) {
+    if (!track_log) return;
+    const estimation::StateEstimate& s = tracker.state();
+    const double sigma = std::sqrt(s.P().topLeftCorner<3, 3>().trace());
+    if (std::fprintf(track_log.get(), "%.6f,%zu,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f\n", t_update, c, stamp, t_update - stamp,
+                     s.x()(0), s.x()(1), s.x()(2), sigma) < 0)
+      io::throwFileError("tracker: track log " + opt.track_log_path, errno);
+  };
+
   bool draining = false;
   while (!ctx.shouldStop()) {
     ws.wait(0.02);
@@ -113,6 +135,7 @@ nlohmann::json runTrackerNode(const scenarios::BallCatchingConfig& cfg, const No
       const auto o = tracker.outcome(m.id);
       if (!o || o->fate != tracking::Fate::Fused || !tracker.initialised()) return;
       ++cd.fused;
+      logTrack(c, clock.now(), stamp);
       publishTrack();
       planner.update(std::max(clock.now(), stamp), tracker.state());
     });
@@ -153,6 +176,9 @@ nlohmann::json runTrackerNode(const scenarios::BallCatchingConfig& cfg, const No
     if (draining) break;
     draining = ctx.worldFinished();  // one more pass takes what is still in flight
   }
+
+  if (track_log && std::fclose(track_log.release()) != 0)
+    io::throwFileError("tracker: track log " + opt.track_log_path, errno);
 
   nlohmann::json j;
   j["role"] = "tracker";

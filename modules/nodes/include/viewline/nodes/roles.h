@@ -51,6 +51,10 @@ struct NodeOptions {
   double setpoint_deadline_s = 0.1;  ///< set-point deadline, s of wall time (robot halts past it)
   double max_wall_s = 60.0;      ///< any node ends after this much wall time, s
   std::string summary_path;      ///< JSON summary written here at the end ("" : none)
+  /// tracker: CSV written here with one row per fused detection ("" : none): the update time and
+  /// the detection's camera, capture stamp and delay (s of simulated time), the ball's estimated
+  /// world position (m) and its standard deviation (m, root of the position covariance's trace)
+  std::string track_log_path;
 };
 
 /// The world node (header comment); returns its summary.
