@@ -23,6 +23,7 @@ struct CameraDelivery {
   std::string name;
   std::uint64_t received = 0, detected = 0, fused = 0, refused = 0;
   std::uint64_t first_frame = 0, last_frame = 0;
+  std::uint64_t earlier_span = 0;  // frames the camera numbered before it restarted (its count starts again)
   bool any = false, alive = true;
   std::vector<double> delays;  // capture stamp -> tracker update, s of simulated time
 };
@@ -59,7 +60,7 @@ nlohmann::json runTrackerNode(const scenarios::BallCatchingConfig& cfg, const No
   for (std::size_t i = 0; i < cams.size(); ++i) cam[i].name = cams[i].name;
   std::map<dds_instance_handle_t, std::size_t> writer_camera;  // detection writer -> camera index
   std::set<std::size_t> refused_rig;
-  nlohmann::json left = nlohmann::json::array(), foreign = nlohmann::json::array();
+  nlohmann::json left = nlohmann::json::array(), rejoined = nlohmann::json::array(), foreign = nlohmann::json::array();
   std::uint64_t next_id = 1, track_msgs = 0, setpoints = 0, unknown_camera = 0;
   double next_control = 0.0;
   const std::string world_frame = "world";
@@ -115,11 +116,20 @@ nlohmann::json runTrackerNode(const scenarios::BallCatchingConfig& cfg, const No
         return;
       }
       const std::size_t c = d.camera;
-      writer_camera[info.publication_handle] = c;
       CameraDelivery& cd = cam[c];
+      const bool new_writer = writer_camera.emplace(info.publication_handle, c).second;
       if (refused_rig.count(c)) {
         ++cd.refused;
         return;
+      }
+      if (new_writer && !cd.alive) {
+        // The camera left and a new writer for it speaks: the node was restarted. Its frame
+        // numbers start again, so the frames it numbered before count apart.
+        cd.alive = true;
+        if (cd.any) cd.earlier_span += cd.last_frame - cd.first_frame + 1;
+        cd.any = false;
+        ctx.log("camera %s rejoined at t = %.3f s", cd.name.c_str(), clock.now());
+        rejoined.push_back({{"camera", cd.name}, {"t", clock.now()}, {"wall_s", ctx.wallSeconds()}});
       }
       ++cd.received;
       if (!cd.any || d.frame_number < cd.first_frame) cd.first_frame = d.frame_number;
@@ -197,10 +207,11 @@ nlohmann::json runTrackerNode(const scenarios::BallCatchingConfig& cfg, const No
   j["setpoints"] = setpoints;
   j["unknown_camera"] = unknown_camera;
   j["cameras_left"] = left;
+  j["cameras_rejoined"] = rejoined;
   j["cameras_refused"] = foreign;
   nlohmann::json cj = nlohmann::json::array();
   for (const CameraDelivery& cd : cam) {
-    const std::uint64_t span = cd.any ? cd.last_frame - cd.first_frame + 1 : 0;
+    const std::uint64_t span = cd.earlier_span + (cd.any ? cd.last_frame - cd.first_frame + 1 : 0);
     // Apparent clock offset, the minimum filter of NTP: delay = transport − offset for a camera
     // whose clock runs `offset` ahead of the time base, so −min(delay) = offset − the smallest
     // transport delay (a slight underestimate of the offset).
@@ -216,7 +227,7 @@ nlohmann::json runTrackerNode(const scenarios::BallCatchingConfig& cfg, const No
                   {"delay_p99_s", detail::quantile(cd.delays, 0.99)},
                   {"apparent_clock_offset_s", offset},
                   {"alive", cd.alive}});
-    if (cd.any)
+    if (cd.received > 0)
       ctx.log("%s: %llu frames (%llu lost), delay p50 %.2f ms p99 %.2f ms, apparent clock offset %.2f ms", cd.name.c_str(),
               static_cast<unsigned long long>(cd.received), static_cast<unsigned long long>(span - std::min(span, cd.received)),
               1e3 * detail::quantile(cd.delays, 0.5), 1e3 * detail::quantile(cd.delays, 0.99), 1e3 * offset);
