@@ -111,11 +111,15 @@ public:
     if (!f) return {};
     return nlohmann::json::parse(f);
   }
-  // The common arguments of node `name` (role, config, domain, seed, summary file).
+  // The common arguments of node `name` (role, config, domain, seed, summary file). The tracker
+  // skips the camera-to-robot registration unless `registered` (the in-process references below
+  // track with the calibrated rig, and it saves seconds).
   std::vector<std::string> args(const std::string& role, const std::string& name, int domain,
-                                std::vector<std::string> more = {}) const {
-    std::vector<std::string> a{role, "--config", kConfig, "--domain", std::to_string(domain), "--seed", "3",
+                                std::vector<std::string> more = {}, bool registered = false,
+                                const std::string& seed = "3") const {
+    std::vector<std::string> a{role, "--config", kConfig, "--domain", std::to_string(domain), "--seed", seed,
                                "--summary", path(name + ".json"), "--max-wall", "40"};
+    if (role == "tracker" && !registered) a.insert(a.end(), {"--set", "registration.enabled=false"});
     a.insert(a.end(), more.begin(), more.end());
     return a;
   }
@@ -273,4 +277,32 @@ TEST_F(NodesLoopback, ACameraWithAnotherRigIsRefused) {
   ASSERT_EQ(n.wait("tracker", 10.0), 0) << n.log("tracker");
   EXPECT_EQ(n.summary("tracker").at("cameras_refused").size(), 1u) << n.log("tracker");
   EXPECT_NE(n.log("tracker").find("REFUSED camera0"), std::string::npos);
+}
+
+TEST_F(NodesLoopback, ASessionOfThrowsIsScoredByTheWorldWithEveryNodeStartingAfreshPerThrow) {
+  const int domain = nodes::test::testDomain(15);
+  Nodes n("session");
+  n.start("tracker", n.args("tracker", "tracker", domain, {}, /*registered=*/true, "1"));
+  n.start("robot", n.args("robot", "robot", domain, {}, false, "1"));
+  n.start("camera0", n.args("camera", "camera0", domain, {"--camera", "0"}, false, "1"));
+  n.start("camera1", n.args("camera", "camera1", domain, {"--camera", "1"}, false, "1"));
+  n.start("world", n.args("world", "world", domain, {"--expect", "4", "--duration", "1.5", "--throws", "3"}, false, "1"));
+  ASSERT_EQ(n.wait("world", 40.0), 0) << n.log("world");
+  for (const char* name : {"tracker", "robot", "camera0", "camera1"}) ASSERT_EQ(n.wait(name, 10.0), 0) << n.log(name);
+  const nlohmann::json w = n.summary("world"), tr = n.summary("tracker"), rb = n.summary("robot");
+  EXPECT_EQ(w.at("throws_scored").get<int>(), 3) << w.dump(1);
+  EXPECT_EQ(tr.at("episodes").get<int>(), 3);
+  EXPECT_EQ(rb.at("episodes").get<int>(), 3);
+  ASSERT_FALSE(tr.at("registration").is_null());
+  EXPECT_LT(tr.at("registration").at("reprojection_px_after").get<double>(), 0.5);
+  // Every set point within the limits across the resets (none from an old plan after a new start).
+  EXPECT_EQ(rb.at("velocity_violations").get<int>() + rb.at("acceleration_violations").get<int>(), 0) << n.log("robot");
+  // The throws of seed 1 the oracle can reach (the first two of three) are caught through the nodes (the clearance is 5 mm).
+  const int reachable = w.at("reachable_throws").get<int>();
+  ASSERT_GE(reachable, 1) << w.dump(1);
+  EXPECT_EQ(w.at("caught_reachable").get<int>(), reachable) << w.dump(1);
+  for (const nlohmann::json& t : w.at("per_throw"))
+    if (t.at("caught").get<bool>()) {
+      EXPECT_LE(t.at("miss_distance_mm").get<double>(), 5.0);
+    }
 }

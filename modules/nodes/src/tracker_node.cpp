@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -9,6 +10,10 @@
 #include "viewline/io/files.h"
 #include "viewline/nodes/simulation.h"
 #include "viewline/planning/catch_planner.h"
+#include "viewline/core/random.h"
+#include "viewline/scenarios/ball_catching/flight_fit.h"
+#include "viewline/scenarios/ball_catching/registration.h"
+#include "viewline/sim/worlds.h"
 #include "viewline/robots/cartesian_robot.h"
 #include "viewline/tracking/tracker.h"
 
@@ -28,28 +33,59 @@ struct CameraDelivery {
   std::vector<double> delays;  // capture stamp -> tracker update, s of simulated time
 };
 
+// Gravity and drag of the flight as the planner's crossing model has them, for the flight fit
+// (the in-process loop's rule: scenarios/ball_catching/loop.cpp).
+estimation::DragBallisticModel fitModel(const scenarios::BallCatchingConfig& cfg) {
+  const planning::CrossingModel m = cfg.plannerConfig().model;
+  estimation::DragBallisticModel d;
+  d.g = m.gravity_w.norm();
+  d.up = -m.gravity_w / d.g;
+  d.k = m.kind == planning::FlightModel::Drag ? m.drag_k : 0.0;
+  d.q = 0.0;
+  return d;
+}
+
 }  // namespace
 
-nlohmann::json runTrackerNode(const scenarios::BallCatchingConfig& cfg, const NodeOptions& opt) {
-  NodeContext ctx(opt, "tracker", "tracker", rigHash(cfg));
-  // The estimators as the ball-catching loop builds them (loop.cpp: ThrowLoop): the calibrated
-  // cameras, the scenario's tracker config, the planner asking the robot model for its limits.
-  // Camera-to-robot registration (registration.enabled) is a session step of the in-process loop
-  // that renders images; the nodes use the calibrated rig as it is.
+nlohmann::json runTrackerNode(const scenarios::BallCatchingConfig& config, const NodeOptions& opt) {
+  NodeContext ctx(opt, "tracker", "tracker", rigHash(config));
+  // The estimators as the ball-catching session builds them (loop.cpp: runBallCatching, ThrowLoop):
+  // the calibrated cameras registered to the robot first (registration.enabled: the session step
+  // that shows the robot's marker to the cameras, simulated here with the session's room and seed,
+  // as on a real rig one would register before starting the nodes), the scenario's tracker config,
+  // the planner asking the robot model for its limits.
+  scenarios::BallCatchingConfig cfg = config;
+  nlohmann::json registration_j = nullptr;
+  if (cfg.registration.enabled) {
+    core::Rng room_rng = core::makeRng(core::deriveSeed(opt.seed, 0xB0B));
+    const scenarios::RegistrationResult r =
+        scenarios::registerCamerasToRobot(cfg, sim::makeRoom(cfg.room, room_rng), core::deriveSeed(opt.seed, 0x4E6));
+    ctx.log("%d cameras registered to the robot: marker reprojection %.3f px -> %.3f px", r.cameras_registered,
+            r.reprojection_px_before, r.reprojection_px_after);
+    registration_j = {{"cameras_registered", r.cameras_registered},
+                      {"reprojection_px_before", r.reprojection_px_before},
+                      {"reprojection_px_after", r.reprojection_px_after}};
+  }
   std::vector<core::Camera> cams;
   for (std::size_t i = 0; i < cfg.activeCameras(); ++i) cams.push_back(cfg.cameras[i].estimatorCamera());
-  tracking::ViewlineTracker tracker(cams, cfg.tracker);
+  auto tracker_ptr = std::make_unique<tracking::ViewlineTracker>(cams, cfg.tracker);
   const robots::SimulatedCartesianRobot robot_model(cfg.robot);
   planning::CatchPlanner planner(cfg.plannerConfig(), robot_model);
   planner.reset(0.0, cfg.robot.home);
+  // The planner predicts from the drag-model fit of the track's images once it is determined,
+  // from the tracker's estimate before (the in-process loop's rule, scenarios/ball_catching/flight_fit.h).
+  scenarios::FlightFit fit(cfg.flight_fit, cams, fitModel(cfg));
+  int fit_track = -1, fit_restarts = -1;
 
   dds::Reader<ClockMsg> clock_r(ctx.participant, ctx.clock_topic, dds::Qos::state(4));
   dds::Reader<DetectionMsg> det_r(ctx.participant, ctx.detection_topic, dds::Qos::detections(256));
   dds::Writer<TrackStateMsg> track_w(ctx.participant, ctx.track_topic, dds::Qos::state(16));
   dds::Writer<SetPointMsg> sp_w(ctx.participant, ctx.setpoint_topic, dds::Qos::setpoints(opt.setpoint_deadline_s));
+  dds::Reader<EpisodeMsg> episode_r(ctx.participant, ctx.episode_topic, dds::Qos::health());
   dds::WaitSet ws(ctx.participant);
   ws.attachData(clock_r);
   ws.attachData(det_r);
+  ws.attachData(episode_r);
   ws.attachData(ctx.health_reader);
   ws.attachStatus(det_r, DDS_LIVELINESS_CHANGED_STATUS);
   ctx.publishHealth(HealthStatus::Running, "tracking " + std::to_string(cams.size()) + " cameras", 0.0);
@@ -65,7 +101,34 @@ nlohmann::json runTrackerNode(const scenarios::BallCatchingConfig& cfg, const No
   double next_control = 0.0;
   const std::string world_frame = "world";
 
+  // A session of throws (the world's rt/viewline/episode): from each episode's start the tracker,
+  // the fit and the plan start afresh, as the in-process loop starts each throw.
+  std::optional<double> pending_episode;
+  int episodes = 0;
+  auto startEpisodeBy = [&](double t) {
+    if (!pending_episode || t < *pending_episode) return;
+    tracker_ptr = std::make_unique<tracking::ViewlineTracker>(cams, cfg.tracker);
+    planner.reset(*pending_episode, cfg.robot.home);
+    fit.reset();
+    fit_track = fit_restarts = -1;
+    pending_episode.reset();
+    ++episodes;
+  };
+  auto planned = [&](const tracking::ImageMeasurement& m) {
+    const tracking::ViewlineTracker& tracker = *tracker_ptr;
+    if (!cfg.flight_fit.enabled) return tracker.state();
+    const tracking::TrackState& ts = tracker.trackState();
+    if (ts.tracks_started != fit_track || ts.restarts != fit_restarts) {  // a new track: a new fit
+      fit.reset();
+      fit_track = ts.tracks_started;
+      fit_restarts = ts.restarts;
+    }
+    const std::optional<estimation::StateEstimate> fitted = fit.add({m.camera, m.t, m.uv, m.sigma_px}, tracker.state());
+    return fitted ? *fitted : tracker.state();
+  };
+
   auto publishTrack = [&] {
+    const tracking::ViewlineTracker& tracker = *tracker_ptr;
     const estimation::StateEstimate& s = tracker.state();
     TrackStateMsg m{};
     m.header.stamp = toTimeMsg(s.t());
@@ -88,7 +151,7 @@ nlohmann::json runTrackerNode(const scenarios::BallCatchingConfig& cfg, const No
   }
   auto logTrack = [&](std::size_t c, double t_update, double stamp) {
     if (!track_log) return;
-    const estimation::StateEstimate& s = tracker.state();
+    const estimation::StateEstimate& s = tracker_ptr->state();
     const double sigma = std::sqrt(s.P().topLeftCorner<3, 3>().trace());
     if (std::fprintf(track_log.get(), "%.6f,%zu,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f\n", t_update, c, stamp, t_update - stamp,
                      s.x()(0), s.x()(1), s.x()(2), sigma) < 0)
@@ -110,6 +173,31 @@ nlohmann::json runTrackerNode(const scenarios::BallCatchingConfig& cfg, const No
       }
     }
     clock_r.take([&](const ClockMsg& m, const dds_sample_info_t&) { clock.onClock(fromTimeMsg(m.clock)); });
+    episode_r.take([&](const EpisodeMsg& e, const dds_sample_info_t&) {
+      if (e.index > 0) pending_episode = fromTimeMsg(e.header.stamp);  // episode 0 is the node's start
+    });
+    // Set points every control period of simulated time, up to the newest tick, before the
+    // detections that arrived: an update then plans from a time no earlier than the last set
+    // point sent (the in-process order: estimates reach the planner, then the tick's set point).
+    while (clock.started() && next_control <= clock.latest()) {
+      startEpisodeBy(next_control);
+      const robots::CartesianState sp = planner.setpoint(next_control);
+      SetPointMsg m{};
+      m.header.stamp = toTimeMsg(next_control);
+      m.header.frame_id = messageString(world_frame);
+      for (int k = 0; k < 3; ++k) {
+        m.position[k] = sp.p(k);
+        m.velocity[k] = sp.v(k);
+      }
+      if (const auto& target = planner.target()) {
+        m.has_target = true;
+        m.target_time = target->t;
+        for (int k = 0; k < 3; ++k) m.target_position[k] = target->p(k);
+      }
+      sp_w.write(m);
+      ++setpoints;
+      next_control += cfg.control_period;
+    }
     det_r.take([&](const DetectionMsg& d, const dds_sample_info_t& info) {
       if (d.camera >= cam.size()) {
         ++unknown_camera;
@@ -138,6 +226,8 @@ nlohmann::json runTrackerNode(const scenarios::BallCatchingConfig& cfg, const No
       const double stamp = fromTimeMsg(d.header.stamp);
       cd.delays.push_back(clock.now() - stamp);
       if (!d.detected) return;
+      startEpisodeBy(stamp);
+      tracking::ViewlineTracker& tracker = *tracker_ptr;
       ++cd.detected;
       const double sigma = std::max(cfg.sigma_px_floor, std::sqrt(0.5 * (d.covariance[0] + d.covariance[3])));
       const tracking::ImageMeasurement m{next_id++, c, stamp, Eigen::Vector2d(d.pixel[0], d.pixel[1]), sigma};
@@ -147,7 +237,10 @@ nlohmann::json runTrackerNode(const scenarios::BallCatchingConfig& cfg, const No
       ++cd.fused;
       logTrack(c, clock.now(), stamp);
       publishTrack();
-      planner.update(std::max(clock.now(), stamp), tracker.state());
+      // Planned from now, but not before the last set point sent nor after the next one (the
+      // plan's set points stay continuous in time).
+      const double t_update = std::clamp(std::max(clock.now(), stamp), next_control - cfg.control_period, next_control);
+      planner.update(t_update, planned(m));
     });
     // A writer that lost its liveliness (process killed, hung, cut off) turns "not alive"; one
     // deleted cleanly (its node ended) is unmatched instead, so only the first is a camera lost.
@@ -164,25 +257,6 @@ nlohmann::json runTrackerNode(const scenarios::BallCatchingConfig& cfg, const No
         ctx.log("camera %s closed its writer at t = %.3f s", who.c_str(), clock.now());
       }
     }
-    // Set points every control period of simulated time, up to the newest tick.
-    while (clock.started() && next_control <= clock.latest()) {
-      const robots::CartesianState sp = planner.setpoint(next_control);
-      SetPointMsg m{};
-      m.header.stamp = toTimeMsg(next_control);
-      m.header.frame_id = messageString(world_frame);
-      for (int k = 0; k < 3; ++k) {
-        m.position[k] = sp.p(k);
-        m.velocity[k] = sp.v(k);
-      }
-      if (const auto& target = planner.target()) {
-        m.has_target = true;
-        m.target_time = target->t;
-        for (int k = 0; k < 3; ++k) m.target_position[k] = target->p(k);
-      }
-      sp_w.write(m);
-      ++setpoints;
-      next_control += cfg.control_period;
-    }
     if (draining) break;
     draining = ctx.worldFinished();  // one more pass takes what is still in flight
   }
@@ -193,7 +267,10 @@ nlohmann::json runTrackerNode(const scenarios::BallCatchingConfig& cfg, const No
   nlohmann::json j;
   j["role"] = "tracker";
   j["rig_hash"] = detail::hex(ctx.rig_hash);
+  const tracking::ViewlineTracker& tracker = *tracker_ptr;
   j["initialised"] = tracker.initialised();
+  j["registration"] = registration_j;
+  j["episodes"] = episodes + 1;
   const estimation::StateEstimate& s = tracker.state();
   if (s.x().size() >= 6) {  // empty before the first track
     j["t"] = s.t();
