@@ -101,8 +101,12 @@ nlohmann::json runWorldNode(const scenarios::BallCatchingConfig& cfg, const Node
   }
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
   ctx.takeHealth();
-  ctx.log("%d nodes follow the clock; running %d x %.2f s of simulated time at %.2fx real time",
-          clock_w.matched().current, opt.throws, D, opt.realtime);
+  if (opt.throws == 1)
+    ctx.log("%d nodes follow the clock; running %.2f s of simulated time at %.2fx real time", clock_w.matched().current, D,
+            opt.realtime);
+  else
+    ctx.log("%d nodes follow the clock; running %d throws of %.2f s of simulated time at %.2fx real time",
+            clock_w.matched().current, opt.throws, D, opt.realtime);
   ctx.publishHealth(HealthStatus::Running, "running", 0.0);
 
   // Each episode is announced this long before it starts (simulated time), so that every node
