@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 
 #include "viewline/core/error.h"
 #include "viewline/io/config_edit.h"
@@ -70,6 +71,8 @@ TuneCommandLine::TuneCommandLine(CLI::App& app) {
   autotune_->add_option("--record-seed", ao.record_seed, "seed of the live recording");
   autotune_->add_option("--record-runs", ao.record_runs, "live runs recorded");
   autotune_->add_option("--start-scale", ao.start_scale, "start from the config's noise values times this");
+  autotune_->add_option("--start-value", start_values_,
+                        "key=value: start this noise parameter (config key) here, e.g. one the config sets to 0");
   autotune_->add_option("--outlier-prior", ao.outlier_prior, "prior outlier probability in the likelihood");
   autotune_->add_option("--span-decades", ao.span_decades, "grid half-width in decades");
   autotune_->add_option("--grid-points", ao.grid_points, "grid points per parameter");
@@ -168,6 +171,12 @@ int TuneCommandLine::runSingle(const AdapterRegistry& registry, const LiveViewFa
 int TuneCommandLine::runAutotune(const AdapterRegistry& registry) {
   AutotuneSessionOptions ao = autotune_options_;
   ao.adapter_options = parseAdapterOptions(autotune_adapter_options_);
+  for (const auto& [k, v] : parseAdapterOptions(start_values_)) {
+    char* end = nullptr;
+    const double x = std::strtod(v.c_str(), &end);
+    if (end == v.c_str() || *end != '\0') throw core::InvalidInput("--start-value " + k + "=" + v + ": expected a number");
+    ao.start_values[k] = x;
+  }
   ao.workers = workers_;
   ao.quiet = quiet_;
   const nlohmann::json j = runAutotuneSession(registry, ao);

@@ -4,12 +4,11 @@
 // config read by the scenario's own loader (loadMobileCaptureConfig: strict keys), so a config the
 // tuning tool accepts or writes is one mobile_capture reads. One run = one chase (seed).
 //
-// Consistency, from the run's telemetry (a runtime::MemorySink; no files). NEES: per vision step
-// the sink has the true object (x, y, θ, v, ω) and the track's estimate with its covariance;
-// every `nees_spacing_s` seconds (nearly independent samples) one 1-dof marginal sample
-// e_i² / P_ii (χ²(1) for a consistent filter) is taken, cycling through x, y, θ (wrapped), v, ω,
-// once the track has been valid for `settle_s`. NIS: the track's own innovation records (2 dof,
-// accepted or gated out), once the track has been valid for `settle_s`.
+// Consistency: the run's own position NEES (2 dof, against P_s + B, one sample every
+// scenarios::kNeesSpacing s once the track has been valid kConsistencySettle s: MobileCaptureRun),
+// and the NIS from the run's telemetry (a runtime::MemorySink; no files): the track's own
+// innovation records (2 dof, accepted or gated out) once the track has been valid for `settle_s`
+// (default the loop's kConsistencySettle, so the two agree).
 //
 // Noise auto-tuning: the noise parameters are the track's random walks q_v, q_w and the white
 // blob-centre noise σ_px (R = σ_px² J Jᵀ, J the ground-projection Jacobian of each detection). A
@@ -42,13 +41,10 @@ namespace viewline::tuning {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
 /// The adapter options (declared with their defaults and ranges in registerMobileCaptureAdapter).
 struct MobileOptions {
   double max_time;      ///< s; 0: the config's world.max_time
-  double nees_spacing;  ///< s between NEES samples
-  double settle;        ///< s of valid track before NEES samples
+  double settle;        ///< s of valid track before NIS samples
 };
 
 /// The adapter options: type, range, default and help of each, bound to its field.
@@ -56,10 +52,8 @@ detail::OptionTable<MobileOptions> mobileOptions() {
   detail::OptionTable<MobileOptions> options;
   options.number("max_time", &MobileOptions::max_time, "0", 0.0, detail::kUnbounded,
                  "s, time limit of a chase (0: the config's world.max_time)")
-      .number("nees_spacing_s", &MobileOptions::nees_spacing, "1", 1e-9, detail::kUnbounded,
-              "s between the 1-dof NEES samples (nearly independent)")
       .number("settle_s", &MobileOptions::settle, "2", 0.0, detail::kUnbounded,
-              "s a track must have been valid before its NEES samples count");
+              "s a track must have been valid before its NIS samples count");
   return options;
 }
 
@@ -191,7 +185,10 @@ public:
     const scenarios::MobileCaptureRun res = scenarios::runMobileCapture(cfg_, seed, &hooks);
     RunResult r;
     r.seed = seed;
-    consistency(memory, r.nees, r.nis, series.get());
+    consistency(memory, r.nis, series.get());
+    r.nees.sum = res.nees_sum;
+    r.nees.dof_sum = 2.0 * static_cast<double>(res.nees_count);
+    r.nees.count = static_cast<std::size_t>(res.nees_count);
     auto& m = r.metrics;
     m["captured"] = res.captured ? 1.0 : 0.0;
     m["capture_time_s"] = res.capture_time;
@@ -240,33 +237,18 @@ private:
     }
   }
 
-  /// NEES: one 1-dof marginal sample every nees_spacing s, cycling over (x, y, θ, v, ω). NIS: the
-  /// track's innovation records. Both once the track has been valid for settle s (a track is
+  /// NIS: the track's innovation records once the track has been valid for settle s (a track is
   /// valid at the times it has an estimate record; a gap of more than a frame is a restart).
-  void consistency(const runtime::MemorySink& mem, Consistency& nees, Consistency& nis, RunSeries* series) const {
+  void consistency(const runtime::MemorySink& mem, Consistency& nis, RunSeries* series) const {
     namespace channel = scenarios::mobile_capture::channel;
-    std::map<double, const Eigen::VectorXd*> truth;  // by time (both records carry the frame's stamp)
-    for (const auto& e : mem.estimates)
-      if (e.channel == channel::kTruthObject) truth[e.t] = &e.x;
     std::map<double, double> valid_since;  // frame time -> start of the track valid then
-    double since = -1.0, last_t = -1e300, next = -1e300;
-    std::size_t component = 0;
+    double since = -1.0, last_t = -1e300;
     for (const auto& e : mem.estimates) {
       if (e.channel != channel::kObject) continue;
       const double t = e.t;
       if (t - last_t > 1.5 * cfg_.vision_period) since = t;  // the track (re)started
       last_t = t;
       valid_since[t] = since;
-      const auto it = truth.find(t);
-      if (it == truth.end() || t - since < opt_.settle || t < next) continue;
-      const std::size_t k = component % 5;
-      double err = e.x[static_cast<Eigen::Index>(k)] - (*it->second)[static_cast<Eigen::Index>(k)];
-      if (k == 2) err = std::remainder(err, 2.0 * kPi);
-      const double var = e.P(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(k));
-      if (!(var > 0.0)) continue;
-      nees.add(err * err / var, 1.0);
-      ++component;
-      next = t + opt_.nees_spacing;
     }
     for (const auto& i : mem.innovationsOf(channel::kObject)) {
       const auto v = valid_since.find(i.t);

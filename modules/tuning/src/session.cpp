@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -230,17 +231,28 @@ struct AutotuneOutcome {
 AutotuneOutcome doAutotune(const ScenarioInstance& base, const ScenarioFile& file, const std::string& out_dir,
                            double start_scale, const ReplayData* given_data, std::uint64_t record_seed, int record_runs,
                            const AutotuneOptions& ao, std::uint64_t verify_seed, int verify_runs, bool quiet,
-                           const std::string& source_name) {
+                           const std::string& source_name, const std::map<std::string, double>& start_values = {}) {
   if (given_data == nullptr && verify_seed == record_seed)
     throw core::InvalidInput(source_name + ": the verification seed " + std::to_string(verify_seed) +
                              " is the recording's seed: the fresh-seed NIS check needs another one");
   AutotuneOutcome o;
   const std::vector<NoiseParameter> params = base.noiseParameters();
   std::vector<double> start;
+  for (const auto& [key, v] : start_values) {
+    if (std::none_of(params.begin(), params.end(), [&](const NoiseParameter& p) { return p.config_key == key; }))
+      throw core::InvalidInput("--start-value " + key + ": not a noise parameter of this scenario");
+    if (!(v > 0.0) || !std::isfinite(v)) throw core::InvalidInput("--start-value " + key + ": expected a positive number");
+  }
   for (const auto& p : params) {
+    // A given start is used as it is; else the config's value times the scale.
+    if (const auto it = start_values.find(p.config_key); it != start_values.end()) {
+      start.push_back(it->second);
+      continue;
+    }
     if (!(p.value > 0.0))
       throw core::InvalidInput(source_name + ": noise parameter '" + p.config_key + "' is " + fmt(p.value) +
-                               ": the log-space search needs a positive starting value");
+                               ": the log-space search needs a positive starting value (give one: --start-value " +
+                               p.config_key + "=<value>)");
     start.push_back(p.value * start_scale);
   }
   const std::unique_ptr<ScenarioInstance> start_instance = base.withNoise(start);
@@ -673,7 +685,7 @@ nlohmann::json runAutotuneSession(const AdapterRegistry& registry, const Autotun
   if (!o.quiet) ao.progress = [](const std::string& s) { std::fprintf(stderr, "%s\n", s.c_str()); };
   const std::uint64_t verify_seed = o.verify_seed != 0 ? o.verify_seed : o.record_seed + 1;
   const AutotuneOutcome at = doAutotune(*base, file, o.out_dir, o.start_scale, data.get(), o.record_seed, o.record_runs, ao,
-                                        verify_seed, o.verify_runs, o.quiet, o.config);
+                                        verify_seed, o.verify_runs, o.quiet, o.config, o.start_values);
   nlohmann::json j = at.json;
   j["scenario"] = o.scenario;
   j["config"] = o.config;

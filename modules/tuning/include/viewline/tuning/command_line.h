@@ -52,6 +52,7 @@ private:
   AutotuneSessionOptions autotune_options_;
   CheckOptions check_options_;
   std::vector<std::string> run_adapter_options_, autotune_adapter_options_, check_adapter_options_;
+  std::vector<std::string> start_values_;  // --start-value key=value items
 };
 
 /// "name=value" items of --option as adapter options; throws core::InvalidInput on a bad item.

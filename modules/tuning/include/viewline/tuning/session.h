@@ -13,6 +13,7 @@
 
 #include <atomic>
 #include <functional>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -72,6 +73,9 @@ struct AutotuneSessionOptions {
   std::uint64_t record_seed = 1000;  ///< seed of the live recording
   int record_runs = 1;        ///< runs of the live recording
   double start_scale = 1.0;   ///< start from the config's noise values times this
+  /// Start values by config key, used as given (e.g. for a noise the config sets to 0, which a
+  /// log-space search cannot start from).
+  std::map<std::string, double> start_values;
   double outlier_prior = 0.05;  ///< AutotuneOptions::outlier_prior
   double span_decades = 2.5;  ///< AutotuneOptions::span_decades
   int grid_points = 11;       ///< AutotuneOptions::grid_points
