@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -231,8 +232,10 @@ struct AutotuneOutcome {
 AutotuneOutcome doAutotune(const ScenarioInstance& base, const ScenarioFile& file, const std::string& out_dir,
                            double start_scale, const ReplayData* given_data, std::uint64_t record_seed, int record_runs,
                            const AutotuneOptions& ao, std::uint64_t verify_seed, int verify_runs, bool quiet,
-                           const std::string& source_name, const std::map<std::string, double>& start_values = {}) {
-  if (given_data == nullptr && verify_seed == record_seed)
+                           const std::string& source_name, const std::map<std::string, double>& start_values = {},
+                           std::optional<std::uint64_t> live_seed = std::nullopt) {
+  const std::uint64_t live = live_seed.value_or(verify_seed);
+  if (given_data == nullptr && (verify_seed == record_seed || live == record_seed))
     throw core::InvalidInput(source_name + ": the verification seed " + std::to_string(verify_seed) +
                              " is the recording's seed: the fresh-seed NIS check needs another one");
   AutotuneOutcome o;
@@ -283,9 +286,10 @@ AutotuneOutcome doAutotune(const ScenarioInstance& base, const ScenarioFile& fil
   }
   if (verify_runs > 0) {
     say(quiet, "auto-tune: " + std::to_string(verify_runs) + " live runs with the start and the tuned noise");
-    o.live_before = evaluate(*start_instance, verify_seed, verify_runs, ao.workers, ao.confidence);
-    o.live_after = evaluate(*tuned_instance, verify_seed, verify_runs, ao.workers, ao.confidence);
+    o.live_before = evaluate(*start_instance, live, verify_runs, ao.workers, ao.confidence);
+    o.live_after = evaluate(*tuned_instance, live, verify_runs, ao.workers, ao.confidence);
     o.json["autotune_live_runs"] = verify_runs;
+    o.json["autotune_live_seed"] = live;
     o.json["autotune_live_nees_before"] = consistencyJson(o.live_before.nees, ao.confidence);
     o.json["autotune_live_nis_before"] = consistencyJson(o.live_before.nis, ao.confidence);
     o.json["autotune_live_nees"] = consistencyJson(o.live_after.nees, ao.confidence);
@@ -684,8 +688,11 @@ nlohmann::json runAutotuneSession(const AdapterRegistry& registry, const Autotun
   ao.confidence = base->confidence();
   if (!o.quiet) ao.progress = [](const std::string& s) { std::fprintf(stderr, "%s\n", s.c_str()); };
   const std::uint64_t verify_seed = o.verify_seed != 0 ? o.verify_seed : o.record_seed + 1;
+  // The live runs keep base seed 1 unless a verification seed is given (seed 1 differs from the
+  // default recording seed, 1000, too).
+  const std::uint64_t live_seed = o.verify_seed != 0 ? o.verify_seed : 1;
   const AutotuneOutcome at = doAutotune(*base, file, o.out_dir, o.start_scale, data.get(), o.record_seed, o.record_runs, ao,
-                                        verify_seed, o.verify_runs, o.quiet, o.config, o.start_values);
+                                        verify_seed, o.verify_runs, o.quiet, o.config, o.start_values, live_seed);
   nlohmann::json j = at.json;
   j["scenario"] = o.scenario;
   j["config"] = o.config;
@@ -701,7 +708,7 @@ nlohmann::json runAutotuneSession(const AdapterRegistry& registry, const Autotun
             {{htmlEscape(j["autotune_verify_data"].get<std::string>()), consistencyCell(at.verify_nis, ao.confidence),
               std::to_string(at.verify_nis.count), at.verify_nis.verdict(ao.confidence)}});
   if (!at.live_after.runs.empty()) {
-    rep.table({"live runs (seed " + std::to_string(verify_seed) + ")", "NEES mean [band]", "NIS mean [band]", "verdict"},
+    rep.table({"live runs (seed " + std::to_string(live_seed) + ")", "NEES mean [band]", "NIS mean [band]", "verdict"},
               {{"start noise", consistencyCell(at.live_before.nees, ao.confidence),
                 consistencyCell(at.live_before.nis, ao.confidence), at.live_before.verdict},
                {"tuned noise", consistencyCell(at.live_after.nees, ao.confidence),

@@ -79,9 +79,10 @@ struct AutotuneSessionOptions {
   double outlier_prior = 0.05;  ///< AutotuneOptions::outlier_prior
   double span_decades = 2.5;  ///< AutotuneOptions::span_decades
   int grid_points = 11;       ///< AutotuneOptions::grid_points
-  int verify_runs = 0;        ///< > 0: live runs of the start and tuned configs for NEES/NIS, from the verify seed
-  /// Seed of the fresh-seed check (a new recording replayed at the tuned noise, and the live runs);
-  /// 0: record_seed + 1. Must differ from record_seed when the data are recorded live.
+  int verify_runs = 0;        ///< > 0: live runs of the start and tuned configs for NEES/NIS (base seed below)
+  /// Seed of the fresh-seed check (a new recording replayed at the tuned noise) and base seed of the
+  /// live runs; 0: record_seed + 1 for the check, 1 for the live runs. Must differ from record_seed
+  /// when the data are recorded live.
   std::uint64_t verify_seed = 0;
   int workers = 0;            ///< threads; 0: all cores
   std::string out_dir = "tune_autotune";  ///< folder of every output (created)
