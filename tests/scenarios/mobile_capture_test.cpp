@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <future>
 #include <vector>
 
 #include "viewline/core/error.h"
@@ -41,23 +42,29 @@ TEST(MobileCapture, HeadlineGuardOnSeedsTheNoiseWasNotTunedOn) {
   // band (with ~500 samples the band is ±12 % of 2).
   const MobileCaptureConfig cfg = shipped();
   ASSERT_TRUE(cfg.rig.has_value());
+  // The three chases run concurrently (each is independent and thread-safe, as in the batch).
+  const std::vector<std::uint64_t> seeds{21u, 22u, 23u};
+  std::vector<int> frames_seen(seeds.size(), 0);
+  std::vector<std::future<MobileCaptureRun>> runs;
+  for (std::size_t k = 0; k < seeds.size(); ++k) {
+    runs.push_back(std::async(std::launch::async, [&cfg, &frames_seen, &seeds, k] {
+      MobileCaptureHooks hooks;
+      hooks.on_frame = [&frames_seen, k](const MobileCaptureFrame& f) {
+        ++frames_seen[k];
+        EXPECT_TRUE(f.image != nullptr && f.image->cols == 320 && f.image->rows == 240);
+      };
+      return runMobileCapture(cfg, seeds[k], &hooks);
+    }));
+  }
   std::vector<double> ratios;
   double nis = 0.0, nees = 0.0;
   long n_nis = 0, n_nees = 0;
-  for (const std::uint64_t seed : {21u, 22u, 23u}) {
-    SCOPED_TRACE(seed);
-    int frames_seen = 0;
-    MobileCaptureHooks hooks;
-    hooks.on_frame = [&](const MobileCaptureFrame& f) {
-      ++frames_seen;
-      ASSERT_NE(f.image, nullptr);
-      EXPECT_EQ(f.image->cols, 320);
-      EXPECT_EQ(f.image->rows, 240);
-    };
-    const MobileCaptureRun r = runMobileCapture(cfg, seed, &hooks);
+  for (std::size_t k = 0; k < seeds.size(); ++k) {
+    SCOPED_TRACE(seeds[k]);
+    const MobileCaptureRun r = runs[k].get();
     EXPECT_TRUE(r.captured);
     EXPECT_TRUE(r.oracle_captured);
-    EXPECT_EQ(frames_seen, r.frames);
+    EXPECT_EQ(frames_seen[k], r.frames);
     EXPECT_GT(r.detections, 0.9 * r.frames);  // the head keeps the object in view
     ASSERT_GT(r.oracle_time, 0.0);
     ratios.push_back(r.capture_time / r.oracle_time);
