@@ -54,7 +54,7 @@ public:
       : cfg_(cfg), flight_(flight), source_(source), est_cams_(std::move(est_cams)), robot_(robot),
         planner_(cfg.plannerConfig(), robot), tracker_(est_cams_, cfg.tracker), res_(res), hooks_(hooks), tel_(tel),
         noise_rng_(core::makeRng(core::deriveSeed(seed, 0xD37))),  // pixel_noise_px only
-        fit_(cfg.flight_fit, est_cams_, flightModel(cfg)) {
+        fit_(cfg.flight_fit, est_cams_, flightModel(cfg), FitAimPlane{cfg.robot.home, cfg.box_normal}) {
     planner_.reset(0.0, cfg.robot.home);
     for (const auto& c : est_cams_) detectors_.emplace_back(cfg.detector, c);
   }
@@ -125,9 +125,20 @@ private:
     if (!det.ok()) return std::nullopt;
     ++res_.detections;
     if (res_.t_first_detection < 0.0) res_.t_first_detection = frame.capture_time;
-    const double sigma_det = std::max(cfg_.sigma_px_floor, std::sqrt(0.5 * det.value().pixel_covariance.trace()));
+    // The detector's std: as measured against the truth (detector.sigma_px), else the blob's own.
+    const double sigma_det = cfg_.sigma_px > 0.0
+                                 ? cfg_.sigma_px
+                                 : std::max(cfg_.sigma_px_floor, std::sqrt(0.5 * det.value().pixel_covariance.trace()));
     const double sigma = std::hypot(sigma_det, cfg_.pixel_noise_px);  // the tracker is told the added noise
     Eigen::Vector2d px = det.value().pixel;
+    // The detector's own error as the tracker sees it: against the estimator camera's image of the
+    // true ball at the stamp (calibration, registration, blur and stamp errors included).
+    if (cfg_.object == "ball" && frame.stamp >= flight_.startTime() && frame.stamp <= flight_.endTime())
+      if (const auto uv_true = est_cams_[ci].project(flight_.state(frame.stamp).p)) {
+        res_.detection_sq_error_px2 += (px - *uv_true).squaredNorm();
+        res_.told_variance_px2 += 2.0 * sigma_det * sigma_det;
+        ++res_.detection_errors;
+      }
     if (cfg_.pixel_noise_px > 0.0)
       px += cfg_.pixel_noise_px * Eigen::Vector2d(core::gaussian(noise_rng_), core::gaussian(noise_rng_));
     const tracking::ImageMeasurement m{next_id_++, ci, frame.stamp, px, sigma};

@@ -59,6 +59,12 @@ struct ThrowResult {
       detections = 0,  ///< images in which the detector found the ball
       fused = 0,       ///< detections the tracker fused
       gated = 0;       ///< detections the tracker's gate rejected
+  /// Sum over the detections of the squared per-axis pixel error (before the extra detection
+  /// noise) against the estimator camera's projection of the true ball at the stamp, px².
+  double detection_sq_error_px2 = 0.0;
+  /// Sum over the detections of the per-axis std the tracker was told, squared, px².
+  double told_variance_px2 = 0.0;
+  int detection_errors = 0;  ///< detections in detection_sq_error_px2 (each contributes 2 axes)
   double t_first_detection = -1.0;                      ///< s, first detection's stamp (-1: none)
   double t_first_move = -1.0;                           ///< planner's first move towards a target
   bool had_target = false,  ///< the planner had a crossing target at some point
@@ -109,6 +115,11 @@ struct CatchSummary {
   int frames = 0,      ///< images over all throws and cameras
       detections = 0;  ///< of which the ball was detected in
   double detection_rate = 0.0;  ///< detections / frames
+  /// RMS per pixel axis of the detections against the estimator cameras' projection of the true
+  /// ball (before the extra detection noise): the detector's own error as the tracker sees it, px.
+  double detection_error_px_rms = 0.0;
+  /// RMS per pixel axis of the std the tracker was told, without the extra noise's share, px.
+  double told_sigma_px_rms = 0.0;
   std::optional<RegistrationResult> registration;  ///< the camera registration, when enabled
   double launch_speed_min = 0.0,   ///< m/s, over the throws
          launch_speed_max = 0.0,   ///< m/s
