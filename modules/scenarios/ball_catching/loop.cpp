@@ -13,6 +13,7 @@
 #include "viewline/core/error.h"
 #include "viewline/core/frames.h"
 #include "viewline/core/random.h"
+#include "viewline/estimation/consistency.h"
 #include "viewline/io/log.h"
 #include "viewline/runtime/delay_line.h"
 #include "viewline/scenarios/ball_catching/world.h"
@@ -149,6 +150,7 @@ private:
     const bool fused = o && o->fate == tracking::Fate::Fused;
     if (fused) ++res_.fused;
     else ++res_.gated;
+    consistency(m, o, tracker_.trackState().restarts > restarts_before);
     if (fused && tracker_.initialised()) to_planner_.send(frame.stamp + cfg_.processing_latency, planned(m));
     if (tel_ && o) report(m, *o, tracker_.trackState().restarts > restarts_before);
     return px;
@@ -166,6 +168,27 @@ private:
     }
     const std::optional<estimation::StateEstimate> fitted = fit_.add({m.camera, m.t, m.uv, m.sigma_px}, tracker_.state());
     return fitted ? *fitted : tracker_.state();
+  }
+
+  // The tracker's NIS and NEES samples (ThrowResult::nis, ::nees; counted as the tuning adapter does).
+  void consistency(const tracking::ImageMeasurement&, const std::optional<tracking::MeasurementOutcome>& o,
+                   bool restarted) {
+    if (!o) return;
+    const bool fused = o->fate == tracking::Fate::Fused;
+    const bool starts = fused && (o->seed || restarted);
+    if (fused && !starts && in_track_ >= kConsistencyBurnIn && std::isfinite(o->gate.mahalanobis))
+      res_.nis.push_back(o->gate.mahalanobis);
+    if (starts) in_track_ = 0;
+    in_track_ += fused;
+    if (fused && res_.fused == kNeesFusedImage && cfg_.object == "ball" && tracker_.initialised()) {
+      const estimation::StateEstimate& s = tracker_.state();
+      if (s.t() >= flight_.startTime() && s.t() <= flight_.endTime()) {
+        const sim::FlightState f = flight_.state(s.t());
+        Eigen::VectorXd x(6);
+        x << f.p, f.v;
+        res_.nees = estimation::nees(s, x);
+      }
+    }
   }
 
   void report(const tracking::ImageMeasurement& m, const tracking::MeasurementOutcome& o, bool restarted) {
@@ -200,6 +223,7 @@ private:
   std::uint64_t next_id_ = 1;
   FlightFit fit_;
   int fit_track_ = -1, fit_restarts_ = -1;  ///< the tracker's track the fit belongs to
+  int in_track_ = 0;  ///< fused images of the current track (consistency burn-in)
 };
 
 }  // namespace
