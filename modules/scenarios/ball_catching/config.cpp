@@ -176,9 +176,11 @@ void readPlanner(const io::ConfigNode& p, planning::CatchPlannerConfig& k) {
   k.commit_min_updates = p.getOr<int>("commit_min_updates", k.commit_min_updates);
   k.give_up = p.getOr<bool>("give_up", k.give_up);
   k.give_up_late = p.getOr<double>("give_up_late_s", k.give_up_late);
+  k.give_up_sigmas = p.getOr<double>("give_up_sigmas", k.give_up_sigmas);
   k.home_delay = p.getOr<double>("home_delay_s", k.home_delay);
   k.min_lead = p.getOr<double>("min_lead_s", k.min_lead);
   k.target_prior_std = p.getOr<double>("target_prior_std_m", k.target_prior_std);
+  k.move_sigmas = p.getOr<double>("move_sigmas", k.move_sigmas);
 }
 
 void readRegistration(const io::ConfigNode& r, CatchRegistration& g) {
