@@ -133,10 +133,12 @@ struct CatchSummary {
   double told_sigma_px_rms = 0.0;
   double nis_mean = 0.0;  ///< mean of every throw's NIS samples (2 dof)
   int nis_samples = 0;    ///< how many
-  double nis_band_lo = 0.0, nis_band_hi = 0.0;  ///< two-sided 99 % chi-square band of nis_mean
+  double nis_band_lo = 0.0;  ///< lower end of the two-sided 99 % chi-square band of nis_mean
+  double nis_band_hi = 0.0;  ///< upper end of that band
   double nees_mean = 0.0;  ///< mean of the throws' NEES samples (6 dof)
   int nees_samples = 0;    ///< how many (one per throw)
-  double nees_band_lo = 0.0, nees_band_hi = 0.0;  ///< two-sided 99 % chi-square band of nees_mean
+  double nees_band_lo = 0.0;  ///< lower end of the two-sided 99 % chi-square band of nees_mean
+  double nees_band_hi = 0.0;  ///< upper end of that band
   std::optional<RegistrationResult> registration;  ///< the camera registration, when enabled
   double launch_speed_min = 0.0,   ///< m/s, over the throws
          launch_speed_max = 0.0,   ///< m/s
