@@ -11,7 +11,7 @@
 #include "viewline/nodes/simulation.h"
 #include "viewline/planning/catch_planner.h"
 #include "viewline/core/random.h"
-#include "viewline/scenarios/ball_catching/flight_fit.h"
+#include "viewline/scenarios/ball_catching/planner_input.h"
 #include "viewline/scenarios/ball_catching/registration.h"
 #include "viewline/sim/worlds.h"
 #include "viewline/robots/cartesian_robot.h"
@@ -32,18 +32,6 @@ struct CameraDelivery {
   bool any = false, alive = true;
   std::vector<double> delays;  // capture stamp -> tracker update, s of simulated time
 };
-
-// Gravity and drag of the flight as the planner's crossing model has them, for the flight fit
-// (the in-process loop's rule: scenarios/ball_catching/loop.cpp).
-estimation::DragBallisticModel fitModel(const scenarios::BallCatchingConfig& cfg) {
-  const planning::CrossingModel m = cfg.plannerConfig().model;
-  estimation::DragBallisticModel d;
-  d.g = m.gravity_w.norm();
-  d.up = -m.gravity_w / d.g;
-  d.k = m.kind == planning::FlightModel::Drag ? m.drag_k : 0.0;
-  d.q = 0.0;
-  return d;
-}
 
 }  // namespace
 
@@ -72,10 +60,8 @@ nlohmann::json runTrackerNode(const scenarios::BallCatchingConfig& config, const
   const robots::SimulatedCartesianRobot robot_model(cfg.robot);
   planning::CatchPlanner planner(cfg.plannerConfig(), robot_model);
   planner.reset(0.0, cfg.robot.home);
-  // The planner predicts from the drag-model fit of the track's images once it is determined,
-  // from the tracker's estimate before (the in-process loop's rule, scenarios/ball_catching/flight_fit.h).
-  scenarios::FlightFit fit(cfg.flight_fit, cams, fitModel(cfg));
-  int fit_track = -1, fit_restarts = -1;
+  // What the planner predicts from: the in-process loop's rule (scenarios/ball_catching/planner_input.h).
+  scenarios::PlannerInput planner_input(cfg, cams);
 
   dds::Reader<ClockMsg> clock_r(ctx.participant, ctx.clock_topic, dds::Qos::state(4));
   dds::Reader<DetectionMsg> det_r(ctx.participant, ctx.detection_topic, dds::Qos::detections(256));
@@ -109,22 +95,9 @@ nlohmann::json runTrackerNode(const scenarios::BallCatchingConfig& config, const
     if (!pending_episode || t < *pending_episode) return;
     tracker_ptr = std::make_unique<tracking::ViewlineTracker>(cams, cfg.tracker);
     planner.reset(*pending_episode, cfg.robot.home);
-    fit.reset();
-    fit_track = fit_restarts = -1;
+    planner_input.reset();
     pending_episode.reset();
     ++episodes;
-  };
-  auto planned = [&](const tracking::ImageMeasurement& m) {
-    const tracking::ViewlineTracker& tracker = *tracker_ptr;
-    if (!cfg.flight_fit.enabled) return tracker.state();
-    const tracking::TrackState& ts = tracker.trackState();
-    if (ts.tracks_started != fit_track || ts.restarts != fit_restarts) {  // a new track: a new fit
-      fit.reset();
-      fit_track = ts.tracks_started;
-      fit_restarts = ts.restarts;
-    }
-    const std::optional<estimation::StateEstimate> fitted = fit.add({m.camera, m.t, m.uv, m.sigma_px}, tracker.state());
-    return fitted ? *fitted : tracker.state();
   };
 
   auto publishTrack = [&] {
@@ -240,7 +213,7 @@ nlohmann::json runTrackerNode(const scenarios::BallCatchingConfig& config, const
       // Planned from now, but not before the last set point sent nor after the next one (the
       // plan's set points stay continuous in time).
       const double t_update = std::clamp(std::max(clock.now(), stamp), next_control - cfg.control_period, next_control);
-      planner.update(t_update, planned(m));
+      planner.update(t_update, planner_input.after(m, tracker));
     });
     // A writer that lost its liveliness (process killed, hung, cut off) turns "not alive"; one
     // deleted cleanly (its node ended) is unmatched instead, so only the first is a camera lost.

@@ -16,6 +16,7 @@
 #include "viewline/estimation/consistency.h"
 #include "viewline/io/log.h"
 #include "viewline/runtime/delay_line.h"
+#include "viewline/scenarios/ball_catching/planner_input.h"
 #include "viewline/scenarios/ball_catching/world.h"
 #include "viewline/tracking/tracker.h"
 #include "viewline/vision/ball_detector.h"
@@ -25,18 +26,6 @@ namespace viewline::scenarios {
 namespace {
 
 using Vector6 = Eigen::Matrix<double, 6, 1>;
-
-// Gravity and drag of the flight as the planner's crossing model has them (one owner: the
-// scenario's plannerConfig()), for the flight fit.
-estimation::DragBallisticModel flightModel(const BallCatchingConfig& cfg) {
-  const planning::CrossingModel m = cfg.plannerConfig().model;
-  estimation::DragBallisticModel d;
-  d.g = m.gravity_w.norm();
-  d.up = -m.gravity_w / d.g;
-  d.k = m.kind == planning::FlightModel::Drag ? m.drag_k : 0.0;
-  d.q = 0.0;
-  return d;
-}
 
 // The tracker's verdict on one submitted image, as a gate decision (tracking::TrackGate's terms).
 tracking::GateDecision decisionOf(const tracking::MeasurementOutcome& o, bool restarted) {
@@ -55,7 +44,7 @@ public:
       : cfg_(cfg), flight_(flight), source_(source), est_cams_(std::move(est_cams)), robot_(robot),
         planner_(cfg.plannerConfig(), robot), tracker_(est_cams_, cfg.tracker), res_(res), hooks_(hooks), tel_(tel),
         noise_rng_(core::makeRng(core::deriveSeed(seed, 0xD37))),  // pixel_noise_px only
-        fit_(cfg.flight_fit, est_cams_, flightModel(cfg), FitAimPlane{cfg.robot.home, cfg.box_normal}) {
+        planner_input_(cfg, est_cams_) {
     planner_.reset(0.0, cfg.robot.home);
     for (const auto& c : est_cams_) detectors_.emplace_back(cfg.detector, c);
   }
@@ -151,23 +140,10 @@ private:
     if (fused) ++res_.fused;
     else ++res_.gated;
     consistency(m, o, tracker_.trackState().restarts > restarts_before);
-    if (fused && tracker_.initialised()) to_planner_.send(frame.stamp + cfg_.processing_latency, planned(m));
+    if (fused && tracker_.initialised())
+      to_planner_.send(frame.stamp + cfg_.processing_latency, planner_input_.after(m, tracker_));
     if (tel_ && o) report(m, *o, tracker_.trackState().restarts > restarts_before);
     return px;
-  }
-
-  // The state the planner predicts from after the fused image m: the drag-model fit of the
-  // track's images once it is determined (flight_fit.h), the tracker's estimate before.
-  estimation::StateEstimate planned(const tracking::ImageMeasurement& m) {
-    if (!cfg_.flight_fit.enabled) return tracker_.state();
-    const tracking::TrackState& ts = tracker_.trackState();
-    if (ts.tracks_started != fit_track_ || ts.restarts != fit_restarts_) {  // a new track: a new fit
-      fit_.reset();
-      fit_track_ = ts.tracks_started;
-      fit_restarts_ = ts.restarts;
-    }
-    const std::optional<estimation::StateEstimate> fitted = fit_.add({m.camera, m.t, m.uv, m.sigma_px}, tracker_.state());
-    return fitted ? *fitted : tracker_.state();
   }
 
   // The tracker's NIS and NEES samples (ThrowResult::nis, ::nees; counted as the tuning adapter does).
@@ -221,8 +197,7 @@ private:
   runtime::DelayLine<estimation::StateEstimate> to_planner_;  // processing latency
   std::optional<Eigen::Vector3d> lead_prediction_;
   std::uint64_t next_id_ = 1;
-  FlightFit fit_;
-  int fit_track_ = -1, fit_restarts_ = -1;  ///< the tracker's track the fit belongs to
+  PlannerInput planner_input_;  // the fit of the track's images (planner_input.h)
   int in_track_ = 0;  ///< fused images of the current track (consistency burn-in)
 };
 
