@@ -146,10 +146,10 @@ void readObserver(const io::ConfigNode& n, TableBallConfig& c) {
   c.observer.table_pose = n.getChoiceOr("table_pose", {"corners", "apriltag"}, "corners") == "apriltag"
                               ? TablePoseSource::AprilTag
                               : TablePoseSource::Corners;
-  c.observer.ball_geometry =
-      n.getChoiceOr("ball_geometry", {"known_radius", "unknown_radius"}, "known_radius") == "unknown_radius"
-          ? BallGeometry::UnknownRadius
-          : BallGeometry::KnownRadius;
+  const std::string geometry = n.getChoiceOr("ball_geometry", {"table_plane", "known_radius", "unknown_radius"}, "table_plane");
+  c.observer.ball_geometry = geometry == "known_radius"     ? BallGeometry::KnownRadius
+                             : geometry == "unknown_radius" ? BallGeometry::UnknownRadius
+                                                            : BallGeometry::TablePlane;
   auto& m = c.observer.tracker.model;
   m.sigma_w = n.getOr<double>("sigma_w", m.sigma_w);
   m.sigma_v = n.getOr<double>("sigma_v", m.sigma_v);

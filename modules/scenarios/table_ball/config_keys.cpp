@@ -55,7 +55,7 @@ io::ConfigReferenceSection tableBallConfigReference() {
       {"camera.supersampling", "", "renderer anti-aliasing sub-samples on edge pixels (1..8)"},
       {"observer", "", "the table and ball observer ([M])"},
       {"observer.table_pose", "", "corners ([M]: red contour, hull, 4 corners, PnP) or apriltag (needs table.tags)"},
-      {"observer.ball_geometry", "", "known_radius (d = r / sin α) or unknown_radius (r from z = r)"},
+      {"observer.ball_geometry", "", "table_plane (the cone's axis meets the plane z = r), known_radius (d = r / sin α) or unknown_radius (r from z = r)"},
       {"observer.sigma_w", "", "process noise σw of [M]'s ball model"},
       {"observer.sigma_v", "m", "measurement noise σv of [M]'s ball model"},
       {"observer.beta", "1/s", "inverse correlation time of the coloured disturbance"},
