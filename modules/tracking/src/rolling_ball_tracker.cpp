@@ -48,7 +48,12 @@ void RollingBallTracker::start(double t, const Eigen::Vector2d& a_xy, const Eige
   if (stateDim() > 6) d.tail(2).setConstant(se * se);  // the first measurement's coloured error
   Eigen::VectorXd xa = Eigen::VectorXd::Zero(stateDim());
   xa.head(6) = x_;
-  state_ = estimation::StateEstimate(xa, d.asDiagonal(), t);
+  Eigen::MatrixXd P0 = d.asDiagonal();
+  if (stateDim() > 6) {
+    // p̂ = y = p + e + v and ê = 0: the two errors are e + v and −e, covariance −σe².
+    for (int i : {0, 1}) P0(2 * i, 6 + i) = P0(6 + i, 2 * i) = -se * se;
+  }
+  state_ = estimation::StateEstimate(xa, P0, t);
   t_ = t;
   initialized_ = true;
   missed_ = 0;
