@@ -14,9 +14,10 @@
 //  - pushes (ours, beyond [M]): a knock on the ball changes its velocity within one tick, a jump
 //    no white acceleration noise of the size that fits the rolling between pushes covers (the
 //    filter would lag for half a second, and its NEES explode). The model adds rare velocity
-//    jumps Δv ~ N(0, impulse_std² I): when the update's NIS exceeds `impulse_nis` (a test at the
-//    chi-square tail, 13.8 = 99.9 % for 2 dof), the jump is assumed to have happened in the
-//    interval, the a-priori velocity covariance grows by impulse_std² per axis and the update is
+//    jumps Δv ~ N(0, impulse_std² I): when the update's NIS exceeds `impulse_nis` (far in the
+//    chi-square tail: a one-frame measurement glitch must not pass for a push), the jump is
+//    assumed at a uniform time in the interval, the a-priori covariance grows accordingly
+//    (var v += q, cov(p, v) += q dt/2, var p += q dt²/3, q = impulse_std²) and the update is
 //    redone (its own NIS is the one reported). impulse_nis = 0 turns it off ([M]);
 //  - coloured measurement error (ours): the ball's measured position inherits the table pose's
 //    error, which is correlated from frame to frame (about 0.3-0.5 at one frame, gone by five);
