@@ -89,10 +89,18 @@ TEST(BallDetector, ReportsWhyItFoundNothing) {
   cv::circle(tiny, cv::Point(300, 200), 1, cv::Scalar(kGreen), cv::FILLED);
   BallDetectorConfig cfg;
   cfg.open_kernel_px = 1;
+  cfg.coarse_step_px = 1;  // the exhaustive search sees every pixel of the 5-pixel cross
   BallDetector det_noopen(cfg);
   r = det_noopen.detect(tiny, 0.0);
   ASSERT_FALSE(r.ok());
   EXPECT_EQ(r.failure().reason, FailureReason::TooSmall);
+  // The coarse search looks for 2x2 blocks of colour; a cross holds none, so it sees no blob.
+  cfg.coarse_step_px = 2;
+  BallDetector det_coarse(cfg);
+  r = det_coarse.detect(tiny, 0.0);
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.failure().reason, FailureReason::NotFound);
+  EXPECT_NE(r.failure().message.find("sampled every 2 px"), std::string::npos) << r.failure().message;
 
   // Two equal balls, no prediction: ambiguous. With a prediction: the near one.
   cv::Mat two = empty.clone();
@@ -107,6 +115,64 @@ TEST(BallDetector, ReportsWhyItFoundNothing) {
   EXPECT_NEAR(r->pixel.x(), 450.0, 0.3);
   EXPECT_NEAR(r->pixel.y(), 260.0, 0.3);
 }
+
+class CoarseSearch : public ::testing::TestWithParam<double> {};  // min_area_px
+
+TEST_P(CoarseSearch, GivesTheExhaustiveAnswerBitForBit) {
+  // Balls of 1.5-30 px radius anywhere (some cut by the border, some with a second ball or a
+  // smaller green patch beside them, some on a noisy image): the coarse-to-fine search (colour
+  // sampled every 2nd pixel, the default) must give exactly what the exhaustive search gives, for
+  // the smallest balls the scenarios accept (min_area_px 4-12).
+  const auto cam = camera656();
+  BallDetectorConfig exhaustive_cfg;
+  exhaustive_cfg.coarse_step_px = 1;
+  exhaustive_cfg.min_area_px = GetParam();
+  BallDetectorConfig coarse_cfg = exhaustive_cfg;
+  coarse_cfg.coarse_step_px = 2;
+  BallDetector exhaustive(exhaustive_cfg, cam), coarse(coarse_cfg, cam);
+  core::Rng rng = core::makeRng(11);
+  int found = 0, small = 0;
+  for (int i = 0; i < 100; ++i) {
+    cv::Mat img = test::texturedBackground(656, 480, 500 + static_cast<unsigned>(i));
+    const double radius = i % 3 == 0 ? core::uniform(rng, 1.5, 3.0) : core::uniform(rng, 3.0, 30.0);
+    const cv::Point2d c(core::uniform(rng, -10.0, 666.0), core::uniform(rng, -10.0, 490.0));
+    const int shift = 4;  // sub-pixel centres
+    const auto fixed = [&](double v) { return static_cast<int>(std::lround(v * (1 << shift))); };
+    cv::circle(img, cv::Point(fixed(c.x), fixed(c.y)), fixed(radius), cv::Scalar(kGreen), cv::FILLED, cv::LINE_AA,
+               shift);
+    if (i % 5 == 1)
+      cv::circle(img, cv::Point(fixed(core::uniform(rng, 0.0, 656.0)), fixed(core::uniform(rng, 0.0, 480.0))),
+                 fixed(core::uniform(rng, 2.0, 20.0)), cv::Scalar(kGreen), cv::FILLED, cv::LINE_AA, shift);
+    if (i % 7 == 2) {
+      core::Rng noise = core::makeRng(900 + static_cast<std::uint64_t>(i));
+      test::addNoise(img, 6.0, noise);
+    }
+    const auto a = exhaustive.detect(img, 0.01 * i);
+    const auto b = coarse.detect(img, 0.01 * i);
+    ASSERT_EQ(a.ok(), b.ok()) << "frame " << i << ": " << (a.ok() ? b.failure().message : a.failure().message);
+    if (!a.ok()) {
+      EXPECT_EQ(a.failure().reason, b.failure().reason) << "frame " << i;
+      continue;
+    }
+    ++found;
+    if (radius < 3.0) ++small;
+    EXPECT_EQ(a->pixel.x(), b->pixel.x()) << "frame " << i;
+    EXPECT_EQ(a->pixel.y(), b->pixel.y()) << "frame " << i;
+    EXPECT_EQ(a->radius_px, b->radius_px) << "frame " << i;
+    EXPECT_EQ(a->area_px, b->area_px) << "frame " << i;
+    EXPECT_EQ(a->pixel_covariance, b->pixel_covariance) << "frame " << i;
+    EXPECT_FALSE(b->used_roi);
+  }
+  // The comparison covered found balls, small ones among them.
+  EXPECT_GT(found, 60);  // balls found (whole, alone or clearly the best)
+  EXPECT_GT(small, 10);  // of them under 3 px radius
+}
+
+INSTANTIATE_TEST_SUITE_P(BallDetector, CoarseSearch,
+                         ::testing::Values(4.0, 6.0, 12.0),
+                         [](const ::testing::TestParamInfo<double>& p) {
+                           return "MinArea" + std::to_string(static_cast<int>(p.param));
+                         });
 
 TEST(BallDetector, HalfOccludedBallIsDegradedWithInflatedCovariance) {
   BallDetector det;

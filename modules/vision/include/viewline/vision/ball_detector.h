@@ -33,6 +33,23 @@
 // around it and only falls back to the full frame when the window shows no
 // ball or cuts it; buffers are reused between calls (one detector per
 // camera, not thread-safe).
+//
+// Full-frame search, coarse to fine: the colour test first runs on every
+// s-th pixel of every s-th row only (coarse_step_px, s² fewer pixels to
+// convert). Any s x s block of pixels holds exactly one sample, so every blob
+// that holds an s x s block of ball-coloured pixels is hit; a hit is kept
+// when its own neighbourhood holds such a block (which drops single noisy
+// pixels, as the opening would), and the exact pipeline above then runs in a
+// window around each group of kept hits, grown by the pixels between samples
+// (s - 1) and the reach of the opening and closing. Such a blob is found and
+// measured exactly as the exhaustive search would (same contour, same centre,
+// bit for bit; test CoarseFullFrameSearchGivesTheExhaustiveAnswerBitForBit);
+// only blobs with no s x s block of colour go unseen. With the default s = 2
+// that is thin lines and isolated crosses, never a ball's disc; s = 3 also
+// misses discs of radius under ~2 px whose anti-aliased edge fails the colour
+// test (areas of 12-15 px), so raise it only for balls that stay larger. Clutter that gives many groups, or
+// windows over half the frame, falls back to the exhaustive search, and so
+// does a blob that reaches its window's edge.
 
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
@@ -60,6 +77,7 @@ struct BallDetectorConfig {
   double edge_noise_px = 0.5;    ///< σe in var = σe² / (π R)
   double min_sigma_px = 0.05;    ///< σ floor of the centre
   double edge_offset_px = 0.5;   ///< added to the minEnclosingCircle radius
+  int coarse_step_px = 2;        ///< full-frame search: colour test on every k-th pixel first (1 = every pixel)
 
   /// Throws core::InvalidInput naming the field.
   void validate() const;
@@ -90,14 +108,27 @@ public:
   const BallDetectorConfig& config() const { return config_; }
 
 private:
-  Result<BallMeasurement> detectIn(const cv::Mat& bgr, const cv::Rect& roi, core::Timestamp stamp,
-                                   const std::optional<Eigen::Vector2d>& predicted, bool& cut_by_roi);
+  // One search: the windows it looks in (the whole frame, a tracking window, or the coarse
+  // search's windows), then the best candidate of all of them.
+  Result<BallMeasurement> search(const cv::Mat& bgr, const std::vector<cv::Rect>& windows, bool whole_frame,
+                                 core::Timestamp stamp, const std::optional<Eigen::Vector2d>& predicted,
+                                 bool& cut_by_window);
+  // Fills windows_ from the coarse colour test; false when the exhaustive search is the better one.
+  bool coarseWindows(const cv::Mat& bgr);
+  // Adds the candidates of one window to the candidate list (contours copied into kept_).
+  void collect(const cv::Mat& bgr, const cv::Rect& window, const std::optional<Eigen::Vector2d>& predicted);
 
   BallDetectorConfig config_;
   std::optional<core::Camera> camera_;
   cv::Mat open_kernel_, close_kernel_;
   cv::Mat hsv_, mask_;  // reused buffers
   std::vector<std::vector<cv::Point>> contours_;
+  std::vector<std::vector<cv::Point>> kept_;  // candidates' contours (capacity reused)
+  std::size_t kept_count_ = 0;
+  double largest_tiny_ = 0.0;                   // largest blob under min_area_px of this search
+  cv::Mat coarse_bgr_, coarse_hsv_, coarse_mask_;  // the coarse search's samples
+  std::vector<cv::Point> hits_;  // the coarse search's samples that passed (full-resolution pixels)
+  std::vector<cv::Rect> windows_;
 };
 
 }  // namespace viewline::vision
