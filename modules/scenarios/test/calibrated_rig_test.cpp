@@ -1,6 +1,6 @@
 // A rig that is only calibrated (rig.yaml + e_M_c.yaml, no truth.yaml): it loads, runs pan-tilt on
-// real frames (a recording, an images folder), and refuses to render (source: sim) with a message
-// that names the folder and says truth.yaml is needed only to render.
+// real frames (a recording, an images folder), table ball on a recording, and both refuse to render
+// (source: sim) with a message that names the folder and says truth.yaml is needed only to render.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -11,6 +11,7 @@
 #include "viewline/core/error.h"
 #include "viewline/io/config_edit.h"
 #include "viewline/scenarios/pan_tilt/loop.h"
+#include "viewline/scenarios/table_ball.h"
 #include "viewline/scenarios/simulated_rig.h"
 
 namespace fs = std::filesystem;
@@ -105,6 +106,38 @@ TEST(CalibratedRig, PanTiltRunsFromARecordingAndFromImages) {
   EXPECT_FALSE(f.ours.scored);
   EXPECT_EQ(f.ours.frames, live.ours.frames);
   EXPECT_GT(f.ours.detections, 15u);
+  fs::remove_all(rec);
+  fs::remove_all(rig);
+}
+
+TEST(CalibratedRig, TableBallRunsFromARecordingAndRefusesToRenderWithoutTruth) {
+  const fs::path rig = scratch("table_rig");
+  fs::create_directories(rig);
+  for (const auto& e : fs::directory_iterator("calib/rigs/table"))
+    if (e.path().filename() != "truth.yaml") fs::copy(e.path(), rig / e.path().filename(), fs::copy_options::recursive);
+  try {
+    scenarios::tableBallConfigFromYaml(io::loadConfigWithValues("config/table_ball.yaml", {"rig=" + rig.string()}));
+    FAIL() << "expected InvalidInput";
+  } catch (const core::InvalidInput& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find(rig.string()), std::string::npos) << msg;
+    EXPECT_NE(msg.find("needed only to render"), std::string::npos) << msg;
+  }
+  // A short recorded run on the simulated table rig, replayed on the calibrated-only one.
+  auto cfg = scenarios::tableBallConfigFromYaml(io::loadConfigWithValues("config/table_ball.yaml", {}));
+  cfg.duration = 0.6;
+  const fs::path rec = scratch("table_rec");
+  scenarios::TableBallHooks record;
+  record.record_dir = rec.string();
+  const auto live = scenarios::runTableBall(cfg, 5, record);
+  auto on_rec = scenarios::tableBallConfigFromYaml(io::loadConfigWithValues(
+      "config/table_ball.yaml", {"rig=" + rig.string(), "source.kind=recording", "source.path=" + rec.string()}));
+  on_rec.duration = cfg.duration;
+  ASSERT_TRUE(on_rec.rig);
+  EXPECT_EQ(on_rec.rig->truth.intrinsics.get_px(), on_rec.rig->calibrated.intrinsics.get_px());
+  const auto r = scenarios::runTableBall(on_rec, 5);
+  EXPECT_EQ(r.frames, live.frames);
+  EXPECT_GT(r.frames, 15);
   fs::remove_all(rec);
   fs::remove_all(rig);
 }
