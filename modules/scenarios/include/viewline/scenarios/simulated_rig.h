@@ -32,7 +32,7 @@ namespace viewline::scenarios {
 /// A rig folder: its calibration and, for a simulated rig, the true cameras the simulator renders with.
 struct SimulatedRig {
   std::string folder;                    ///< the rig folder as resolved (no trailing slash)
-  calib::RigTruth truth;                 ///< what the simulator renders with (and scores against); empty without truth.yaml
+  calib::RigTruth truth;                 ///< what the simulator renders with (scores against); empty: no truth.yaml
   std::vector<core::Camera> calibrated;  ///< rig.yaml: what estimators use
   bool has_truth = true;                 ///< false for a calibrated-only rig (no truth.yaml)
 

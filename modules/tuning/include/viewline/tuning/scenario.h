@@ -10,8 +10,9 @@
 //
 // For the noise auto-tuning an instance also names its noise parameters (process, measurement),
 // records what a replay needs (the measurements with their time stamps) from a live run, from
-// the scenario app's --log directory or from a recording of its frames (--record), and re-runs its filter on those measurements for candidate
-// noise values, returning the innovation cost (autotune.h).
+// the scenario app's --log directory or from a recording of its frames (--record), and re-runs
+// its filter on those measurements for candidate noise values, returning the innovation cost
+// (autotune.h).
 //
 // Adapters are compiled only when their scenario's library exists (modules/tuning/CMakeLists.txt)
 // and register themselves in makeBuiltinAdapters().
