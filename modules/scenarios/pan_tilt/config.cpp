@@ -82,7 +82,7 @@ PanTiltScenarioConfig loadPanTiltScenarioConfig(const io::ConfigNode& root) {
     c.disc_radius = s.get<double>("disc_radius");
   }
   if (root.has("rig")) {
-    // Default simulated rig: truth for the simulator, calibration for the controllers.
+    // A rig: truth for the simulator (a simulated rig), calibration for the controllers.
     const SimulatedRig rig = loadSimulatedRig(root, "rig");
     const auto where = [&](const std::string& what) {
       return root.location("rig") + ": key '" + root.keyPath("rig") + "': " + what;
