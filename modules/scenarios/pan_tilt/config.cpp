@@ -82,16 +82,23 @@ PanTiltScenarioConfig loadPanTiltScenarioConfig(const io::ConfigNode& root) {
     c.disc_radius = s.get<double>("disc_radius");
   }
   if (root.has("rig")) {
-    // Default simulated rig: truth for the simulator, calibration for the controllers.
+    // A rig: truth for the simulator (a simulated rig), calibration for the controllers.
     const SimulatedRig rig = loadSimulatedRig(root, "rig");
     const auto where = [&](const std::string& what) {
       return root.location("rig") + ": key '" + root.keyPath("rig") + "': " + what;
     };
-    if (!rig.truth.e_M_c) throw core::InvalidInput(where(rig.folder + "/truth.yaml has no hand_eye section (not a pan-tilt rig)"));
+    // A calibrated-only rig (no truth.yaml) cannot render: source: sim needs the truth.
+    if (c.source.simulated()) {
+      try {
+        rig.requireTruth("source: sim renders the frames");
+      } catch (const core::InvalidInput& e) {
+        throw core::InvalidInput(where(e.what()));
+      }
+    }
+    if (rig.hasTruth() && !rig.truth.e_M_c)
+      throw core::InvalidInput(where(rig.folder + "/truth.yaml has no hand_eye section (not a pan-tilt rig)"));
     c.rig_folder = rig.folder;
-    c.true_camera = rig.trueCamera(kRigCamera);
     c.calibrated_camera = rig.calibratedCamera(kRigCamera);
-    c.true_e_M_c = *rig.truth.e_M_c;
     try {
       const auto he = io::ConfigNode::loadFile(rig.file("e_M_c.yaml"));  // calibrate-hand-eye output
       c.calibrated_e_M_c = io::readPose(he.child("e_M_c"));
@@ -99,6 +106,15 @@ PanTiltScenarioConfig loadPanTiltScenarioConfig(const io::ConfigNode& root) {
       he.finish();
     } catch (const core::InvalidInput& e) {
       throw core::InvalidInput(where(e.what()));
+    }
+    if (rig.hasTruth()) {
+      c.true_camera = rig.trueCamera(kRigCamera);
+      c.true_e_M_c = *rig.truth.e_M_c;
+    } else {
+      // Real frames: nothing is rendered, and the unit (simulated or a driver) carries the camera
+      // where the calibration says it is, so the "true" camera and mount are the calibrated ones.
+      c.true_camera = c.calibrated_camera;
+      c.true_e_M_c = c.calibrated_e_M_c;
     }
     c.image_width = c.true_camera->width;
     c.image_height = c.true_camera->height;

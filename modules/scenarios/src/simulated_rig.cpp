@@ -1,5 +1,6 @@
 #include "viewline/scenarios/simulated_rig.h"
 
+#include <filesystem>
 #include <sstream>
 
 #include "viewline/core/error.h"
@@ -20,7 +21,15 @@ const core::Camera& findCamera(const std::vector<core::Camera>& cameras, const s
 }
 }  // namespace
 
+void SimulatedRig::requireTruth(const std::string& what) const {
+  if (has_truth) return;
+  throw core::InvalidInput(folder + " has no truth.yaml (a calibrated-only rig): " + what +
+                           ", and truth.yaml (the simulator's cameras) is needed only to render; run this rig on real "
+                           "frames (source: images, video, recording or v4l2) or add truth.yaml");
+}
+
 const core::Camera& SimulatedRig::trueCamera(const std::string& name) const {
+  requireTruth("its true camera '" + name + "' was asked for");
   return findCamera(truth.cameras, name, folder + "/truth.yaml");
 }
 
@@ -34,8 +43,11 @@ SimulatedRig loadSimulatedRig(const std::string& folder_in) {
   SimulatedRig rig;
   rig.folder = folder_in;
   while (rig.folder.size() > 1 && rig.folder.back() == '/') rig.folder.pop_back();
-  rig.truth = calib::loadRigTruth(rig.file("truth.yaml"));
   rig.calibrated = io::loadRig(rig.file("rig.yaml"));
+  // Only the simulator needs truth.yaml: without it the rig is calibrated only (a real rig).
+  rig.has_truth = std::filesystem::exists(rig.file("truth.yaml"));
+  if (!rig.has_truth) return rig;
+  rig.truth = calib::loadRigTruth(rig.file("truth.yaml"));
   if (rig.truth.cameras.size() != rig.calibrated.size()) {
     throw core::InvalidInput(rig.folder + ": truth.yaml has " + std::to_string(rig.truth.cameras.size()) +
                              " cameras but rig.yaml has " + std::to_string(rig.calibrated.size()) +

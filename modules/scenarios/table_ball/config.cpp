@@ -203,6 +203,8 @@ TableBallConfig tableBallConfigFromYaml(const io::ConfigNode& root) {
   if (root.has("rig")) {
     const std::string folder = root.getPath("rig");
     try {
+      // A calibrated-only rig (no truth.yaml) cannot render: source: sim needs the truth.
+      if (c.source.simulated()) loadSimulatedRig(folder).requireTruth("source: sim renders the frames");
       c.rig = loadTableRig(folder);
     } catch (const core::InvalidInput& e) {
       throw core::InvalidInput(root.location("rig") + ": key 'rig': " + e.what());
@@ -249,7 +251,8 @@ TableBallConfig::RigCameras loadTableRig(const std::string& folder) {
   const SimulatedRig rig = loadSimulatedRig(folder);
   TableBallConfig::RigCameras out;
   out.folder = std::filesystem::path(rig.folder).lexically_normal().string();
-  out.truth = rig.trueCamera("head");
+  // A calibrated-only rig replays recorded frames: nothing renders, so the camera is its calibration.
+  out.truth = rig.hasTruth() ? rig.trueCamera("head") : rig.calibratedCamera("head");
   out.calibrated = rig.calibratedCamera("head");
   // ground.yaml (camera-to-ground): the calibrated rotation of the head at rest to the ground
   // (z up), which is all the observer needs of the rest pose besides the nominal table prior.

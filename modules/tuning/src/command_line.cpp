@@ -68,6 +68,8 @@ TuneCommandLine::TuneCommandLine(CLI::App& app) {
   autotune_->add_option("--config", ao.config, "scenario YAML")->required();
   autotune_->add_option("--set", ao.set, io::kSetOptionHelp)->take_all();
   autotune_->add_option("--log", ao.log_dir, "the scenario app's --log folder (default: record a live run)");
+  autotune_->add_option("--recording", ao.recording,
+                        "a recording of the scenario's frames (its app's --record folder) to fit on; no truth needed");
   autotune_->add_option("--record-seed", ao.record_seed, "seed of the live recording");
   autotune_->add_option("--record-runs", ao.record_runs, "live runs recorded");
   autotune_->add_option("--start-scale", ao.start_scale, "start from the config's noise values times this");
@@ -92,6 +94,8 @@ TuneCommandLine::TuneCommandLine(CLI::App& app) {
   check_->add_option("--set", co.set, io::kSetOptionHelp)->take_all();
   check_->add_option("--seeds", co.seeds, "seeded runs pooled");
   check_->add_option("--seed", co.seed, "base seed (run i: deriveSeed(seed, i)); pick one the noise was not tuned on");
+  check_->add_option("--recording", co.recording,
+                     "a recording of the scenario's frames (--record folder): NIS of the config's filter on it, not seeded runs");
   check_->add_option("--out", co.out_dir, "folder for summary.json (default: none)");
   check_->add_option("--option", check_adapter_options_, "adapter option name=value");
   check_->add_option("--workers", workers_, "threads (0: all cores)");
@@ -192,11 +196,14 @@ int TuneCommandLine::runAutotune(const AdapterRegistry& registry) {
     std::printf("  live NEES with the tuned noise %.3f in [%.3f, %.3f]: %s\n", get(j, "autotune_nees_mean"),
                 j["autotune_nees_bounds"][0].get<double>(), j["autotune_nees_bounds"][1].get<double>(),
                 j["autotune_nees_inside"].get<bool>() ? "inside" : "OUTSIDE");
-  std::printf("  fresh seed %llu (%s): NIS %.3f in [%.3f, %.3f] (%s)\n",
-              static_cast<unsigned long long>(j["autotune_verify_seed"].get<std::uint64_t>()),
-              j["autotune_verify_data"].get<std::string>().c_str(), get(j, "autotune_verify_nis_mean"),
-              element(j["autotune_verify_nis_bounds"], 0), element(j["autotune_verify_nis_bounds"], 1),
-              j["autotune_verify_nis_verdict"].get<std::string>().c_str());
+  if (j.contains("autotune_verify_seed"))
+    std::printf("  fresh seed %llu (%s): NIS %.3f in [%.3f, %.3f] (%s)\n",
+                static_cast<unsigned long long>(j["autotune_verify_seed"].get<std::uint64_t>()),
+                j["autotune_verify_data"].get<std::string>().c_str(), get(j, "autotune_verify_nis_mean"),
+                element(j["autotune_verify_nis_bounds"], 0), element(j["autotune_verify_nis_bounds"], 1),
+                j["autotune_verify_nis_verdict"].get<std::string>().c_str());
+  else
+    std::printf("  fitted on a recording: check the tuned config on another one (viewline_tune check --recording)\n");
   std::printf("  tuned config: %s\n  report: %s\n", j["autotuned_config"].get<std::string>().c_str(),
               j["report"].get<std::string>().c_str());
   return 0;
@@ -208,8 +215,12 @@ int TuneCommandLine::runCheck(const AdapterRegistry& registry) {
   co.workers = workers_;
   co.quiet = quiet_;
   const nlohmann::json j = runCheckSession(registry, co);
-  std::printf("viewline_tune check: %s %s, %d seed(s) from %llu (confidence %.2f)\n", co.scenario.c_str(),
-              co.config.c_str(), co.seeds, static_cast<unsigned long long>(co.seed), get(j, "confidence"));
+  if (!co.recording.empty())
+    std::printf("viewline_tune check: %s %s on recording %s (confidence %.2f)\n  %s\n", co.scenario.c_str(),
+                co.config.c_str(), co.recording.c_str(), get(j, "confidence"), j["data"].get<std::string>().c_str());
+  else
+    std::printf("viewline_tune check: %s %s, %d seed(s) from %llu (confidence %.2f)\n", co.scenario.c_str(),
+                co.config.c_str(), co.seeds, static_cast<unsigned long long>(co.seed), get(j, "confidence"));
   for (const char* k : {"check_nis", "check_nees"}) {
     const nlohmann::json& c = j[k];
     std::printf("  %-4s mean %-9.4g band [%.4g, %.4g]  %zu samples, %g dof  %s\n", k + 6, get(c, "mean"),

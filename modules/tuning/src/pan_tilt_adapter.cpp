@@ -29,6 +29,7 @@
 #include <optional>
 
 #include "adapter_util.h"
+#include "pan_tilt_recording.h"
 #include "viewline/control/pan_tilt_servo.h"
 #include "viewline/core/error.h"
 #include "viewline/core/random.h"
@@ -100,7 +101,7 @@ detail::OptionTable<PanTiltOptions> panTiltOptions() {
       .integer("burn_in", &PanTiltOptions::burn_in, "5", 1, 1e6, "accepted measurements of a track before its innovations count")
       .number("nees_spacing_s", &PanTiltOptions::nees_spacing, "2", 1e-9, detail::kUnbounded, "s between NEES samples (nearly independent)")
       .integer("log_seed", &PanTiltOptions::log_seed, "1", 0, 1e15,
-               "seed of a pan_tilt_tracking --log run (its path amplitude gives R)");
+               "seed of the run a --log folder or a --recording comes from (its path amplitude gives R)");
   return options;
 }
 
@@ -245,6 +246,24 @@ public:
     rec.R = trueR(opt_.log_seed);
     d->items.push_back(rec);
     d->source = dir + "/predictive_frames.csv (R from the config, seed option log_seed)";
+    return d;
+  }
+
+  /// A recording's frames through the scenario's detector and loop (pan_tilt_recording.h), seed
+  /// log_seed; NIS only (a recording of a real rig has no truth).
+  std::unique_ptr<ReplayData> loadRecording(const std::string& dir) const override {
+    const detail::PanTiltRecordingRun run = detail::panTiltRecordingRun(cfg_, dir);
+    PanTiltOptions o = opt_;
+    o.duration = 0.0;  // the recording's length, set in run.config
+    const PanTiltInstance on(run.config, o, r_scale_);
+    runtime::MemorySink sink;
+    Recorded rec = on.recordOne(opt_.log_seed, {}, nullptr, sink);
+    rec.has_truth = false;
+    auto d = newReplayData();
+    d->items.push_back(std::move(rec));
+    d->source = "recording " + run.dir + " (" + std::to_string(run.grabs) +
+                " grabs through the scenario's detector and loop, seed option log_seed " + std::to_string(opt_.log_seed) +
+                "; " + run.note + ")";
     return d;
   }
 

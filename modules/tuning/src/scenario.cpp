@@ -60,6 +60,10 @@ namespace {
 std::vector<NoiseParameter> ScenarioInstance::noiseParameters() const { unsupported(*this); }
 std::unique_ptr<ReplayData> ScenarioInstance::record(std::uint64_t, int) const { unsupported(*this); }
 std::unique_ptr<ReplayData> ScenarioInstance::loadLog(const std::string&) const { unsupported(*this); }
+std::unique_ptr<ReplayData> ScenarioInstance::loadRecording(const std::string& dir) const {
+  requireAutotune("this scenario");
+  throw core::InvalidInput(dir + ": this scenario's tuning adapter does not read recordings (pan_tilt does)");
+}
 ReplayResult ScenarioInstance::replay(const ReplayData&, const std::vector<double>&, double, bool) const {
   unsupported(*this);
 }

@@ -11,6 +11,8 @@
 //   viewline_tune run      --scenario dart --config config/dart_tracking.yaml --seed 1 --out out/run [--display]
 //   viewline_tune autotune --scenario dart --config config/dart_tracking.yaml [--log DIR] --out out/autotune
 //   viewline_tune check    --scenario mobile_capture --config config/mobile_capture.yaml --seeds 3 [--seed 2]
+//   viewline_tune autotune --scenario pan_tilt --config C.yaml --recording A --out out/autotune
+//   viewline_tune check    --scenario pan_tilt --config out/autotune/autotuned_config.yaml --recording B
 //   viewline_tune list
 
 #include <CLI/CLI.hpp>

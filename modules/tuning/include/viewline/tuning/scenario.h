@@ -9,9 +9,10 @@
 // mutable state; the result depends only on (config, seed).
 //
 // For the noise auto-tuning an instance also names its noise parameters (process, measurement),
-// records what a replay needs (the measurements with their time stamps) from a live run or from
-// the scenario app's --log directory, and re-runs its filter on those measurements for candidate
-// noise values, returning the innovation cost (autotune.h).
+// records what a replay needs (the measurements with their time stamps) from a live run, from
+// the scenario app's --log directory or from a recording of its frames (--record), and re-runs
+// its filter on those measurements for candidate noise values, returning the innovation cost
+// (autotune.h).
 //
 // Adapters are compiled only when their scenario's library exists (modules/tuning/CMakeLists.txt)
 // and register themselves in makeBuiltinAdapters().
@@ -159,6 +160,10 @@ public:
   virtual std::unique_ptr<ReplayData> record(std::uint64_t seed, int runs) const;
   /// Reads the replay data from the scenario app's --log directory.
   virtual std::unique_ptr<ReplayData> loadLog(const std::string& dir) const;
+  /// Reads the replay data from a viewline recording folder (the scenario app's --record): its
+  /// frames run through the scenario's own detector and loop, so no truth is needed (NIS only).
+  /// Default: throws core::InvalidInput saying this adapter does not read recordings.
+  virtual std::unique_ptr<ReplayData> loadRecording(const std::string& dir) const;
   /// Re-runs the filter on the data with the given noise values (in noiseParameters() order).
   /// `outlier_prior` is the prior probability that a measurement is a gross outlier (0: none).
   virtual ReplayResult replay(const ReplayData& data, const std::vector<double>& noise, double outlier_prior,

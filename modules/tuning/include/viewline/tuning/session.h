@@ -70,6 +70,10 @@ struct AutotuneSessionOptions {
   std::string scenario;       ///< adapter name
   std::string config;         ///< scenario YAML
   std::string log_dir;        ///< the scenario app's --log folder; "" = record a live run
+  /// A recording of the scenario's frames (its app's --record folder) to fit on, instead of a live
+  /// run or a log: the frames go through the scenario's detector and loop, no truth needed. There is
+  /// no fresh-seed run then: check the tuned config on a second recording (check --recording).
+  std::string recording;
   std::uint64_t record_seed = 1000;  ///< seed of the live recording
   int record_runs = 1;        ///< runs of the live recording
   double start_scale = 1.0;   ///< start from the config's noise values times this
@@ -101,6 +105,9 @@ struct CheckOptions {
   int seeds = 3;               ///< seeded runs pooled
   int workers = 0;             ///< threads; 0: all cores
   std::string out_dir;         ///< "" : no files; else summary.json there
+  /// A recording of the scenario's frames (--record folder): the NIS of the config's filter on its
+  /// measurements, instead of seeded runs (no truth needed, so no NEES); "" = seeded runs.
+  std::string recording;
   std::vector<std::string> set;  ///< --set edits of the config (see SessionOptions::set)
   AdapterOptions adapter_options;  ///< --option values (checked against the adapter's declarations)
   bool quiet = false;          ///< no progress lines on stderr
