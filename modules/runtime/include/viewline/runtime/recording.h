@@ -147,8 +147,8 @@ private:
 };
 
 // A session recording: a scenario that runs several independent units (throws, runs), each on its
-// own clock, records one recording folder per unit under DIR (DIR/<unit>_iii, iii: the index, 3
-// digits) and, at the top, session.json ({"scenario": NAME, "seed": S, "units": N, "unit": "<unit>"})
+// own clock, records one recording folder per unit under DIR (DIR/UNIT_iii, iii: the index, 3
+// digits) and, at the top, session.json ({"scenario": NAME, "seed": S, "units": N, "unit": UNIT})
 // and config.yaml (the config as run). The seed is what a replay must be given again: a scenario
 // keeps simulated, from the seed, what a recording does not hold.
 
@@ -160,7 +160,7 @@ struct SessionRecording {
   std::string unit;        ///< their name ("throw", "run")
 };
 
-/// The folder of unit `index` of a session recording: DIR/<unit>_iii.
+/// The folder of unit `index` of a session recording: DIR/UNIT_iii (UNIT: "throw", "run").
 std::string sessionUnitDir(const std::string& dir, const std::string& unit, int index);
 
 /// Starts a session recording: refuses (core::InvalidInput) a folder that exists and is not empty or
@@ -168,7 +168,7 @@ std::string sessionUnitDir(const std::string& dir, const std::string& unit, int 
 void beginSessionRecording(const std::string& dir, const SessionRecording& session, const std::string& config_text);
 
 /// Reads DIR/session.json; throws core::InvalidInput naming the folder when it holds no session
-/// recording of `scenario` (written by "<scenario> --record").
+/// recording of `scenario` (written by its app with --record).
 SessionRecording readSessionRecording(const std::string& dir, const std::string& scenario);
 
 /// Checks that DIR can be replayed with this seed and number of units; throws core::InvalidInput
