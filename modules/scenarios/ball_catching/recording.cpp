@@ -84,7 +84,7 @@ ThrowFrames::ThrowFrames(std::vector<sim::SimCamera> cameras, core::Rng& rng, co
                          const sim::World& world, double t_end, std::string object)
     : rig_(std::make_unique<RigFrameSource>(std::move(cameras), rng, render, world, t_end)), object_(std::move(object)) {}
 
-ThrowFrames::ThrowFrames(const std::string& throw_dir) {
+ThrowFrames::ThrowFrames(const std::string& throw_dir, std::size_t cameras) {
   if (!fs::is_regular_file(fs::path(throw_dir) / "recording.csv"))
     throw core::InvalidInput(throw_dir + ": no recording.csv (a throw of a ball_catching recording; an interrupted "
                              "recording has none for its last throw)");
@@ -92,6 +92,10 @@ ThrowFrames::ThrowFrames(const std::string& throw_dir) {
   if (replay_->truthColumns() != kTruthColumns)
     throw core::InvalidInput(throw_dir + "/truth.csv: expected the ball_catching truth columns (object_seen, in_front, "
                              "in_image, p_x, p_y, p_z)");
+  if (replay_->cameraCount() > cameras)
+    throw core::InvalidInput(throw_dir + "/recording.csv: frames of " + std::to_string(replay_->cameraCount()) +
+                             " cameras, the config uses " + std::to_string(cameras) +
+                             " (replay with the config of the recording, its config.yaml)");
 }
 
 ThrowFrames::~ThrowFrames() = default;

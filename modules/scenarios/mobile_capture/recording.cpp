@@ -51,6 +51,9 @@ MobileCaptureFrames::MobileCaptureFrames(const std::string& run_dir, const sim::
   replay_ = std::make_unique<runtime::RecordingSource>(run_dir);
   if (replay_->truthColumns() != kTruthColumns)
     throw core::InvalidInput(run_dir + "/truth.csv: expected the mobile_capture truth columns (x, y, theta, v, omega)");
+  if (replay_->cameraCount() != 1)
+    throw core::InvalidInput(run_dir + "/recording.csv: frames of " + std::to_string(replay_->cameraCount()) +
+                             " cameras; the head camera is one");
 }
 
 MobileCaptureFrames::~MobileCaptureFrames() = default;

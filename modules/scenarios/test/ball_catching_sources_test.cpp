@@ -80,6 +80,11 @@ TEST(BallCatchingSources, ReplayOfARecordingGivesTheSameSummaryBitForBit) {
   // Another seed would draw other pixel noise and registration: refused, naming the recorded seed.
   EXPECT_NE(errorOf([&] { scenarios::runBallCatching(cfg, 2, 12, replay); }).find("replay with --seed 11"),
             std::string::npos);
+  // A config with fewer cameras than the recording's.
+  const auto one_camera = scenarios::loadBallCatchingConfig(io::loadConfigWithValues(
+      "config/ball_catching.yaml", {"registration.enabled=false", "rate_override_hz=25", "camera_count=1"}));
+  EXPECT_NE(errorOf([&] { scenarios::runBallCatching(one_camera, 2, 11, replay); }).find("frames of 2 cameras"),
+            std::string::npos);
   // More throws than recorded.
   EXPECT_NE(errorOf([&] { scenarios::runBallCatching(cfg, 3, 11, replay); }).find("holds 2 throws"), std::string::npos);
   // A recording is never written over.

@@ -37,7 +37,8 @@ std::string errorOf(F&& f) {
 }
 
 // A short batch: a few simulated seconds per run, and the summary's filter test and sweep small.
-const std::vector<std::string> kShort = {"world.max_time=8", "filter_test.runs=1", "fov_sweep.poses=5"};
+const std::vector<std::string> kShort = {"world.max_time=8", "filter_test.runs=1", "filter_test.duration=20",
+                                         "fov_sweep.poses=5"};
 
 }  // namespace
 

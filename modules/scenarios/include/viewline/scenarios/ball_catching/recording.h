@@ -31,6 +31,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <vector>
 #include <optional>
 #include <string>
 #include <vector>
@@ -77,9 +78,9 @@ public:
   /// `object` names the tracked object in the renderer's truth.
   ThrowFrames(std::vector<sim::SimCamera> cameras, core::Rng& rng, const sim::RenderSettings& render,
               const sim::World& world, double t_end, std::string object);
-  /// A recorded throw (throw_dir = catchThrowDir(DIR, i)); throws core::InvalidInput naming the file
-  /// when it is not one (no index, no truth).
-  explicit ThrowFrames(const std::string& throw_dir);
+  /// A recorded throw (throw_dir = catchThrowDir(DIR, i)) for a loop with `cameras` cameras; throws
+  /// core::InvalidInput naming the file when it is not one (no index, no truth) or holds more cameras.
+  ThrowFrames(const std::string& throw_dir, std::size_t cameras);
   ~ThrowFrames() override;
   ThrowFrames(const ThrowFrames&) = delete;
   ThrowFrames& operator=(const ThrowFrames&) = delete;
