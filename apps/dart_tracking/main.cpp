@@ -45,8 +45,10 @@ int main(int argc, char** argv) {
       yaml << io::loadConfigWithValues(opt.config_path, opt.sets).yaml();
       cb.config_text = std::string(yaml.c_str()) + "\n";
     }
-    if (!opt.replay_dir.empty() && cli.count("--runs") == 0)
-      runs = runtime::readSessionRecording(opt.replay_dir, "dart_tracking").units;
+    const std::string replay = !opt.replay_dir.empty() ? opt.replay_dir
+                               : cfg.source.kind == runtime::SourceKind::Recording ? cfg.source.recording
+                                                                                   : std::string();
+    if (!replay.empty() && cli.count("--runs") == 0) runs = runtime::readSessionRecording(replay, "dart_tracking").units;
     if (log.enabled()) {
       io::CsvWriter& csv = log.stream("detections", scenarios::dartLogColumns());
       cb.log = [&csv](const scenarios::DartLogRow& r) { csv.rowText(scenarios::dartLogRow(r)); };

@@ -374,7 +374,10 @@ DartSummary runDartExperiments(const DartScenarioConfig& cfg, std::uint64_t seed
   sum.gate_mahalanobis.gate = "mahalanobis";
   sum.scenario_gate.gate = tracking::toString(cfg.tracker.gate.kind);
   Pools pools;
-  DartFlights flights(cb.record_dir, cb.replay_dir, seed, runs, cb.config_text);
+  const std::string replay =
+      !cb.replay_dir.empty() ? cb.replay_dir
+                             : cfg.source.kind == runtime::SourceKind::Recording ? cfg.source.recording : std::string();
+  DartFlights flights(cb.record_dir, replay, seed, runs, cb.config_text);
   DartRun one(cfg, cams, exact, offset, cb, pools, sum, flights);
   int done = 0;
   for (int run = 0; run < runs; ++run) {

@@ -50,9 +50,22 @@ TEST(DartRecording, ReplayOfRecordedDetectionsGivesTheSameSummaryBitForBit) {
   EXPECT_EQ(withoutWallClock(scenarios::summaryToJson(again, cfg)).dump(),
             withoutWallClock(scenarios::summaryToJson(live, cfg)).dump());
 
+  // The same recording named by the config's source.
+  const auto from_config = scenarios::loadDartScenario("config/dart_tracking.yaml",
+                                                       {"source.kind=recording", "source.path=" + dir.string()});
+  EXPECT_EQ(withoutWallClock(scenarios::summaryToJson(scenarios::runDartExperiments(from_config, 3, 4), cfg)).dump(),
+            withoutWallClock(scenarios::summaryToJson(live, cfg)).dump());
+
   EXPECT_NE(errorOf([&] { scenarios::runDartExperiments(cfg, 4, 4, replay); }).find("replay with --seed 3"),
             std::string::npos);
   EXPECT_NE(errorOf([&] { scenarios::runDartExperiments(cfg, 3, 5, replay); }).find("holds 4 runs"), std::string::npos);
   EXPECT_NE(errorOf([&] { scenarios::runDartExperiments(cfg, 3, 1, record); }).find("is not empty"), std::string::npos);
   fs::remove_all(dir);
+}
+
+TEST(DartRecording, FootageIsRefused) {
+  const std::string e = errorOf([] {
+    scenarios::loadDartScenario("config/dart_tracking.yaml", {"source.kind=video", "source.path=x.mp4"});
+  });
+  EXPECT_NE(e.find("source.kind video is not supported by dart_tracking"), std::string::npos) << e;
 }

@@ -63,7 +63,7 @@ struct DartRunCallbacks {
   /// changes when, never what: the figures are the same.
   runtime::Pacing pacing;
   std::string record_dir;   ///< --record DIR: every run's detections, truth and draws (recording.h); "" : none
-  std::string replay_dir;   ///< --replay DIR: the trackers on a recording's detections instead of simulated ones
+  std::string replay_dir;   ///< --replay DIR: the trackers on a recording's detections (overrides `source:`)
   std::string config_text;  ///< the config as run, written into a recording (config.yaml)
 };
 
