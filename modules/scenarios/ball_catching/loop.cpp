@@ -237,8 +237,9 @@ ThrowResult runThrow(const BallCatchingConfig& cfg, const sim::Scene& room, int 
   std::vector<core::Camera> est_cams;  // calibrated (rig:) or the render camera (inline cameras)
   for (std::size_t i = 0; i < cfg.activeCameras(); ++i) est_cams.push_back(cfg.cameras[i].estimatorCamera());
   std::unique_ptr<ThrowFrames> frames =
-      replay_root.empty() ? std::make_unique<ThrowFrames>(throwCameras(cfg, rng), rng, cfg.render, world, t_end, cfg.object)
-                          : std::make_unique<ThrowFrames>(catchThrowDir(replay_root, index), est_cams.size());
+      replay_root.empty()
+          ? std::make_unique<ThrowFrames>(throwCameras(cfg, rng), rng, cfg.render, world, t_end, cfg.object)
+          : std::make_unique<ThrowFrames>(catchThrowDir(replay_root, index), est_cams.size());
   if (hooks && !hooks->record_dir.empty()) frames->record(catchThrowDir(hooks->record_dir, index), est_cams, d);
   ThrowFrames& source = *frames;
   ThrowLoop loop(cfg, flight, source, std::move(est_cams), robot, res, hooks, tel, seed);

@@ -108,13 +108,12 @@ MobileCaptureRun runMobileCapture(const MobileCaptureConfig& cfg, std::uint64_t 
   RobotSim robot(cfg);
   // The head camera: the renderer, or a recorded run (recording.h), recorded when asked.
   const std::string replay_dir = hooks ? hooks->replay_dir : std::string();
+  const auto camera_pose = [&] {
+    const robots::BasePose& p = robot.base.pose();
+    return trueCamera_c_M_w(robot.head, robot.q, p.x, p.y, p.theta);
+  };
   std::unique_ptr<MobileCaptureFrames> frames =
-      replay_dir.empty() ? std::make_unique<MobileCaptureFrames>(cfg, target, rng,
-                                                                 [&] {
-                                                                   const robots::BasePose& p = robot.base.pose();
-                                                                   return trueCamera_c_M_w(robot.head, robot.q, p.x, p.y,
-                                                                                           p.theta);
-                                                                 })
+      replay_dir.empty() ? std::make_unique<MobileCaptureFrames>(cfg, target, rng, camera_pose)
                          : std::make_unique<MobileCaptureFrames>(replay_dir, target);
   if (hooks && !hooks->record_dir.empty()) frames->record(hooks->record_dir, estimatorCamera(cfg));
   MobileCaptureFrames& source = *frames;
