@@ -1,8 +1,9 @@
 // ball_catching: [L]'s ball catcher. Thin main: the common flags, the YAML scenario (every
 // setting is a config key: --set camera_count=1, --set rate_override_hz=100,
 // --set noise_sigma_override=8, --set robot.v_max=1, --set robot.a_max=26, --set planner.model=ballistic,
-// --set robot.kind=arm, --set threads=4), scenarios::runBallCatching, the summary. The loop is
-// documented in modules/scenarios/include/viewline/scenarios/ball_catching/loop.h.
+// --set robot.kind=arm, --set threads=4), --record DIR / --replay DIR (ball_catching/recording.h),
+// scenarios::runBallCatching, the summary. The loop is documented in
+// modules/scenarios/include/viewline/scenarios/ball_catching/loop.h.
 
 #include <CLI/CLI.hpp>
 #include <cstdio>
@@ -14,6 +15,7 @@
 #include "viewline/io/log.h"
 #include "viewline/runtime/progress.h"
 #include "viewline/scenarios/ball_catching.h"
+#include "viewline/scenarios/ball_catching/recording.h"
 #include "viewline/viz/ball_catching_display.h"
 
 using namespace viewline;
@@ -25,12 +27,27 @@ int main(int argc, char** argv) {
   opt.config_path = "config/ball_catching.yaml";
   int throws = 20;
   apps::addCommonOptions(cli, opt);
-  cli.add_option("--throws", throws, "number of throws (throw i uses deriveSeed(seed, i))")->check(CLI::PositiveNumber);
+  apps::addRecordOption(cli, opt);
+  apps::addReplayOption(cli, opt);
+  cli.add_option("--throws", throws,
+                 "number of throws (throw i uses deriveSeed(seed, i)); with --replay: default the recording's")
+      ->check(CLI::PositiveNumber);
   if (const auto code = apps::parseCommandLine(cli, argc, argv)) return *code;
   return apps::runGuarded("ball_catching", [&] {
-    const auto cfg = scenarios::loadBallCatchingConfig(io::loadConfigWithValues(opt.config_path, opt.sets));
+    const io::ConfigNode root = io::loadConfigWithValues(opt.config_path, opt.sets);
+    const auto cfg = scenarios::loadBallCatchingConfig(root);
     scenarios::CatchHooks hooks;
     hooks.pacing = opt.pacing();
+    hooks.record_dir = opt.record_dir;
+    hooks.replay_dir = opt.replay_dir;
+    if (!opt.record_dir.empty()) {
+      YAML::Emitter yaml;
+      yaml << root.yaml();
+      hooks.config_text = std::string(yaml.c_str()) + "\n";
+    }
+    // A replay runs the recording's throws unless --throws asks for fewer.
+    const std::string replay = scenarios::catchReplayRoot(cfg, &hooks);
+    if (!replay.empty() && cli.count("--throws") == 0) throws = scenarios::recordedCatchThrows(replay);
     // --log DIR: one folder per throw (throw_007/, the runtime's CSV files), throws.csv on top.
     io::LogDirectory log(opt.log_dir);
     if (log.enabled()) hooks.telemetry = scenarios::csvTelemetry(opt.log_dir);

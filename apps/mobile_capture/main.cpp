@@ -1,6 +1,7 @@
 // mobile_capture: [K]'s mobile robot with a pan/tilt camera chasing and grasping a red object that
 // moves on the floor. Thin main: the common flags, the YAML scenario, one displayed/logged run when
-// asked, then scenarios::runMobileCaptureBatch and its summary. The scenario is documented in
+// asked, then scenarios::runMobileCaptureBatch and its summary; --record DIR / --replay DIR
+// (mobile_capture/recording.h). The scenario is documented in
 // modules/scenarios/include/viewline/scenarios/mobile_capture.h.
 
 #include <cstdio>
@@ -26,13 +27,31 @@ int main(int argc, char** argv) {
   opt.config_path = "config/mobile_capture.yaml";
   int runs = 1, jobs = 0;
   apps::addCommonOptions(cli, opt);
-  cli.add_option("--runs", runs, "number of capture runs (run i uses deriveSeed(seed, i))")->check(CLI::PositiveNumber);
+  apps::addRecordOption(cli, opt);
+  apps::addReplayOption(cli, opt);
+  cli.add_option("--runs", runs, "number of capture runs (run i uses deriveSeed(seed, i)); with --replay: default the recording's")
+      ->check(CLI::PositiveNumber);
   cli.add_option("--jobs", jobs, "worker threads (default: the config's threads)");
   if (const auto code = apps::parseCommandLine(cli, argc, argv)) return *code;
   return apps::runGuarded("mobile_capture", [&] {
-    auto cfg = scenarios::loadMobileCaptureConfig(io::loadConfigWithValues(opt.config_path, opt.sets));
+    const io::ConfigNode root = io::loadConfigWithValues(opt.config_path, opt.sets);
+    auto cfg = scenarios::loadMobileCaptureConfig(root);
     if (jobs > 0) cfg.threads = jobs;
     cfg.validate();
+    // --record / --replay: the batch's runs in a session recording (mobile_capture/recording.h).
+    scenarios::MobileCaptureSessionIo files;
+    files.record_dir = opt.record_dir;
+    files.replay_dir = opt.replay_dir;
+    if (!opt.record_dir.empty()) {
+      YAML::Emitter yaml;
+      yaml << root.yaml();
+      files.config_text = std::string(yaml.c_str()) + "\n";
+    }
+    const std::string replay = scenarios::mobileCaptureReplayRoot(cfg, files);
+    if (!replay.empty()) {  // read first: a folder that is no recording is refused before any run
+      const int recorded = scenarios::recordedMobileCaptureRuns(replay);
+      if (cli.count("--runs") == 0) runs = recorded;
+    }
     // One watched and/or logged run first: the batch's run 0 (same seed).
     const bool display = opt.wantDisplay("mobile_capture");
     if (!opt.log_dir.empty() || display) {
@@ -41,6 +60,7 @@ int main(int argc, char** argv) {
       scenarios::MobileCaptureHooks hooks;
       if (!opt.log_dir.empty()) hooks.telemetry = &csv;
       hooks.pacing = opt.pacing();
+      if (!replay.empty()) hooks.replay_dir = scenarios::mobileCaptureRunDir(replay, 0);  // the batch records run 0
       std::unique_ptr<viz::MobileCaptureDisplay> view;
       if (display) {
         view = std::make_unique<viz::MobileCaptureDisplay>(cfg);
@@ -59,7 +79,8 @@ int main(int argc, char** argv) {
       scenarios::logFilterTest(scenarios::runFilterTest(cfg, core::deriveSeed(opt.seed, 100000)), log);
     }
     runtime::Progress progress = opt.quiet ? runtime::Progress::quiet() : runtime::Progress("runs", runs);
-    const auto s = scenarios::runMobileCaptureBatch(cfg, runs, opt.seed, [&](int done, int) { progress.update(done); });
+    const auto s =
+        scenarios::runMobileCaptureBatch(cfg, runs, opt.seed, [&](int done, int) { progress.update(done); }, files);
     progress.finish();
     nlohmann::json j = nlohmann::json::parse(scenarios::summaryJson(s, cfg));
     if (!opt.summary_path.empty()) {

@@ -46,6 +46,13 @@ SCENARIO_APPS = {
 }
 
 
+# Apps with --record DIR / --replay DIR: a recording is never written into a folder that is not new
+# and empty (exit 1, the folder untouched), nor where no folder can be made (exit 1); --replay of a
+# folder that does not exist is a usage error (exit 2). Each message names the folder.
+RECORD_APPS = ["ball_catching", "mobile_capture", "dart_tracking"]
+RECORD_CLASSES = {"record_nonempty": 1, "record_unwritable": 1, "replay_missing": 2}
+
+
 def table():
     """executable -> dict(file=(flag or None for a positional, rest of the command line), outputs, wrong_type,
     contradictory, expected-status overrides)."""
@@ -121,6 +128,8 @@ def cases():
     for app in SCENARIO_APPS:
         out += [f"{app}.full_disk_summary", f"{app}.sigint", f"{app}.sigterm"]
     out.append("dart_tracking.full_disk_log")
+    for app in RECORD_APPS:
+        out += [f"{app}.{cls}" for cls in RECORD_CLASSES]
     return out
 
 
@@ -239,6 +248,46 @@ def run_interrupt(app, sig, binary, work):
     print(f"ok: stopped {stop_s:.2f} s after {name}")
 
 
+def run_record_case(app, cls, binary, work):
+    cfg, short, _, _ = SCENARIO_APPS[app]
+    shutil.rmtree(work, ignore_errors=True)
+    os.makedirs(work)
+    summary = os.path.join(work, "summary.json")
+    if cls == "record_nonempty":
+        folder = os.path.join(work, "rec")
+        os.makedirs(folder)
+        with open(os.path.join(folder, "keep.txt"), "w") as f:
+            f.write("not a recording\n")
+        flag = ["--record", folder]
+    elif cls == "record_unwritable":
+        # Under a regular file no folder can be made, whoever runs the test (root ignores permissions).
+        with open(os.path.join(work, "a_file"), "w") as f:
+            f.write("x\n")
+        folder = os.path.join(work, "a_file", "rec")
+        flag = ["--record", folder]
+    else:
+        folder = os.path.join(work, "no_such_recording")
+        flag = ["--replay", folder]
+    cmd = [binary, "--config", cfg, "--quiet", "--summary", summary] + short + flag
+    try:
+        p = subprocess.run(cmd, capture_output=True, text=True, errors="replace", timeout=TIMEOUT_S)
+    except subprocess.TimeoutExpired:
+        fail(f"hang: no exit within {TIMEOUT_S} s: {' '.join(cmd)}")
+    print("$ " + " ".join(cmd))
+    print(f"exit {p.returncode}\n--- stderr\n{p.stderr[-3000:]}\n--- stdout\n{p.stdout[-1000:]}")
+    if p.returncode < 0:
+        fail(f"crash: killed by signal {-p.returncode}")
+    if p.returncode != RECORD_CLASSES[cls]:
+        fail(f"exit status {p.returncode}, expected {RECORD_CLASSES[cls]} ({cls})")
+    if folder not in p.stderr:
+        fail(f"the message does not name {folder}")
+    if os.path.exists(summary):
+        fail("a summary was written although the run failed")
+    if cls == "record_nonempty" and os.listdir(folder) != ["keep.txt"]:
+        fail(f"the existing folder was written into: {os.listdir(folder)}")
+    print("ok")
+
+
 SKIP = 77  # ctest's SKIP_RETURN_CODE for these tests
 
 
@@ -308,6 +357,8 @@ def main():
     os.chdir(a.source)  # the configs and calibration files the command lines name are relative to the checkout
     if cls.startswith("full_disk_"):
         run_full_disk(exe, cls[len("full_disk_"):], binary, a.work)
+    elif cls in RECORD_CLASSES:
+        run_record_case(exe, cls, binary, a.work)
     elif cls in ("sigint", "sigterm"):
         run_interrupt(exe, signal.SIGINT if cls == "sigint" else signal.SIGTERM, binary, a.work)
     else:

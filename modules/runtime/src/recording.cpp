@@ -345,4 +345,58 @@ std::string RecordingSource::configText() const {
   return csv::readWholeFile(p.string(), "recording config");
 }
 
+// ---------------------------------------------------------------------------- sessions
+
+std::string sessionUnitDir(const std::string& dir, const std::string& unit, int index) {
+  char number[16];
+  std::snprintf(number, sizeof number, "_%03d", index);
+  return (fs::path(dir) / (unit + number)).string();
+}
+
+void beginSessionRecording(const std::string& dir, const SessionRecording& session, const std::string& config_text) {
+  if (dir.empty()) throw core::InvalidInput("recording: the folder name is empty");
+  std::error_code ec;
+  // A session is never recorded over another one, nor mixed with other files.
+  if (fs::exists(dir, ec) && !(fs::is_directory(dir, ec) && fs::is_empty(dir, ec)))
+    throw core::InvalidInput("recording folder " + dir + " exists and is not empty; choose a new folder");
+  fs::create_directories(dir, ec);
+  if (ec || !fs::is_directory(dir))
+    throw core::InvalidInput("recording folder " + dir + ": cannot be created (" +
+                             (ec ? ec.message() : std::string("not a folder")) + ")");
+  io::writeJsonFile((fs::path(dir) / "session.json").string(), {{"scenario", session.scenario},
+                                                                {"seed", session.seed},
+                                                                {"units", session.units},
+                                                                {"unit", session.unit}});
+  if (!config_text.empty()) io::writeTextFileAtomic((fs::path(dir) / "config.yaml").string(), config_text);
+}
+
+SessionRecording readSessionRecording(const std::string& dir, const std::string& scenario) {
+  const std::string file = (fs::path(dir) / "session.json").string();
+  if (!fs::is_regular_file(file))
+    throw core::InvalidInput(dir + ": no session.json: not a " + scenario + " recording (written by " + scenario +
+                             " --record)");
+  const nlohmann::json j = io::readJsonFile(file);
+  if (!j.is_object() || !j.contains("scenario") || !j["scenario"].is_string() || j["scenario"] != scenario)
+    throw core::InvalidInput(file + ": not a " + scenario + " recording (\"scenario\": \"" + scenario + "\" expected)");
+  if (!j.contains("seed") || !j["seed"].is_number_unsigned() || !j.contains("units") ||
+      !j["units"].is_number_integer() || j["units"].get<int>() < 1 || !j.contains("unit") || !j["unit"].is_string())
+    throw core::InvalidInput(file + ": expected \"seed\" (unsigned), \"units\" (>= 1) and \"unit\" (a name)");
+  SessionRecording s;
+  s.scenario = scenario;
+  s.seed = j["seed"].get<std::uint64_t>();
+  s.units = j["units"].get<int>();
+  s.unit = j["unit"].get<std::string>();
+  return s;
+}
+
+void checkSessionReplay(const std::string& dir, const std::string& scenario, std::uint64_t seed, int units) {
+  const SessionRecording s = readSessionRecording(dir, scenario);
+  if (s.seed != seed)
+    throw core::InvalidInput(dir + " was recorded with seed " + std::to_string(s.seed) + ", not " + std::to_string(seed) +
+                             " (what the recording does not hold is simulated from the seed): replay with --seed " +
+                             std::to_string(s.seed));
+  if (units > s.units)
+    throw core::InvalidInput(dir + " holds " + std::to_string(s.units) + " " + s.unit + "s, not " + std::to_string(units));
+}
+
 }  // namespace viewline::runtime

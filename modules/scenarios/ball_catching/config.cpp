@@ -5,6 +5,7 @@
 #include "viewline/core/error.h"
 #include "viewline/core/frames.h"
 #include "viewline/io/camera_fields.h"
+#include "viewline/scenarios/ball_catching/recording.h"
 #include "viewline/scenarios/simulated_rig.h"
 
 namespace viewline::scenarios {
@@ -273,6 +274,7 @@ void BallCatchingConfig::validate() const {
 BallCatchingConfig loadBallCatchingConfig(const io::ConfigNode& root) {
   BallCatchingConfig c;
   c.name = root.getOr<std::string>("name", c.name);
+  c.source = readCatchSource(root);  // sim or a recording (ball_catching/recording.h)
   c.threads = root.getOr<int>("threads", c.threads);
   c.processing_latency = root.getOr<double>("processing_latency_s", c.processing_latency);
   c.camera_count = root.getOr<unsigned>("camera_count", 0u);

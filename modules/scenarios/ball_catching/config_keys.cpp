@@ -17,7 +17,8 @@ io::ConfigReferenceSection ballCatchingConfigReference() {
   // No shipped file has inline cameras (both name a rig): a camera given by its geometry.
   s.probes = {
       "cameras:\n  - {name: a, position: [0.0, -3.0, 1.5], look_at: [2.0, 0.0, 1.3], cx: 320, cy: 240}\n"
-      "robot: {kind: stage}\n"};
+      "robot: {kind: stage}\n",
+      "source: {kind: recording, path: rec}\n"};
   s.read = [](const io::ConfigNode& root) { loadBallCatchingConfig(root); };
   s.keys = {
       {"name", "", "scenario name in summaries"},
@@ -147,6 +148,9 @@ io::ConfigReferenceSection ballCatchingConfigReference() {
       {"room", "", "the rendered room"},
       {"room.walls", "", "render walls around the floor"},
       {"room.floor_size", "m", "side of the floor square"},
+      {"source", "", "where the frames come from (absent: the rendered cameras)"},
+      {"source.kind", "", "sim (the rendered cameras) or recording (a folder written by --record); other kinds are refused"},
+      {"source.path", "", "recording: the folder written by --record (as --replay)"},
   };
   return s;
 }

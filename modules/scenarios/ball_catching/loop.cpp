@@ -17,6 +17,7 @@
 #include "viewline/io/log.h"
 #include "viewline/runtime/delay_line.h"
 #include "viewline/scenarios/ball_catching/planner_input.h"
+#include "viewline/scenarios/ball_catching/recording.h"
 #include "viewline/scenarios/ball_catching/world.h"
 #include "viewline/tracking/tracker.h"
 #include "viewline/vision/ball_detector.h"
@@ -38,7 +39,7 @@ tracking::GateDecision decisionOf(const tracking::MeasurementOutcome& o, bool re
 // a frame becoming ready.
 class ThrowLoop {
 public:
-  ThrowLoop(const BallCatchingConfig& cfg, const sim::DragFlight& flight, RigFrameSource& source,
+  ThrowLoop(const BallCatchingConfig& cfg, const sim::DragFlight& flight, ThrowFrames& source,
             std::vector<core::Camera> est_cams, robots::SimulatedCartesianRobot& robot, ThrowResult& res,
             const CatchHooks* hooks, runtime::TelemetrySink* tel, std::uint64_t seed)
       : cfg_(cfg), flight_(flight), source_(source), est_cams_(std::move(est_cams)), robot_(robot),
@@ -79,7 +80,7 @@ public:
     if (!frame) return true;  // dropped
     ++res_.frames;
     const std::size_t ci = frame->camera;
-    const sim::ObjectTruth* truth = source_.lastTruthOf(cfg_.object);
+    const CatchFrameTruth* truth = source_.lastTruth();
     if (truth && truth->in_front && truth->in_image && res_.t_first_visible < 0.0)
       res_.t_first_visible = frame->capture_time;
     if (tel_ && truth) tel_->estimate({"truth", frame->capture_time, flight_.state(frame->capture_time).p, {}});
@@ -184,7 +185,7 @@ private:
 
   const BallCatchingConfig& cfg_;
   const sim::DragFlight& flight_;
-  RigFrameSource& source_;
+  ThrowFrames& source_;
   std::vector<core::Camera> est_cams_;
   robots::SimulatedCartesianRobot& robot_;
   planning::CatchPlanner planner_;
@@ -215,7 +216,9 @@ ThrowResult runThrow(const BallCatchingConfig& cfg, const sim::Scene& room, int 
 
   // 1. The throw and its true crossing of the plane through home (the planner moves the hole in
   // that plane; scoreThrow checks it against the robot's actual position).
-  const ThrowDraw d = drawThrow(cfg, rng);
+  // A replay takes the throw recorded beside its frames (recording.h).
+  const std::string replay_root = catchReplayRoot(cfg, hooks);
+  const ThrowDraw d = replay_root.empty() ? drawThrow(cfg, rng) : readRecordedThrow(catchThrowDir(replay_root, index));
   res.release = d.release;
   res.launch_velocity = d.launch_velocity;
   res.launch_speed = d.launch_velocity.norm();
@@ -231,9 +234,14 @@ ThrowResult runThrow(const BallCatchingConfig& cfg, const sim::Scene& room, int 
   robots::SimulatedCartesianRobot robot(cfg.robot);
   robot.reset(0.0);
   const CatchWorld world(room, flight, cfg, robot);
-  RigFrameSource source(throwCameras(cfg, rng), rng, cfg.render, world, t_end);
   std::vector<core::Camera> est_cams;  // calibrated (rig:) or the render camera (inline cameras)
   for (std::size_t i = 0; i < cfg.activeCameras(); ++i) est_cams.push_back(cfg.cameras[i].estimatorCamera());
+  std::unique_ptr<ThrowFrames> frames =
+      replay_root.empty()
+          ? std::make_unique<ThrowFrames>(throwCameras(cfg, rng), rng, cfg.render, world, t_end, cfg.object)
+          : std::make_unique<ThrowFrames>(catchThrowDir(replay_root, index), est_cams.size());
+  if (hooks && !hooks->record_dir.empty()) frames->record(catchThrowDir(hooks->record_dir, index), est_cams, d);
+  ThrowFrames& source = *frames;
   ThrowLoop loop(cfg, flight, source, std::move(est_cams), robot, res, hooks, tel, seed);
 
   // 3. One clock: the control tick every period, the next frame when it is ready.
@@ -259,6 +267,7 @@ ThrowResult runThrow(const BallCatchingConfig& cfg, const sim::Scene& room, int 
   // The set points in flight reach the box after the last frame.
   if (!sched.stopRequested()) sched.runUntil(t_end + robot.commandLatency() + cfg.control_period);
   if (interrupted) *interrupted = sched.stopRequested();
+  if (!sched.stopRequested()) frames->finishRecording();
 
   // 4. Outcome.
   scoreThrow(res, cfg, robot, loop.planner(), loop.leadPrediction());
@@ -281,6 +290,8 @@ CatchSummary runBallCatching(const BallCatchingConfig& cfg, int throws, std::uin
   if (throws < 1) throw core::InvalidInput("throws: expected >= 1");
   cfg.validate();
   const auto wall0 = std::chrono::steady_clock::now();
+  if (!hooks.record_dir.empty()) beginCatchRecording(hooks.record_dir, seed, throws, hooks.config_text);
+  if (const std::string replay = catchReplayRoot(cfg, &hooks); !replay.empty()) checkCatchReplay(replay, seed, throws);
   core::Rng room_rng = core::makeRng(core::deriveSeed(seed, 0xB0B));
   const sim::Scene room = sim::makeRoom(cfg.room, room_rng);
   std::optional<RegistrationResult> registration;

@@ -1,6 +1,7 @@
 #include "viewline/scenarios/dart/config.h"
 
 #include "viewline/core/checks.h"
+#include "viewline/core/error.h"
 #include "viewline/core/frames.h"
 #include "viewline/io/config_check.h"
 #include "viewline/io/config_edit.h"
@@ -140,6 +141,13 @@ void readExperiments(const io::ConfigNode& e, DartScenarioConfig& cfg) {
 
 DartScenarioConfig dartScenarioFromNode(const io::ConfigNode& root) {
   DartScenarioConfig cfg = defaultDartScenario();
+  cfg.source = runtime::readSourceConfig(root);
+  // The experiments consume detections, not images: a recording of them (dart/recording.h) can
+  // replace the generator, footage cannot.
+  if (!cfg.source.simulated() && cfg.source.kind != runtime::SourceKind::Recording)
+    throw core::InvalidInput(root.location("source") + ": source.kind " + runtime::toString(cfg.source.kind) +
+                             " is not supported by dart_tracking (sim or recording: the experiments run on "
+                             "detections with their truth, and render or read no images)");
   if (root.has("cameras")) {
     cfg.cameras.clear();
     for (const io::ConfigNode& c : root.childList("cameras")) cfg.cameras.push_back(readCamera(c));

@@ -15,6 +15,7 @@ io::ConfigReferenceSection dartConfigReference() {
       "simulated cameras, the viewline tracker's consistency, gates, asynchronous and late data and "
       "single-camera start. Every key is optional (defaults: `scenarios::defaultDartScenario()`).";
   s.shipped = {"dart_tracking.yaml"};
+  s.probes = {"source: {kind: recording, path: rec}\n"};
   s.read = [](const io::ConfigNode& root) { dartScenarioFromNode(root); };
   s.keys = {
       {"cameras", "", "the simulated cameras (absent: two cameras, side and rear, 2-3 m from the thrower)"},
@@ -39,6 +40,9 @@ io::ConfigReferenceSection dartConfigReference() {
       {"throw.truth_accel_psd", "m²/s³", "white acceleration of the true flights (0: pure ballistic)"},
       {"pixel_noise_px", "px", "detection noise (std per axis)"},
       {"outlier_rate", "", "fraction of detections that are gross outliers anywhere in the image, in [0, 1)"},
+      {"source", "", "where the detections come from (absent: generated from the simulated flights)"},
+      {"source.kind", "", "sim (generated) or recording (a folder written by --record); other kinds are refused"},
+      {"source.path", "", "recording: the folder written by --record (as --replay)"},
       {"tracker", "", "the viewline tracker (tracking::TrackerConfig)"},
       {"tracker.prior_position", "m", "prior position of a new track (absent: [1, 0, 1.75], mid-flight)"},
       {"tracker.prior_velocity", "m/s", "prior velocity of a new track (absent: [12, 0, 0], towards the board)"},

@@ -9,6 +9,7 @@
 #include "viewline/core/random.h"
 #include "viewline/estimation/consistency.h"
 #include "viewline/runtime/scheduler.h"
+#include "viewline/scenarios/dart/recording.h"
 #include "viewline/tracking/image_ekf.h"
 
 namespace viewline::scenarios {
@@ -81,16 +82,18 @@ struct Pools {
 class DartRun {
 public:
   DartRun(const DartScenarioConfig& cfg, const std::vector<core::Camera>& cams, const TrackerConfig& exact,
-          const TrackerConfig& offset, const DartRunCallbacks& cb, Pools& pools, DartSummary& sum)
-      : cfg_(cfg), cams_(cams), exact_(exact), offset_(offset), cb_(cb), p_(pools), sum_(sum) {}
+          const TrackerConfig& offset, const DartRunCallbacks& cb, Pools& pools, DartSummary& sum, DartFlights& flights)
+      : cfg_(cfg), cams_(cams), exact_(exact), offset_(offset), cb_(cb), p_(pools), sum_(sum), flights_(flights) {}
 
   void run(int run, std::uint64_t run_seed) {
     run_ = run;
+    flights_.beginRun(run);  // simulated, recorded or replayed flights (recording.h)
     consistency(core::deriveSeed(run_seed, 1));
     gates(core::deriveSeed(run_seed, 2));
     async(core::deriveSeed(run_seed, 3));
     scenario(core::deriveSeed(run_seed, 5));
     singleCamera(core::deriveSeed(run_seed, 4));
+    flights_.endRun();
   }
 
 private:
@@ -112,7 +115,7 @@ private:
   // A: alternating cameras, no outliers: NEES and RMSE / PCRLB.
   void consistency(std::uint64_t seed) {
     core::Rng rng = core::makeRng(seed);
-    const DartFlight f = simulateDartFlight(cfg_, cams_, DartClockMode::Alternating, 0.0, rng);
+    const DartFlight f = flights_.flight("A_alternating", cfg_, cams_, DartClockMode::Alternating, 0.0, rng);
     const std::vector<double> bound = positionPcrlb(cfg_, cams_, f);
     ViewlineTracker tr(cams_, exact_);
     p_.measurements += f.detections.size();
@@ -144,7 +147,7 @@ private:
   // B: alternating cameras with outliers: both gates, image EKF.
   void gates(std::uint64_t seed) {
     core::Rng rng = core::makeRng(seed);
-    const DartFlight f = simulateDartFlight(cfg_, cams_, DartClockMode::Alternating, cfg_.outlier_rate, rng);
+    const DartFlight f = flights_.flight("B_gates", cfg_, cams_, DartClockMode::Alternating, cfg_.outlier_rate, rng);
     for (GateKind kind : {GateKind::Directional, GateKind::Mahalanobis}) {
       TrackerConfig tc = exact_;
       tc.gate.kind = kind;
@@ -168,7 +171,7 @@ private:
   // C: free-running clocks with jitter, no outliers: exact vs Δt-offset vs image EKF.
   void async(std::uint64_t seed) {
     core::Rng rng = core::makeRng(seed);
-    const DartFlight f = simulateDartFlight(cfg_, cams_, DartClockMode::FreeRunning, 0.0, rng);
+    const DartFlight f = flights_.flight("C_async", cfg_, cams_, DartClockMode::FreeRunning, 0.0, rng);
     ViewlineTracker tr_exact(cams_, exact_), tr_offset(cams_, offset_);
     tracking::ImageSpaceEkf ekf(cams_, exact_);
     for (std::size_t i = 0; i < f.detections.size(); ++i) {
@@ -190,7 +193,7 @@ private:
   // order (capture + U(0, late_max_delay)).
   void scenario(std::uint64_t seed) {
     core::Rng rng = core::makeRng(seed);
-    const DartFlight f = simulateDartFlight(cfg_, cams_, DartClockMode::FreeRunning, cfg_.outlier_rate, rng);
+    const DartFlight f = flights_.flight("D_scenario", cfg_, cams_, DartClockMode::FreeRunning, cfg_.outlier_rate, rng);
     ViewlineTracker tr_exact(cams_, exact_);
     for (std::size_t i = 0; i < f.detections.size(); ++i) {
       const DartDetection& d = f.detections[i];
@@ -209,7 +212,8 @@ private:
     clock.setPacing(cb_.pacing);
     double last_arrival = 0.0;
     for (std::size_t i = 0; i < f.detections.size(); ++i) {
-      const double arrival = f.detections[i].m.t + core::uniform(rng, 0.0, cfg_.late_max_delay);
+      const double arrival =
+          f.detections[i].m.t + flights_.draw("D_scenario", [&] { return core::uniform(rng, 0.0, cfg_.late_max_delay); });
       last_arrival = std::max(last_arrival, arrival);
       clock.at(arrival, runtime::priority::Delivery, [this, &tr_late, &d = f.detections[i]](double) {
         if (tr_late.submit(d.m) != Refusal::None) ++sum_.late_refused;
@@ -240,15 +244,18 @@ private:
   // E: one camera, prior far off, against a filter started at the truth.
   void singleCamera(std::uint64_t seed) {
     core::Rng rng = core::makeRng(seed);
-    const DartFlight f = simulateDartFlight(cfg_, cams_, DartClockMode::SingleCamera, 0.0, rng);
+    const DartFlight f = flights_.flight("E_single", cfg_, cams_, DartClockMode::SingleCamera, 0.0, rng);
     if (f.detections.empty()) return;
     TrackerConfig ref = exact_, off = exact_;
     ref.prior_mean = f.detections.front().truth;
     ref.prior_cov = cfg_.single_prior_std * cfg_.single_prior_std * Matrix6::Identity();
     off.prior_cov = ref.prior_cov;
     off.prior_mean = ref.prior_mean;
-    off.prior_mean.head<3>() += core::uniform(rng, 0.0, cfg_.single_offset_max) * randomDirection(rng);
-    off.prior_mean.tail<3>() += core::uniform(rng, 0.0, cfg_.single_offset_max) * randomDirection(rng);
+    const auto offset = [&] {
+      return Eigen::Vector3d(core::uniform(rng, 0.0, cfg_.single_offset_max) * randomDirection(rng));
+    };
+    off.prior_mean.head<3>() += flights_.draw3("E_single", offset);
+    off.prior_mean.tail<3>() += flights_.draw3("E_single", offset);
     ViewlineTracker tr_ref(cams_, ref), tr_off(cams_, off);
     std::size_t converged_after = 0;  // number of measurements after which it stays within tolerance
     for (std::size_t i = 0; i < f.detections.size(); ++i) {
@@ -298,6 +305,7 @@ private:
   const DartRunCallbacks& cb_;
   Pools& p_;
   DartSummary& sum_;
+  DartFlights& flights_;
   int run_ = 0;
 };
 
@@ -366,7 +374,11 @@ DartSummary runDartExperiments(const DartScenarioConfig& cfg, std::uint64_t seed
   sum.gate_mahalanobis.gate = "mahalanobis";
   sum.scenario_gate.gate = tracking::toString(cfg.tracker.gate.kind);
   Pools pools;
-  DartRun one(cfg, cams, exact, offset, cb, pools, sum);
+  const std::string replay =
+      !cb.replay_dir.empty() ? cb.replay_dir
+                             : cfg.source.kind == runtime::SourceKind::Recording ? cfg.source.recording : std::string();
+  DartFlights flights(cb.record_dir, replay, seed, runs, cb.config_text);
+  DartRun one(cfg, cams, exact, offset, cb, pools, sum, flights);
   int done = 0;
   for (int run = 0; run < runs; ++run) {
     one.run(run, core::deriveSeed(seed, static_cast<std::uint64_t>(run)));

@@ -10,6 +10,7 @@
 #include "viewline/core/frames.h"
 #include "viewline/io/config_check.h"
 #include "viewline/io/camera_fields.h"
+#include "viewline/scenarios/mobile_capture/recording.h"
 #include "viewline/scenarios/simulated_rig.h"
 
 namespace viewline::scenarios {
@@ -107,6 +108,7 @@ void positive(const io::ConfigNode& n, const std::string& key, double v) {
 
 MobileCaptureConfig loadMobileCaptureConfig(const io::ConfigNode& root) {
   MobileCaptureConfig c = MobileCaptureConfig::defaults();
+  c.source = readMobileCaptureSource(root);  // sim or a recording (mobile_capture/recording.h)
   if (root.has("world")) {
     const auto w = root.child("world");
     readOpt(w, "robot_start", c.robot_start);

@@ -16,7 +16,7 @@ io::ConfigReferenceSection mobileCaptureConfigReference() {
       "`MobileCaptureConfig::defaults()`).";
   s.shipped = {"mobile_capture.yaml"};
   // The shipped file names a rig: the inline camera's field of view too.
-  s.probes = {"camera: {width: 640, height: 480, hfov_deg: 50, vfov_deg: 40}\n"};
+  s.probes = {"camera: {width: 640, height: 480, hfov_deg: 50, vfov_deg: 40}\n", "source: {kind: recording, path: rec}\n"};
   s.read = [](const io::ConfigNode& root) { loadMobileCaptureConfig(root); };
   s.keys = {
       {"world", "", "the floor, the robot and the object"},
@@ -112,6 +112,9 @@ io::ConfigReferenceSection mobileCaptureConfigReference() {
       {"fov_sweep.points", "", "floor points per pose"},
       {"fov_sweep.pixel_sigma", "px", "noise added to the projected pixels"},
       {"threads", "", "parallel runs"},
+      {"source", "", "where the frames come from (absent: the rendered head camera)"},
+      {"source.kind", "", "sim (the rendered head camera) or recording (a folder written by --record); other kinds are refused"},
+      {"source.path", "", "recording: the folder written by --record (as --replay)"},
   };
   return s;
 }

@@ -2,10 +2,12 @@
 
 #include <Eigen/Cholesky>
 #include <cmath>
+#include <memory>
 #include <optional>
 
 #include "viewline/core/interrupt.h"
 #include "viewline/robots/mobile_ground_localization.h"
+#include "viewline/scenarios/mobile_capture/recording.h"
 #include "viewline/scenarios/mobile_capture/world.h"
 
 namespace viewline::scenarios {
@@ -104,10 +106,17 @@ MobileCaptureRun runMobileCapture(const MobileCaptureConfig& cfg, std::uint64_t 
   Streams rng(seed);
   const sim::GroundTarget target(targetParams(cfg, sim::GroundProfile::Capture, targetDuration(cfg)), rng.object);
   RobotSim robot(cfg);
-  RenderedHeadCamera source(cfg, target, rng, [&] {
+  // The head camera: the renderer, or a recorded run (recording.h), recorded when asked.
+  const std::string replay_dir = hooks ? hooks->replay_dir : std::string();
+  const auto camera_pose = [&] {
     const robots::BasePose& p = robot.base.pose();
     return trueCamera_c_M_w(robot.head, robot.q, p.x, p.y, p.theta);
-  });
+  };
+  std::unique_ptr<MobileCaptureFrames> frames =
+      replay_dir.empty() ? std::make_unique<MobileCaptureFrames>(cfg, target, rng, camera_pose)
+                         : std::make_unique<MobileCaptureFrames>(replay_dir, target);
+  if (hooks && !hooks->record_dir.empty()) frames->record(hooks->record_dir, estimatorCamera(cfg));
+  MobileCaptureFrames& source = *frames;
   vision::BallDetector detector(cfg.detector);
   core::Camera camera = estimatorCamera(cfg);  // detection ROI, ground localisation
   const robots::AnglePerPixel printed{cfg.hfov, cfg.vfov, robots::AngleRange::PrintedSlant};
@@ -324,6 +333,7 @@ MobileCaptureRun runMobileCapture(const MobileCaptureConfig& cfg, std::uint64_t 
   if (sink) sink->flush();
   // requestStop() also ends a run at its capture; a signal or the view's quit ends it early.
   if (core::interruptRequested()) run.interrupted = true;
+  if (!run.interrupted) source.finishRecording();
   if (run.interrupted) return run;
 
   const OracleResult oracle = runOracle(cfg, seed);

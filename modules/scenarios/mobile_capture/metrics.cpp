@@ -131,9 +131,14 @@ FovSweepResult compareGroundLocalization(const MobileCaptureConfig& cfg, std::ui
 // Batch and summary.
 
 MobileCaptureSummary runMobileCaptureBatch(const MobileCaptureConfig& cfg, int runs, std::uint64_t seed,
-                                           const std::function<void(int, int)>& progress) {
+                                           const std::function<void(int, int)>& progress,
+                                           const MobileCaptureSessionIo& io) {
   cfg.validate();
   if (runs < 1) throw core::InvalidInput("runs: expected >= 1");
+  const std::string replay_root = mobileCaptureReplayRoot(cfg, io);
+  if (!io.record_dir.empty())
+    runtime::beginSessionRecording(io.record_dir, {"mobile_capture", seed, runs, "run"}, io.config_text);
+  if (!replay_root.empty()) runtime::checkSessionReplay(replay_root, "mobile_capture", seed, runs);
   const auto start = std::chrono::steady_clock::now();
   MobileCaptureSummary s;
   s.runs.resize(static_cast<std::size_t>(runs));
@@ -155,7 +160,11 @@ MobileCaptureSummary runMobileCaptureBatch(const MobileCaptureConfig& cfg, int r
       if (i >= runs) return;
       try {
         auto& r = s.runs[static_cast<std::size_t>(i)];
-        r = runMobileCapture(cfg, core::deriveSeed(seed, static_cast<std::uint64_t>(i)));
+        MobileCaptureHooks files;  // the run's folders in a session recording
+        if (!io.record_dir.empty()) files.record_dir = mobileCaptureRunDir(io.record_dir, i);
+        if (!replay_root.empty()) files.replay_dir = mobileCaptureRunDir(replay_root, i);
+        const bool with_files = !files.record_dir.empty() || !files.replay_dir.empty();
+        r = runMobileCapture(cfg, core::deriveSeed(seed, static_cast<std::uint64_t>(i)), with_files ? &files : nullptr);
         if (r.interrupted) {
           stopped = true;
           return;

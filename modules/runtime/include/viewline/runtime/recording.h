@@ -146,4 +146,33 @@ private:
   std::size_t cameras_ = 1;
 };
 
+// A session recording: a scenario that runs several independent units (throws, runs), each on its
+// own clock, records one recording folder per unit under DIR (DIR/UNIT_iii, iii: the index, 3
+// digits) and, at the top, session.json ({"scenario": NAME, "seed": S, "units": N, "unit": UNIT})
+// and config.yaml (the config as run). The seed is what a replay must be given again: a scenario
+// keeps simulated, from the seed, what a recording does not hold.
+
+/// What session.json says.
+struct SessionRecording {
+  std::string scenario;    ///< the scenario that recorded it
+  std::uint64_t seed = 0;  ///< the session's seed
+  int units = 0;           ///< the number of units (throws, runs) recorded
+  std::string unit;        ///< their name ("throw", "run")
+};
+
+/// The folder of unit `index` of a session recording: DIR/UNIT_iii (UNIT: "throw", "run").
+std::string sessionUnitDir(const std::string& dir, const std::string& unit, int index);
+
+/// Starts a session recording: refuses (core::InvalidInput) a folder that exists and is not empty or
+/// cannot be created, then writes session.json and config.yaml (when config_text is not empty).
+void beginSessionRecording(const std::string& dir, const SessionRecording& session, const std::string& config_text);
+
+/// Reads DIR/session.json; throws core::InvalidInput naming the folder when it holds no session
+/// recording of `scenario` (written by its app with --record).
+SessionRecording readSessionRecording(const std::string& dir, const std::string& scenario);
+
+/// Checks that DIR can be replayed with this seed and number of units; throws core::InvalidInput
+/// saying what differs (and the --seed to give).
+void checkSessionReplay(const std::string& dir, const std::string& scenario, std::uint64_t seed, int units);
+
 }  // namespace viewline::runtime

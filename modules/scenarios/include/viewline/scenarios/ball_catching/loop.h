@@ -68,7 +68,13 @@ struct CatchHooks {
   /// Called after each finished throw with the throws done and the total (any thread).
   std::function<void(int done, int total)> progress;
   runtime::Pacing pacing;  ///< wall-clock pacing of every throw (0: as fast as possible)
+  std::string record_dir;   ///< --record DIR: every throw's frames and truth (recording.h); "" : none
+  std::string replay_dir;   ///< --replay DIR: the throws of a recording instead of the renderer (overrides `source:`)
+  std::string config_text;  ///< the config as run, written into a recording (config.yaml)
 };
+
+/// The recording a session replays: hooks->replay_dir, else the config's `source:` folder, else "" (render).
+std::string catchReplayRoot(const BallCatchingConfig& cfg, const CatchHooks* hooks);
 
 /// A CatchHooks::telemetry that writes throw i's records as CSV (runtime::CsvSink: one file per
 /// record kind and channel) into `dir/throw_iii/` (iii: the throw index, 3 digits; each throw has

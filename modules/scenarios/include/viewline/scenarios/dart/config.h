@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "viewline/io/config.h"
+#include "viewline/runtime/source_config.h"
 #include "viewline/tracking/tracker.h"
 
 namespace viewline::scenarios {
@@ -63,6 +64,7 @@ struct DartScenarioConfig {
   std::size_t nees_index = 9;       ///< measurement (0-based) at which each run gives its NEES sample
   std::size_t settled_index = 4;    ///< RMSE / PCRLB pooled over measurements with index >= this
   double confidence = 0.99;  ///< two-sided probability of the NEES consistency bounds
+  runtime::SourceConfig source;  ///< `source:` sim (generated detections) or recording (dart/recording.h)
 
   /// The tracker's configuration with the scenario's gravity in its model.
   tracking::TrackerConfig trackerConfig() const;

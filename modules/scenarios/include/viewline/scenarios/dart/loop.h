@@ -62,6 +62,9 @@ struct DartRunCallbacks {
   /// wall clock with factor > 0 (the app's --realtime), as fast as possible by default. Pacing
   /// changes when, never what: the figures are the same.
   runtime::Pacing pacing;
+  std::string record_dir;   ///< --record DIR: every run's detections, truth and draws (recording.h); "" : none
+  std::string replay_dir;   ///< --replay DIR: the trackers on a recording's detections (overrides `source:`)
+  std::string config_text;  ///< the config as run, written into a recording (config.yaml)
 };
 
 /// Runs experiments A-E for `runs` seeded runs of a validated config (loadDartScenario validates;

@@ -14,6 +14,7 @@
 #include "viewline/planning/capture_planner.h"
 #include "viewline/robots/differential_drive.h"
 #include "viewline/robots/mobile_pan_tilt.h"
+#include "viewline/runtime/source_config.h"
 #include "viewline/tracking/unicycle_tracker.h"
 #include "viewline/vision/ball_detector.h"
 
@@ -120,6 +121,7 @@ struct MobileCaptureConfig {
   double fov_sweep_pixel_sigma = 0.5;   ///< px noise added to the projected pixels
 
   int threads = 2;                      ///< parallel runs in runMobileCaptureBatch
+  runtime::SourceConfig source;         ///< `source:` sim (render) or recording (a folder of --record, recording.h)
 
   /// The control tick (s): the base's wheel-PID period, which every other control-rate step follows.
   double controlPeriod() const { return base.control_period; }

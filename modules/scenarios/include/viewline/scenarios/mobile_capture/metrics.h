@@ -9,6 +9,7 @@
 
 #include "viewline/io/log.h"
 #include "viewline/scenarios/mobile_capture/loop.h"
+#include "viewline/scenarios/mobile_capture/recording.h"
 
 namespace viewline::scenarios {
 
@@ -73,9 +74,11 @@ struct MobileCaptureSummary {
 
 /// `runs` runs with seeds deriveSeed(seed, i) on cfg.threads threads, the filter test
 /// (cfg.filter_test_runs seeds) and the field-of-view sweep. `progress(done, total)` is called
-/// from the worker threads (serialised).
+/// from the worker threads (serialised). `io`: record the runs into a new session recording, or run
+/// on one (recording.h; the config's `source:` names one too), run i in DIR/run_iii.
 MobileCaptureSummary runMobileCaptureBatch(const MobileCaptureConfig& cfg, int runs, std::uint64_t seed,
-                                           const std::function<void(int, int)>& progress = nullptr);
+                                           const std::function<void(int, int)>& progress = nullptr,
+                                           const MobileCaptureSessionIo& io = {});
 
 /// The summary as JSON text.
 std::string summaryJson(const MobileCaptureSummary& s, const MobileCaptureConfig& cfg, int indent = 2);

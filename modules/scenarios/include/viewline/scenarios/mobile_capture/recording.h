@@ -1,0 +1,88 @@
+#pragma once
+// Mobile capture on recorded frames: `--record DIR` writes every run's head-camera frames with their
+// clocks and the object's truth; `--replay DIR` (or `source: {kind: recording, path: DIR}`) runs
+// the same batch on them, and with the same config and seed it gives the same summary bit for bit.
+//
+// Layout of DIR (a session recording, runtime/recording.h):
+//   session.json   {"scenario": "mobile_capture", "seed": S, "units": N, "unit": "run"}
+//   config.yaml    the scenario config as run (after --set edits)
+//   run_iii/       one runtime recording per run (its own clock from 0): cam0/<sequence>.png,
+//                  camera0.xml (the estimators' calibration), recording.csv, truth.csv
+// truth.csv, per frame: the object's true state at the frame's stamp, x, y (m, world floor), theta
+// (rad), v (m/s), omega (rad/s).
+//
+// What stays simulated in a replay, from the seed: the object's path (the grasp is scored against
+// it at every control tick and the oracle chases it, not only at the frames), the robot (the laws
+// drive it from the replayed estimates) and the filter test and field-of-view sweep of the summary.
+// The recorded truth is checked against that path at every frame: a recording replayed with another
+// seed or object settings is refused (core::InvalidInput naming the frame), never scored against
+// the wrong path.
+//
+// Other sources (images, video, v4l2) are refused by the config reader: the run's grasp, its oracle
+// and its robot need the simulated object and base, which footage does not have.
+
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "viewline/core/camera.h"
+#include "viewline/io/config.h"
+#include "viewline/runtime/frame_source.h"
+#include "viewline/runtime/recording.h"
+#include "viewline/runtime/source_config.h"
+#include "viewline/scenarios/mobile_capture/world.h"
+#include "viewline/sim/physics.h"
+
+namespace viewline::scenarios {
+
+/// Reads the config's `source:` (runtime::readSourceConfig): sim or recording; other kinds are
+/// refused with core::InvalidInput naming file:line (see the file comment).
+runtime::SourceConfig readMobileCaptureSource(const io::ConfigNode& root);
+
+/// Record and replay folders of a batch (runMobileCaptureBatch); empty: none.
+struct MobileCaptureSessionIo {
+  std::string record_dir;   ///< --record DIR: a new session recording
+  std::string replay_dir;   ///< --replay DIR: a session recording to run on (overrides the config's source)
+  std::string config_text;  ///< the config as run, written into a recording (config.yaml)
+};
+
+/// The session recording a batch replays: io.replay_dir, else the config's `source:` folder, else "" (render).
+std::string mobileCaptureReplayRoot(const MobileCaptureConfig& cfg, const MobileCaptureSessionIo& io);
+/// The folder of run `index` in a session recording: DIR/run_iii.
+std::string mobileCaptureRunDir(const std::string& dir, int index);
+/// The number of runs of a session recording; throws core::InvalidInput when DIR holds none.
+int recordedMobileCaptureRuns(const std::string& dir);
+
+/// The head camera of one run: the simulator's renderer (optionally recorded) or a recorded run.
+class MobileCaptureFrames : public runtime::FrameSource {
+public:
+  /// The renderer (RenderedHeadCamera: cfg, target, rng, camera_pose as there).
+  MobileCaptureFrames(const MobileCaptureConfig& cfg, const sim::GroundTarget& target, mobile_capture::Streams& rng,
+                      mobile_capture::RenderedHeadCamera::PoseProvider camera_pose);
+  /// A recorded run (run_dir = mobileCaptureRunDir(DIR, i)) whose truth must be `target`'s path;
+  /// throws core::InvalidInput naming the file when it is not a mobile-capture run recording.
+  MobileCaptureFrames(const std::string& run_dir, const sim::GroundTarget& target);
+  ~MobileCaptureFrames() override;
+  MobileCaptureFrames(const MobileCaptureFrames&) = delete;
+  MobileCaptureFrames& operator=(const MobileCaptureFrames&) = delete;
+
+  /// Records every grab from now on into run_dir (a new folder), with `camera` (the estimators'
+  /// calibration, ViSP XML) and the object's truth per frame.
+  void record(const std::string& run_dir, const core::Camera& camera);
+  /// Writes the recording's index (an interrupted run leaves none: it is not replayable).
+  void finishRecording();
+
+  std::size_t cameraCount() const override { return 1; }
+  /// The renderer's next vision tick, or the recorded ready time, s.
+  std::optional<core::Timestamp> nextReadyTime() const override;
+  /// The next frame (recorded when record() was called; checked against the truth in a replay).
+  std::optional<runtime::Frame> grab() override;
+
+private:
+  const sim::GroundTarget& target_;
+  std::unique_ptr<mobile_capture::RenderedHeadCamera> renderer_;
+  std::unique_ptr<runtime::RecordingSource> replay_;
+  std::unique_ptr<runtime::RecordingWriter> writer_;
+};
+
+}  // namespace viewline::scenarios
