@@ -15,3 +15,5 @@ list(APPEND scenarios_sources pan_tilt/config_keys.cpp)
 list(APPEND scenarios_tests test/pan_tilt_footage_test.cpp)
 # The loop on other frame sources: record and replay bit for bit, footage not scored.
 list(APPEND scenarios_tests test/pan_tilt_sources_test.cpp)
+# Guard of the headline figures: the shipped filter replayed on each path's synthetic measurements.
+list(APPEND scenarios_tests test/pan_tilt_headline_test.cpp)

@@ -2,6 +2,7 @@
 #include "viewline/tracking/planar_target/filter.h"
 
 #include <Eigen/Cholesky>
+#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -34,7 +35,8 @@ estimation::NonlinearTransition cvWithOmega(double q, double q_omega, double dt)
 int PlanarTargetFilter::stateDim() const {
   switch (config_.model) {
     case TargetModel::ConstantVelocity:
-    case TargetModel::WaypointParticles: return 4;
+    case TargetModel::WaypointParticles:
+    case TargetModel::Mixture: return 4;
     case TargetModel::CoordinatedTurn:
     case TargetModel::Imm: return 5;
     default: return 6;
@@ -43,6 +45,7 @@ int PlanarTargetFilter::stateDim() const {
 
 Eigen::VectorXd PlanarTargetFilter::modeProbabilities() const {
   if (imm_ && imm_->initialized()) return imm_->probabilities();
+  if (!parts_.empty()) return part_probability_;
   return {};
 }
 
@@ -59,6 +62,20 @@ PlanarTargetFilter::PlanarTargetFilter(const TargetFilterConfig& config)
       corners_(config_.jump_min_samples, config_.jump_corner_sigma),
       turns_(config_.turn_prior_weight > 0.0),
       region_(config_.region_center, config_.region_size) {
+  if (config_.model == TargetModel::Mixture) {
+    TargetFilterConfig legs = config_;  // every corner key applies to the cv part
+    legs.model = TargetModel::ConstantVelocity;
+    TargetFilterConfig turn = config_;  // the ct part: none of the corner keys (they are cv's)
+    turn.model = TargetModel::CoordinatedTurn;
+    turn.jump_window = turn.jump_rate = turn.turn_prior_weight = 0.0;
+    turn.constant_speed = false;
+    turn.jump_evidence = "kink";
+    turn.jump_decision = "test";
+    turn.region_size.setZero();
+    parts_.emplace_back(legs);
+    parts_.emplace_back(turn);
+    return;
+  }
   const int n = stateDim();
   const Eigen::Matrix2d I = Eigen::Matrix2d::Identity();
   model_.A = Eigen::MatrixXd::Zero(n, n);
@@ -122,7 +139,13 @@ void PlanarTargetFilter::setParticleState() {
 }
 
 void PlanarTargetFilter::reset(core::Timestamp t, const Eigen::Vector2d& z, const Eigen::Matrix2d& R) {
-  start(t, z, R);
+  if (!parts_.empty()) {  // the model probabilities are kept: a lost target has not changed its motion
+    for (PlanarTargetFilter& f : parts_) f.reset(t, z, R);
+    initialized_ = true;
+    setMixtureState(t);
+  } else {
+    start(t, z, R);
+  }
   Update u;
   u.decision = GateDecision::Start;
   count(u);
@@ -163,6 +186,7 @@ void PlanarTargetFilter::start(core::Timestamp t, const Eigen::Vector2d& z, cons
 PlanarTargetFilter::Update PlanarTargetFilter::update(core::Timestamp t, const Eigen::Vector2d& z,
                                                       const Eigen::Matrix2d& R) {
   output_.reset();
+  if (!parts_.empty()) return updateMixture(t, z, R);
   if (config_.model == TargetModel::WaypointParticles) {
     Update out;
     if (!initialized_) {
@@ -290,6 +314,7 @@ PlanarTargetFilter::Update PlanarTargetFilter::step(core::Timestamp t, const Eig
 
 PlanarTargetFilter::Kinematics PlanarTargetFilter::at(core::Timestamp t) const {
   if (!initialized_) throw core::Error("PlanarTargetFilter::at: filter not initialised");
+  if (!parts_.empty()) return mixtureAt(t);
   Kinematics k;
   if (particles_) {
     const WaypointParticleFilter::Moments m = particles_->moments(std::max(t, particles_->t()));
@@ -323,6 +348,90 @@ PlanarTargetFilter::Kinematics PlanarTargetFilter::at(core::Timestamp t) const {
   k.P_pos = P.block(0, 0, 2, 2);
   if (region_.active() && dt > 1e-9) region_.stopAtBoundary(est.x().head<2>(), k.p, k.v, k.a);
   return k;
+}
+
+PlanarTargetFilter::Kinematics PlanarTargetFilter::mixtureAt(core::Timestamp t) const {
+  Kinematics k;
+  std::vector<Kinematics> ks;
+  for (const PlanarTargetFilter& f : parts_) ks.push_back(f.at(t));
+  for (std::size_t i = 0; i < ks.size(); ++i) {
+    const double w = part_probability_(static_cast<int>(i));
+    k.p += w * ks[i].p;
+    k.v += w * ks[i].v;
+    k.a += w * ks[i].a;
+  }
+  for (std::size_t i = 0; i < ks.size(); ++i) {
+    const Eigen::Vector2d d = ks[i].p - k.p;
+    k.P_pos += part_probability_(static_cast<int>(i)) * (ks[i].P_pos + d * d.transpose());
+  }
+  return k;
+}
+
+void PlanarTargetFilter::setMixtureState(core::Timestamp t) {
+  // Each part's (p, v) block (the ct part carries ω after them), moment-matched.
+  Eigen::Vector4d x = Eigen::Vector4d::Zero();
+  Eigen::Matrix4d P = Eigen::Matrix4d::Zero();
+  for (std::size_t i = 0; i < parts_.size(); ++i)
+    x += part_probability_(static_cast<int>(i)) * parts_[i].estimate().x().head<4>();
+  for (std::size_t i = 0; i < parts_.size(); ++i) {
+    const estimation::StateEstimate& e = parts_[i].estimate();
+    const Eigen::Vector4d d = e.x().head<4>() - x;
+    P += part_probability_(static_cast<int>(i)) * (e.P().topLeftCorner<4, 4>() + d * d.transpose());
+  }
+  state_ = estimation::StateEstimate(Eigen::VectorXd(x), Eigen::MatrixXd(P), t);
+}
+
+PlanarTargetFilter::Update PlanarTargetFilter::updateMixture(core::Timestamp t, const Eigen::Vector2d& z,
+                                                             const Eigen::Matrix2d& R) {
+  core::requireFinite(z, "PlanarTargetFilter: z");
+  Update out;
+  if (!initialized_) {
+    for (PlanarTargetFilter& f : parts_) f.update(t, z, R);
+    initialized_ = true;
+    setMixtureState(t);
+    out.accepted = out.reinitialized = true;
+    out.decision = GateDecision::Start;
+    count(out);
+    return out;
+  }
+  // Markov prediction of the model probabilities over dt: each switches to the other at
+  // mixture_switch_rate (the chain's transition probability 1 − exp(−r dt)).
+  const double dt = std::max(0.0, t - state_.t());
+  const double e = 0.5 * (1.0 - std::exp(-2.0 * config_.mixture_switch_rate * dt));
+  Eigen::Vector2d prior(part_probability_(0) * (1.0 - e) + part_probability_(1) * e,
+                        part_probability_(1) * (1.0 - e) + part_probability_(0) * e);
+  // The predictive likelihood of each part, N(z; p̂ᵢ(t), Pᵢ + R), and the mixture's own NIS.
+  Eigen::Vector2d log_like;
+  Kinematics mix;
+  std::vector<Kinematics> ks;
+  for (const PlanarTargetFilter& f : parts_) ks.push_back(f.at(t));
+  for (int i = 0; i < 2; ++i) {
+    const Eigen::Matrix2d S = ks[static_cast<std::size_t>(i)].P_pos + R;
+    const Eigen::Vector2d d = z - ks[static_cast<std::size_t>(i)].p;
+    log_like(i) = -0.5 * d.dot(S.ldlt().solve(d)) - 0.5 * std::log(S.determinant());
+    mix.p += prior(i) * ks[static_cast<std::size_t>(i)].p;
+  }
+  for (int i = 0; i < 2; ++i) {
+    const Eigen::Vector2d d = ks[static_cast<std::size_t>(i)].p - mix.p;
+    mix.P_pos += prior(i) * (ks[static_cast<std::size_t>(i)].P_pos + d * d.transpose());
+  }
+  const Eigen::Vector2d innovation = z - mix.p;
+  const double nis = innovation.dot((mix.P_pos + R).ldlt().solve(innovation));
+  std::vector<Update> ups;
+  for (PlanarTargetFilter& f : parts_) ups.push_back(f.update(t, z, R));
+  const double top = log_like.maxCoeff();
+  Eigen::Vector2d post = prior.array() * (log_like.array() - top).exp();
+  // Floor: neither model is ever ruled out beyond recovery by one outlier (a corner's first measurements).
+  post = (post / post.sum()).cwiseMax(1e-6);
+  part_probability_ = post / post.sum();
+  setMixtureState(t);
+  // The gate's decision, the corner report and "accepted" are the more probable part's.
+  const std::size_t lead = part_probability_(0) >= part_probability_(1) ? 0 : 1;
+  out = ups[lead];
+  out.jump = ups.front().jump;
+  out.nis = nis;
+  count(out);
+  return out;
 }
 
 }  // namespace viewline::tracking
