@@ -161,7 +161,10 @@ int main(int argc, char** argv) {
         for (double g : synthetic ? std::vector<double>{} : baseline_gains) {
           scenarios::PanTiltScenarioConfig c = cfg;
           c.control.servo.gain = g;  // the baseline's λ (ours has its predictive_gain)
-          r.baseline_px.push_back(scenarios::runPanTilt(c, r.seed, scenarios::PanTiltControllerKind::Baseline).image_error_rms_px);
+          r.baseline_px.push_back(g == cfg.control.servo.gain && r.run.has_baseline  // the comparison's own run
+                                      ? r.run.baseline.image_error_rms_px
+                                      : scenarios::runPanTilt(c, r.seed, scenarios::PanTiltControllerKind::Baseline)
+                                            .image_error_rms_px);
         }
         if (bayes && !synthetic) {
           scenarios::PanTiltScenarioConfig c = cfg;
