@@ -158,6 +158,7 @@ private:
   std::vector<double> regionJumpOdds() const;
   bool usesImm() const { return config_.model == TargetModel::CoordinatedTurn || config_.model == TargetModel::Imm; }
   void setParticleState();  ///< state_ from the particles' moments at their time
+  /// update() of model mixture: both parts updated, their probabilities from the predictive likelihoods.
   Update updateMixture(core::Timestamp t, const Eigen::Vector2d& z, const Eigen::Matrix2d& R);
   Kinematics mixtureAt(core::Timestamp t) const;  ///< the parts' at(t) as one Gaussian
   void setMixtureState(core::Timestamp t);  ///< state_ = the parts' (p, v) estimates as one Gaussian
