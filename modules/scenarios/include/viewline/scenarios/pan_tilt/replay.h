@@ -50,15 +50,15 @@ enum class PanTiltReplayEstimator {
   /// (waypoints uniform in filter.region, one constant speed), the causal reference; `jumps` is 0.
   WaypointParticles,
 };
-/// With a log, writes the stream replay_frames (t, truth, detected, measurement, the estimator's output,
-/// accepted, jumps so far) for per-frame comparisons. `particles`: the particle count of
-/// WaypointParticles.
 /// Writes a frames CSV that replayPanTiltFilter reads (t, truth_x, truth_y, detected, meas_x, meas_y) without a
 /// camera: the path of `seed` at every frame (fps, duration of the config), measured with [T]'s noise
 /// (σ per axis as the scenario's, its own seeded stream, not the closed loop's draws) and not detected
 /// during the occlusion. For filter studies over many seeds at a fraction of a closed loop's cost.
 void writeSyntheticPanTiltFrames(const PanTiltScenarioConfig& config, std::uint64_t seed, const std::string& frames_csv);
 
+/// With a log, writes the stream replay_frames (t, truth, detected, measurement, the estimator's output,
+/// accepted, jumps so far) for per-frame comparisons. `particles`: the particle count of
+/// WaypointParticles.
 PanTiltReplayMetrics replayPanTiltFilter(const PanTiltScenarioConfig& config, std::uint64_t seed,
                                          const std::string& frames_csv,
                                          PanTiltReplayEstimator estimator = PanTiltReplayEstimator::Filter,
