@@ -400,27 +400,26 @@ PlanarTargetFilter::Update PlanarTargetFilter::updateMixture(core::Timestamp t, 
   const double e = 0.5 * (1.0 - std::exp(-2.0 * config_.mixture_switch_rate * dt));
   Eigen::Vector2d prior(part_probability_(0) * (1.0 - e) + part_probability_(1) * e,
                         part_probability_(1) * (1.0 - e) + part_probability_(0) * e);
-  // The predictive likelihood of each part, N(z; p̂ᵢ(t), Pᵢ + R), and the mixture's own NIS.
+  // The predictive likelihood of each part, N(z; p̂ᵢ(t), Pᵢ + R), and the mixture's own NIS: against at(t),
+  // the prediction a consumer (the telemetry's innovation record) sees before the update.
   Eigen::Vector2d log_like;
-  Kinematics mix;
   std::vector<Kinematics> ks;
   for (const PlanarTargetFilter& f : parts_) ks.push_back(f.at(t));
   for (int i = 0; i < 2; ++i) {
     const Eigen::Matrix2d S = ks[static_cast<std::size_t>(i)].P_pos + R;
     const Eigen::Vector2d d = z - ks[static_cast<std::size_t>(i)].p;
     log_like(i) = -0.5 * d.dot(S.ldlt().solve(d)) - 0.5 * std::log(S.determinant());
-    mix.p += prior(i) * ks[static_cast<std::size_t>(i)].p;
   }
-  for (int i = 0; i < 2; ++i) {
-    const Eigen::Vector2d d = ks[static_cast<std::size_t>(i)].p - mix.p;
-    mix.P_pos += prior(i) * (ks[static_cast<std::size_t>(i)].P_pos + d * d.transpose());
-  }
+  const Kinematics mix = mixtureAt(t);
   const Eigen::Vector2d innovation = z - mix.p;
   const double nis = innovation.dot((mix.P_pos + R).ldlt().solve(innovation));
   std::vector<Update> ups;
   for (PlanarTargetFilter& f : parts_) ups.push_back(f.update(t, z, R));
+  // A measurement every part's gate rejected (an outlier) says nothing about the motion: the
+  // probabilities only take the chain's prediction (otherwise the wider part would win it).
+  const bool evidence = std::any_of(ups.begin(), ups.end(), [](const Update& u) { return u.accepted; });
   const double top = log_like.maxCoeff();
-  Eigen::Vector2d post = prior.array() * (log_like.array() - top).exp();
+  Eigen::Vector2d post = evidence ? Eigen::Vector2d(prior.array() * (log_like.array() - top).exp()) : prior;
   // Floor: neither model is ever ruled out beyond recovery by one outlier (a corner's first measurements).
   post = (post / post.sum()).cwiseMax(1e-6);
   part_probability_ = post / post.sum();

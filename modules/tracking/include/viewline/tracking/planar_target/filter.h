@@ -36,8 +36,9 @@
 // N(z; p̂ᵢ, Pᵢ + R) (Bar-Shalom, Li, Kirubarajan 2001, §11.6, the multiple-model estimator without
 // interaction: the cv filter's corner history cannot be mixed). The output (at(), estimate()) is the
 // Gaussian mixture's mean and covariance (spread of the means included); the NIS that update() reports
-// is the measurement's against that mixture's prediction. Corner diagnostics (jumps, speed, turns,
-// region) are the cv part's.
+// is the measurement's against that mixture's prediction; a measurement every part's gate rejects leaves
+// the probabilities at the chain's prediction. Corner diagnostics (jumps, speed, turns, region) are the
+// cv part's.
 
 #include <Eigen/Core>
 #include <cstdint>
