@@ -417,14 +417,9 @@ PlanarTargetFilter::Update PlanarTargetFilter::updateMixture(core::Timestamp t, 
   for (PlanarTargetFilter& f : parts_) ups.push_back(f.update(t, z, R));
   // A measurement every part's gate rejected (an outlier) says nothing about the motion: the
   // probabilities only take the chain's prediction (otherwise the wider part would win it).
-  const bool evidence =
-      std::any_of(ups.begin(), ups.end(), [](const Update& u) { return u.accepted && !u.reinitialized; });
+  const bool evidence = std::any_of(ups.begin(), ups.end(), [](const Update& u) { return u.accepted; });
   const double top = log_like.maxCoeff();
   Eigen::Vector2d post = evidence ? Eigen::Vector2d(prior.array() * (log_like.array() - top).exp()) : prior;
-  // A part that restarted at this measurement (its gate rejected the ones before) has failed the motion
-  // and holds only the measurement itself: while the other part still tracks, it starts again from the floor.
-  for (int i = 0; i < 2; ++i)
-    if (ups[static_cast<std::size_t>(i)].reinitialized && !ups[static_cast<std::size_t>(1 - i)].reinitialized) post(i) = 0.0;
   // Floor: neither model is ever ruled out beyond recovery by one outlier (a corner's first measurements).
   post = (post / post.sum()).cwiseMax(1e-6);
   part_probability_ = post / post.sum();
