@@ -58,3 +58,8 @@ endif()
 include(GNUInstallDirs)
 install(DIRECTORY ${VIEWLINE_DOCS_OUTPUT_DIR}/api/ DESTINATION ${CMAKE_INSTALL_DOCDIR}/api
   COMPONENT api_docs OPTIONAL)
+
+# Every relative link and picture of the Markdown pages names a file inside the repository
+# (scripts/check-links), and no page sends the reader outside it.
+add_test(NAME docs.links COMMAND bash ${PROJECT_SOURCE_DIR}/scripts/check-links ${PROJECT_SOURCE_DIR})
+set_tests_properties(docs.links PROPERTIES LABELS docs)

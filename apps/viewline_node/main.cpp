@@ -34,8 +34,10 @@ int main(int argc, char** argv) {
   cli.add_option("--realtime", opt.realtime, "simulated seconds per wall second")->capture_default_str()->check(
       CLI::PositiveNumber);
   cli.add_option("--tick", opt.tick_s, "world: simulated clock period, s")->capture_default_str()->check(CLI::PositiveNumber);
-  cli.add_option("--duration", opt.duration_s, "world: simulated time to run, s")->capture_default_str()->check(
+  cli.add_option("--duration", opt.duration_s, "world: simulated time to run per throw, s")->capture_default_str()->check(
       CLI::PositiveNumber);
+  cli.add_option("--throws", opt.throws, "world: throws in the session (the in-process session's, one per --duration)")
+      ->capture_default_str()->check(CLI::PositiveNumber);
   cli.add_option("--release", opt.release_s, "world: throw release time, s")->capture_default_str();
   cli.add_option("--expect", opt.expect, "world: nodes that must follow the clock before it starts")
       ->capture_default_str();
@@ -46,6 +48,8 @@ int main(int argc, char** argv) {
       ->capture_default_str()->check(CLI::PositiveNumber);
   cli.add_option("--max-wall", opt.max_wall_s, "end after this much wall time, s")->capture_default_str();
   cli.add_option("--summary", opt.summary_path, "write the node's JSON summary here");
+  cli.add_option("--track-log", opt.track_log_path,
+                 "tracker: CSV of every fused detection (update time, camera, stamp, delay, position, sigma)");
   if (const auto code = apps::parseCommandLine(cli, argc, argv)) return *code;
   return apps::runGuarded("viewline_node " + role, [&] {
     const auto cfg = scenarios::loadBallCatchingConfig(io::loadConfigWithValues(config_path, sets));

@@ -3,11 +3,15 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Cholesky>
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <future>
+#include <vector>
 
 #include "viewline/core/error.h"
 #include "viewline/core/frames.h"
+#include "viewline/core/statistics.h"
 #include "viewline/io/config.h"
 #include "viewline/runtime/telemetry.h"
 #include "viewline/scenarios/mobile_capture.h"
@@ -30,9 +34,63 @@ MobileCaptureConfig perfectCamera() {
   return cfg;
 }
 
+TEST(MobileCapture, HeadlineGuardOnSeedsTheNoiseWasNotTunedOn) {
+  // The shipped config (calibrated rig) on 3 seeds; its noise was tuned on the runs of seed 1000
+  // (config/mobile_capture.yaml). docs/results.md "Mobile capture": success 1.00, median time
+  // ratio to the oracle ~1.13, NIS and position NEES inside their 99 % bands. The thresholds fail
+  // at a ~20 % regression: a missed capture, a median ratio above 1.35, a NIS mean outside its
+  // band (with ~500 samples the band is ±12 % of 2).
+  const MobileCaptureConfig cfg = shipped();
+  ASSERT_TRUE(cfg.rig.has_value());
+  // The three chases run concurrently (each is independent and thread-safe, as in the batch).
+  const std::vector<std::uint64_t> seeds{21u, 22u, 23u};
+  std::vector<int> frames_seen(seeds.size(), 0);
+  std::vector<std::future<MobileCaptureRun>> runs;
+  for (std::size_t k = 0; k < seeds.size(); ++k) {
+    runs.push_back(std::async(std::launch::async, [&cfg, &frames_seen, &seeds, k] {
+      MobileCaptureHooks hooks;
+      hooks.on_frame = [&frames_seen, k](const MobileCaptureFrame& f) {
+        ++frames_seen[k];
+        EXPECT_TRUE(f.image != nullptr && f.image->cols == 320 && f.image->rows == 240);
+      };
+      return runMobileCapture(cfg, seeds[k], &hooks);
+    }));
+  }
+  std::vector<double> ratios;
+  double nis = 0.0, nees = 0.0;
+  long n_nis = 0, n_nees = 0;
+  for (std::size_t k = 0; k < seeds.size(); ++k) {
+    SCOPED_TRACE(seeds[k]);
+    const MobileCaptureRun r = runs[k].get();
+    EXPECT_TRUE(r.captured);
+    EXPECT_TRUE(r.oracle_captured);
+    EXPECT_EQ(frames_seen[k], r.frames);
+    EXPECT_GT(r.detections, 0.9 * r.frames);  // the head keeps the object in view
+    ASSERT_GT(r.oracle_time, 0.0);
+    ratios.push_back(r.capture_time / r.oracle_time);
+    // Ground localisation in the loop: exact back-projection beats [K]'s angle per pixel; the
+    // calibrated rig adds its calibration error (world rays ~1 px off: several cm at 3-4 m from a
+    // camera 0.44 m high).
+    ASSERT_GT(r.localization.count, 50);
+    const double exact = std::sqrt(r.localization.sse_exact / r.localization.count);
+    EXPECT_LT(exact, std::sqrt(r.localization.sse_printed / r.localization.count));
+    EXPECT_LT(exact, 0.10);
+    nis += r.nis_sum, n_nis += r.nis_count, nees += r.nees_sum, n_nees += r.nees_count;
+  }
+  std::sort(ratios.begin(), ratios.end());
+  EXPECT_GT(ratios[1], 0.8);  // the oracle has perfect knowledge: not beaten by much
+  EXPECT_LT(ratios[1], 1.35);
+  ASSERT_GT(n_nis, 300);
+  ASSERT_GT(n_nees, 20);
+  const core::Interval nis_band = core::averagedChiSquareInterval(2.0, static_cast<double>(n_nis), 0.99);
+  const core::Interval nees_band = core::averagedChiSquareInterval(2.0, static_cast<double>(n_nees), 0.99);
+  EXPECT_TRUE(nis_band.contains(nis / n_nis)) << nis / n_nis << " not in [" << nis_band.lo << ", " << nis_band.hi << "]";
+  EXPECT_TRUE(nees_band.contains(nees / n_nees)) << nees / n_nees << " not in [" << nees_band.lo << ", " << nees_band.hi << "]";
+}
+
 TEST(MobileCapture, ShortSeededCaptureFromKsStart) {
-  // On the shipped calibrated rig and on a perfect camera.
-  for (const bool calibrated : {true, false}) {
+  // On a perfect camera (the calibrated rig: HeadlineGuardOnSeedsTheNoiseWasNotTunedOn).
+  for (const bool calibrated : {false}) {
     SCOPED_TRACE(calibrated ? "calibrated rig" : "perfect camera");
     MobileCaptureConfig cfg = calibrated ? shipped() : perfectCamera();
     ASSERT_EQ(cfg.rig.has_value(), calibrated);

@@ -112,7 +112,10 @@ nlohmann::json runCameraNode(const scenarios::BallCatchingConfig& cfg, const Nod
         f->pixel.reset();
         if (det) {
           f->pixel = det->pixel;
-          cov = det->pixel_covariance;
+          // The detector's std as measured against the truth (detector.sigma_px), else the blob's
+          // own covariance: what the in-process loop tells its tracker.
+          cov = cfg.sigma_px > 0.0 ? Eigen::Matrix2d(cfg.sigma_px * cfg.sigma_px * Eigen::Matrix2d::Identity())
+                                   : det->pixel_covariance;
         }
       }
       DetectionMsg d{};

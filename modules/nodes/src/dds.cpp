@@ -72,7 +72,7 @@ Qos Qos::cameraWriter() {
 }
 Qos Qos::setpoints(double deadline_s) {
   Qos q;
-  q.reliable(true).keepLast(1).deadline(deadline_s);
+  q.reliable(true).keepLast(64).deadline(deadline_s);
   return q;
 }
 Qos Qos::state(int depth) {

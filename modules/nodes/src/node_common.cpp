@@ -38,6 +38,7 @@ NodeContext::NodeContext(const NodeOptions& o, std::string n, std::string r, std
       setpoint_topic(participant, viewline_msg_dds__SetPoint__desc, topic::kSetPoint),
       robot_topic(participant, viewline_msg_dds__RobotState__desc, topic::kRobotState),
       health_topic(participant, viewline_msg_dds__NodeHealth__desc, topic::kHealth),
+      episode_topic(participant, viewline_msg_dds__Episode__desc, topic::kEpisode),
       // Deeper than one: health is keyless (ROS 2 style), so one history holds every node's.
       health_writer(participant, health_topic, dds::Qos::health()),
       health_reader(participant, health_topic, dds::Qos(dds::Qos::health()).keepLast(64)),

@@ -58,7 +58,8 @@ public:
   std::string name, role;
   std::uint64_t rig_hash;
   dds::Participant participant;
-  dds::Topic clock_topic, truth_topic, detection_topic, track_topic, setpoint_topic, robot_topic, health_topic;
+  dds::Topic clock_topic, truth_topic, detection_topic, track_topic, setpoint_topic, robot_topic, health_topic,
+      episode_topic;
   dds::Writer<NodeHealthMsg> health_writer;
   dds::Reader<NodeHealthMsg> health_reader;
 

@@ -13,9 +13,11 @@ nlohmann::json runRobotNode(const scenarios::BallCatchingConfig& cfg, const Node
   dds::Reader<ClockMsg> clock_r(ctx.participant, ctx.clock_topic, dds::Qos::state(4));
   dds::Reader<SetPointMsg> sp_r(ctx.participant, ctx.setpoint_topic, dds::Qos::setpoints(opt.setpoint_deadline_s));
   dds::Writer<RobotStateMsg> state_w(ctx.participant, ctx.robot_topic, dds::Qos::state(16));
+  dds::Reader<EpisodeMsg> episode_r(ctx.participant, ctx.episode_topic, dds::Qos::health());
   dds::WaitSet ws(ctx.participant);
   ws.attachData(clock_r);
   ws.attachData(sp_r);
+  ws.attachData(episode_r);
   ws.attachData(ctx.health_reader);
   ws.attachStatus(sp_r, DDS_REQUESTED_DEADLINE_MISSED_STATUS);
   ctx.publishHealth(HealthStatus::Running, robot.name(), 0.0);
@@ -27,9 +29,20 @@ nlohmann::json runRobotNode(const scenarios::BallCatchingConfig& cfg, const Node
   double last_cmd_t = 0.0, last_sp_wall = 0.0;
   nlohmann::json halts = nlohmann::json::array();
   const std::string world_frame = "world";
+  int episodes = 1;
   while (!ctx.shouldStop()) {
     ws.wait(0.01);
     ctx.takeHealth();
+    // A new throw of the session: back at home from the episode's start (the in-process loop
+    // starts each throw there); set points older than the start are dropped.
+    episode_r.take([&](const EpisodeMsg& e, const dds_sample_info_t&) {
+      if (e.index == 0) return;  // the node's start
+      const double t0 = fromTimeMsg(e.header.stamp);
+      robot.reset(t0);
+      last_cmd_t = t0;
+      halted = false;
+      ++episodes;
+    });
     sp_r.take([&](const SetPointMsg& m, const dds_sample_info_t&) {
       const double t = fromTimeMsg(m.header.stamp);
       if (t < last_cmd_t) return;  // older than the halt (or a duplicate): the robot does not go back
@@ -76,6 +89,8 @@ nlohmann::json runRobotNode(const scenarios::BallCatchingConfig& cfg, const Node
   j["setpoints"] = received;
   j["states"] = states;
   j["halted"] = halted;
+  j["episodes"] = episodes;
+  j["acceleration_violations"] = robot.accelerationViolations();
   j["halts"] = halts;
   j["deadline_s"] = opt.setpoint_deadline_s;
   j["velocity_violations"] = robot.velocityViolations();

@@ -1,5 +1,6 @@
 #include "viewline/planning/catch_planner.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "viewline/core/error.h"
@@ -44,9 +45,11 @@ void CatchPlannerConfig::validate() const {
   };
   nonneg(latency, "robot.latency_s");
   nonneg(give_up_late, "planner.give_up_late_s");
+  nonneg(give_up_sigmas, "planner.give_up_sigmas");
   nonneg(home_delay, "planner.home_delay_s");
   nonneg(min_lead, "planner.min_lead_s");
   nonneg(target_prior_std, "planner.target_prior_std_m");
+  nonneg(move_sigmas, "planner.move_sigmas");
   if (!(std::isfinite(start_sigma) && start_sigma > 0.0)) throw InvalidInput("planner.start_sigma_m: expected > 0");
   if (!(std::isfinite(commit_sigma) && commit_sigma > 0.0)) throw InvalidInput("planner.commit_sigma_m: expected > 0");
   if (commit_min_updates < 1) throw InvalidInput("planner.commit_min_updates: expected >= 1");
@@ -112,11 +115,23 @@ PlannerUpdate CatchPlanner::update(double now, const estimation::StateEstimate& 
   // per-axis profile with the same numbers relaxes |v| <= V to |v_i| <= V (so it is never slower
   // than any norm-limited motion), while the planner's own Euclidean family from a moving start is
   // conservative; going home cannot catch anything, chasing might.
+  // With give_up_sigmas k: the crossing k std nearer the box (along the line to it) and k std later.
+  Eigen::Vector3d p_near = c.p;
+  double t_late = c.t;
+  if (cfg_.give_up_sigmas > 0.0) {
+    const Eigen::Vector3d d = s.p - c.p;
+    if (d.norm() > 1e-12) {
+      const Eigen::Vector3d u = d.normalized();
+      const double sigma_u = std::sqrt(std::max(0.0, u.dot(c.cov_p * u)));
+      p_near = c.p + u * std::min(d.norm(), cfg_.give_up_sigmas * sigma_u);
+    }
+    t_late = c.t + cfg_.give_up_sigmas * std::sqrt(std::max(0.0, c.var_t));
+  }
   const double arrival_bound =
       cfg_.limits.norm == robots::LimitNorm::Euclidean
-          ? now + cfg_.latency + SyncProfile::minimumDuration(s.p, s.v, c.p, cfg_.limits.v_max, cfg_.limits.a_max)
-          : out.arrival;
-  if (commit_time_ && cfg_.give_up && (!in_workspace || arrival_bound > c.t + cfg_.give_up_late)) {
+          ? now + cfg_.latency + SyncProfile::minimumDuration(s.p, s.v, p_near, cfg_.limits.v_max, cfg_.limits.a_max)
+          : now + cfg_.latency + minimumDuration(cfg_.limits, s.p, s.v, p_near);
+  if (commit_time_ && cfg_.give_up && (!in_workspace || arrival_bound > t_late + cfg_.give_up_late)) {
     give_up_time_ = now;
     phase_ = CatchPhase::GaveUp;
     planTo(now, cfg_.home);
@@ -133,6 +148,19 @@ PlannerUpdate CatchPlanner::update(double now, const estimation::StateEstimate& 
     goal = cfg_.home + s0 * S.ldlt().solve(c.p - cfg_.home);
     goal -= cfg_.normal * cfg_.normal.dot(goal - cfg_.home);  // stay in the plane
     if (workspace_ && !workspace_(goal)) goal = c.p;
+  }
+  if (cfg_.move_sigmas > 0.0) {
+    // Soft threshold per in-plane axis (an orthonormal basis of the plane).
+    const Eigen::Vector3d a = std::abs(cfg_.normal.z()) < 0.9 ? Eigen::Vector3d::UnitZ() : Eigen::Vector3d::UnitX();
+    const Eigen::Vector3d e1 = (a - cfg_.normal * cfg_.normal.dot(a)).normalized();
+    const Eigen::Vector3d e2 = cfg_.normal.cross(e1);
+    Eigen::Vector3d shrunk = cfg_.home;
+    for (const Eigen::Vector3d& e : {e1, e2}) {
+      const double mu = e.dot(goal - cfg_.home);
+      const double sd = std::sqrt(std::max(0.0, e.dot(c.cov_p * e)));
+      shrunk += e * std::copysign(std::max(0.0, std::abs(mu) - cfg_.move_sigmas * sd), mu);
+    }
+    if (!workspace_ || workspace_(shrunk)) goal = shrunk;
   }
   if (!first_move_) first_move_ = now;
   planTo(now, goal);

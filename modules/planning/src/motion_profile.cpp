@@ -130,6 +130,22 @@ AxisState AxisProfile::at(double t) const {
   return s;
 }
 
+AxisProfile AxisProfile::fromPhases(double p0, double v0, double s1, double t1, double tc, double s3, double t3) {
+  AxisProfile pr;
+  pr.p0_ = p0;
+  pr.v0_ = v0;
+  pr.s1_ = s1;
+  pr.t1_ = t1;
+  pr.vc_ = v0 + s1 * t1;
+  pr.tc_ = tc;
+  pr.s3_ = s3;
+  pr.t3_ = t3;
+  pr.a_ = std::max(std::abs(s1), std::abs(s3));
+  pr.T_ = t1 + tc + t3;
+  pr.pf_ = p0 + v0 * t1 + 0.5 * s1 * t1 * t1 + pr.vc_ * (tc + t3) + 0.5 * s3 * t3 * t3;
+  return pr;
+}
+
 double SyncProfile::minimumDuration(const Eigen::Vector3d& p0, const Eigen::Vector3d& v0, const Eigen::Vector3d& pf,
                                     const Eigen::Vector3d& v_max, const Eigen::Vector3d& a_max) {
   double T = 0.0;
@@ -246,9 +262,49 @@ NormProblem normProblem(const Eigen::Vector3d& p0, const Eigen::Vector3d& v0_in,
 
 }  // namespace
 
+namespace {
+
+// The velocity-chord family (file comment): direction u, phase-1 duration t1, cruise tc and the
+// motion frame, or nothing when the cruise line cannot be reached (goal too close to turn onto).
+struct ChordPlan {
+  Eigen::Vector3d u = Eigen::Vector3d::UnitX(), e2 = Eigen::Vector3d::Zero();
+  double t1 = 0.0, tc = 0.0, T = 0.0;
+};
+
+std::optional<ChordPlan> chordPlan(const Eigen::Vector3d& p0, Eigen::Vector3d v0, const Eigen::Vector3d& pf,
+                                   double V, double A) {
+  if (v0.norm() > V) v0 *= V / v0.norm();
+  const double brake = V * V / (2.0 * A);
+  Eigen::Vector3d d = pf - p0;
+  if (!(d.norm() > brake)) return std::nullopt;
+  ChordPlan c;
+  c.u = d.normalized();
+  bool converged = false;
+  for (int it = 0; it < 40 && !converged; ++it) {
+    c.t1 = (V * c.u - v0).norm() / A;
+    d = pf - (p0 + 0.5 * (v0 + V * c.u) * c.t1);
+    if (!(d.norm() > brake)) return std::nullopt;
+    const Eigen::Vector3d un = d.normalized();
+    converged = (un - c.u).norm() < 1e-13;
+    c.u = un;
+  }
+  if (!converged) return std::nullopt;
+  c.t1 = (V * c.u - v0).norm() / A;
+  d = pf - (p0 + 0.5 * (v0 + V * c.u) * c.t1);
+  c.tc = (d.norm() - brake) / V;
+  c.T = c.t1 + c.tc + V / A;
+  const Eigen::Vector3d across = v0 - c.u * c.u.dot(v0);
+  if (across.norm() > 1e-15) c.e2 = across.normalized();
+  return c;
+}
+
+}  // namespace
+
 double SyncProfile::minimumDurationEuclidean(const Eigen::Vector3d& p0, const Eigen::Vector3d& v0,
                                              const Eigen::Vector3d& pf, double v_max, double a_max) {
-  return normProblem(p0, v0, pf, v_max, a_max).minimumTime();
+  const double T = normProblem(p0, v0, pf, v_max, a_max).minimumTime();
+  const std::optional<ChordPlan> c = chordPlan(p0, v0, pf, v_max, a_max);
+  return c ? std::min(T, c->T) : T;
 }
 
 SyncProfile SyncProfile::planEuclidean(double t0, const Eigen::Vector3d& p0, const Eigen::Vector3d& v0,
@@ -263,6 +319,18 @@ SyncProfile SyncProfile::planEuclidean(double t0, const Eigen::Vector3d& p0, con
   s.e1_ = np.e1;
   s.e2_ = np.e2;
   s.T_ = np.minimumTime();
+  if (const std::optional<ChordPlan> c = chordPlan(p0, v0, pf, v_max, a_max); c && c->T < s.T_) {
+    // The velocity chord is faster (a turn from a moving start): axis 1 along u, axis 2 across.
+    const Eigen::Vector3d v = v0.norm() > v_max ? Eigen::Vector3d(v0 * (v_max / v0.norm())) : v0;
+    const double v1 = v.dot(c->u), v2 = v.dot(c->e2);
+    const double s1 = c->t1 > 0.0 ? (v_max - v1) / c->t1 : 0.0, s2 = c->t1 > 0.0 ? -v2 / c->t1 : 0.0;
+    s.e1_ = c->u;
+    s.e2_ = c->e2;
+    s.T_ = c->T;
+    s.axes_[0] = AxisProfile::fromPhases(0.0, v1, s1, c->t1, c->tc, -a_max, v_max / a_max);
+    s.axes_[1] = AxisProfile::fromPhases(0.0, v2, s2, c->t1, 0.0, 0.0, 0.0);
+    return s;
+  }
   for (int k = 0; k < 2; ++k) {
     if (np.idle(k)) continue;  // the default axis stays at 0, at rest
     // Bisection tolerances can leave T a hair short for the critical axis: nudge it up (as plan()).

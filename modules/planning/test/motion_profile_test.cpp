@@ -229,3 +229,21 @@ TEST(MotionProfile, EuclideanReplanningIsContinuousAndWithinTheNorms) {
     prev = s;
   }
 }
+
+// A turn at full speed (the catch planner re-plans while the box already moves towards an earlier
+// prediction): the velocity chord turns with the full acceleration, so it arrives sooner than
+// stopping first and then taking the straight line, and stays within the norms.
+TEST(MotionProfile, EuclideanTurnAtFullSpeedBeatsStoppingFirst) {
+  const double V = 0.5, A = 13.0;
+  const Eigen::Vector3d p0(4.0, 0.0, 1.1), v0(0.0, V, 0.0);
+  for (const Eigen::Vector3d& d : {Eigen::Vector3d(0, 0, 0.3), Eigen::Vector3d(0, -0.1, 0.25), Eigen::Vector3d(0, 0.1, 0.1)}) {
+    const Eigen::Vector3d pf = p0 + d;
+    const SyncProfile pr = SyncProfile::planEuclidean(0.0, p0, v0, pf, V, A);
+    const Eigen::Vector3d stop = p0 + v0 * (V / (2.0 * A));  // braking at A along -v0
+    const double stop_then_go = V / A + AxisProfile::minimumTime(0, 0, (pf - stop).norm(), V, A);
+    EXPECT_LT(pr.duration(), stop_then_go - 0.01) << d.transpose();
+    EXPECT_LT((pr.at(pr.arrivalTime()).p - pf).norm(), 1e-9);
+    EXPECT_LT((pr.at(0.0).v - v0).norm(), 1e-12);
+    expectWithinNormLimits(pr, V, A);
+  }
+}

@@ -64,6 +64,16 @@ void writeBinaryAtomic(const std::string& path, const std::vector<unsigned char>
 
 std::string cameraName(std::size_t k) { return "camera" + std::to_string(k); }
 
+// The index row of frame f, grabbed at ready_time (its file set by the caller).
+RecordingEntry entryOf(double ready_time, const Frame& f) {
+  RecordingEntry e;
+  e.ready_time = ready_time;
+  e.camera = f.camera;
+  e.sequence = f.sequence;
+  e.capture_time = f.capture_time;
+  e.stamp = f.stamp;
+  return e;
+}
 }  // namespace
 
 // ---------------------------------------------------------------------------- parsers
@@ -196,12 +206,7 @@ void RecordingWriter::frame(double ready_time, const Frame& f) {
   if (!cv::imencode(".png", f.image, png, {cv::IMWRITE_PNG_COMPRESSION, 1}))
     throw core::InvalidInput(path.string() + ": the image cannot be encoded as PNG");
   writeBinaryAtomic(path.string(), png);
-  RecordingEntry e;
-  e.ready_time = ready_time;
-  e.camera = f.camera;
-  e.sequence = f.sequence;
-  e.capture_time = f.capture_time;
-  e.stamp = f.stamp;
+  RecordingEntry e = entryOf(ready_time, f);
   e.file = name;
   entries_.push_back(std::move(e));
 }
@@ -215,13 +220,7 @@ void RecordingWriter::lost(double ready_time) {
 
 void RecordingWriter::lost(double ready_time, const Frame& f) {
   if (finished_) throw core::InvalidInput("recording " + dir_ + ": a grab after finish()");
-  RecordingEntry e;
-  e.ready_time = ready_time;
-  e.camera = f.camera;
-  e.sequence = f.sequence;
-  e.capture_time = f.capture_time;
-  e.stamp = f.stamp;
-  e.file.clear();
+  RecordingEntry e = entryOf(ready_time, f);  // no file: lost
   known_lost_.push_back(entries_.size());
   entries_.push_back(e);
 }

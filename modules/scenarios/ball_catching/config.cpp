@@ -146,6 +146,7 @@ void readDetector(const io::ConfigNode& d, BallCatchingConfig& c) {
   c.detector.open_kernel_px = d.getOr<int>("open_kernel_px", c.detector.open_kernel_px);
   c.detector.close_kernel_px = d.getOr<int>("close_kernel_px", c.detector.close_kernel_px);
   c.sigma_px_floor = d.getOr<double>("sigma_px_floor", c.sigma_px_floor);
+  c.sigma_px = d.getOr<double>("sigma_px", c.sigma_px);
   c.pixel_noise_px = d.getOr<double>("pixel_noise_px", c.pixel_noise_px);
 }
 
@@ -175,9 +176,11 @@ void readPlanner(const io::ConfigNode& p, planning::CatchPlannerConfig& k) {
   k.commit_min_updates = p.getOr<int>("commit_min_updates", k.commit_min_updates);
   k.give_up = p.getOr<bool>("give_up", k.give_up);
   k.give_up_late = p.getOr<double>("give_up_late_s", k.give_up_late);
+  k.give_up_sigmas = p.getOr<double>("give_up_sigmas", k.give_up_sigmas);
   k.home_delay = p.getOr<double>("home_delay_s", k.home_delay);
   k.min_lead = p.getOr<double>("min_lead_s", k.min_lead);
   k.target_prior_std = p.getOr<double>("target_prior_std_m", k.target_prior_std);
+  k.move_sigmas = p.getOr<double>("move_sigmas", k.move_sigmas);
 }
 
 void readRegistration(const io::ConfigNode& r, CatchRegistration& g) {
@@ -249,10 +252,16 @@ void BallCatchingConfig::validate() const {
   if (!(control_period > 0.0)) throw InvalidInput("robot.control_period_s: expected > 0");
   if (!(processing_latency >= 0.0)) throw InvalidInput("processing_latency_s: expected >= 0");
   if (!(sigma_px_floor > 0.0)) throw InvalidInput("detector.sigma_px_floor: expected > 0");
+  if (!(sigma_px >= 0.0 && std::isfinite(sigma_px))) throw InvalidInput("detector.sigma_px: expected a finite value >= 0");
   if (!(pixel_noise_px >= 0.0 && std::isfinite(pixel_noise_px)))
     throw InvalidInput("detector.pixel_noise_px: expected a finite value >= 0");
   if (threads < 1) throw InvalidInput("threads: expected >= 1");
-  if (flight_fit.min_images < 6) throw InvalidInput("flight_fit.min_images: expected >= 6 (six unknowns)");
+  if (flight_fit.min_images < (flight_fit.hasPrior() ? 1 : 6))
+    throw InvalidInput("flight_fit.min_images: expected >= 6 (six unknowns) without a prior, >= 1 with one");
+  if (flight_fit.prior_std.minCoeff() < 0.0 || !flight_fit.prior_std.allFinite() || !flight_fit.prior_mean.allFinite())
+    throw InvalidInput("flight_fit.prior_*: expected finite values, stds >= 0");
+  if (!(flight_fit.aim_prior_std >= 0.0 && std::isfinite(flight_fit.aim_prior_std)))
+    throw InvalidInput("flight_fit.aim_prior_std_m: expected a finite value >= 0");
   if (flight_fit.min_cameras < 1) throw InvalidInput("flight_fit.min_cameras: expected >= 1");
   if (flight_fit.max_iterations < 1) throw InvalidInput("flight_fit.max_iterations: expected >= 1");
   robot.validate();
@@ -306,6 +315,12 @@ BallCatchingConfig loadBallCatchingConfig(const io::ConfigNode& root) {
     c.flight_fit.min_images = f.getOr<int>("min_images", c.flight_fit.min_images);
     c.flight_fit.min_cameras = f.getOr<int>("min_cameras", c.flight_fit.min_cameras);
     c.flight_fit.max_iterations = f.getOr<int>("max_iterations", c.flight_fit.max_iterations);
+    FlightFitConfig& ff = c.flight_fit;
+    ff.prior_mean.head<3>() = f.getOr<Eigen::Vector3d>("prior_position", ff.prior_mean.head<3>());
+    ff.prior_mean.tail<3>() = f.getOr<Eigen::Vector3d>("prior_velocity", ff.prior_mean.tail<3>());
+    ff.prior_std.head<3>() = f.getOr<Eigen::Vector3d>("prior_std_position", ff.prior_std.head<3>());
+    ff.prior_std.tail<3>() = f.getOr<Eigen::Vector3d>("prior_std_velocity", ff.prior_std.tail<3>());
+    ff.aim_prior_std = f.getOr<double>("aim_prior_std_m", ff.aim_prior_std);
   }
   if (root.has("render")) {
     const auto r = root.child("render");

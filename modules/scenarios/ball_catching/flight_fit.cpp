@@ -11,9 +11,22 @@ namespace viewline::scenarios {
 using Vec6 = Eigen::Matrix<double, 6, 1>;
 using Mat6 = Eigen::Matrix<double, 6, 6>;
 
-FlightFit::FlightFit(FlightFitConfig cfg, std::vector<core::Camera> cameras, estimation::DragBallisticModel model)
-    : cfg_(cfg), cams_(std::move(cameras)), model_(std::move(model)) {
-  if (cfg_.min_images < 6) throw core::InvalidInput("flight_fit.min_images: expected >= 6 (six unknowns)");
+FlightFit::FlightFit(FlightFitConfig cfg, std::vector<core::Camera> cameras, estimation::DragBallisticModel model,
+                     FitAimPlane aim)
+    : cfg_(cfg), aim_(aim), cams_(std::move(cameras)), model_(std::move(model)) {
+  if (cfg_.min_images < (cfg_.hasPrior() ? 1 : 6))
+    throw core::InvalidInput("flight_fit.min_images: expected >= 6 (six unknowns) without a prior, >= 1 with one");
+  if (!cfg_.prior_mean.allFinite() || !cfg_.prior_std.allFinite() || cfg_.prior_std.minCoeff() < 0.0 ||
+      !(std::isfinite(cfg_.aim_prior_std) && cfg_.aim_prior_std >= 0.0))
+    throw core::InvalidInput("flight_fit prior: expected finite means and stds >= 0");
+  if (cfg_.aim_prior_std > 0.0) {
+    if (!(std::abs(aim_.normal.norm() - 1.0) < 1e-9) || !aim_.centre.allFinite())
+      throw core::InvalidInput("FlightFit: the aim plane needs a finite centre and a unit normal");
+    // In-plane orthonormal basis: any vector not along n, made orthogonal to it, and n × it.
+    const Eigen::Vector3d a = std::abs(aim_.normal.z()) < 0.9 ? Eigen::Vector3d::UnitZ() : Eigen::Vector3d::UnitX();
+    E_.col(0) = (a - aim_.normal * aim_.normal.dot(a)).normalized();
+    E_.col(1) = aim_.normal.cross(E_.col(0));
+  }
   if (cfg_.min_cameras < 1) throw core::InvalidInput("flight_fit.min_cameras: expected >= 1");
   if (cfg_.max_iterations < 1) throw core::InvalidInput("flight_fit.max_iterations: expected >= 1");
   model_.q = 0.0;
@@ -99,6 +112,7 @@ bool FlightFit::solve() {
       H += w * J.transpose() * J;
       b += w * J.transpose() * (f.uv - *uv);
     }
+    addPrior(*x_ref_, H, b);
     const Eigen::LDLT<Mat6> ldlt(H);
     if (ldlt.info() != Eigen::Success || !ldlt.isPositive()) return false;
     const Vec6 delta = ldlt.solve(b);
@@ -108,6 +122,46 @@ bool FlightFit::solve() {
     if (delta.head<3>().norm() < 1e-6 && delta.tail<3>().norm() < 1e-5) break;
   }
   return x_ref_->allFinite();
+}
+
+void FlightFit::addPrior(const Vec6& x, Mat6& H, Vec6& b) const {
+  for (int k = 0; k < 6; ++k)
+    if (cfg_.prior_std(k) > 0.0) {
+      const double w = 1.0 / (cfg_.prior_std(k) * cfg_.prior_std(k));
+      H(k, k) += w;
+      b(k) += w * (cfg_.prior_mean(k) - x(k));
+    }
+  if (!(cfg_.aim_prior_std > 0.0)) return;
+  // Crossing of the plane through the aim centre: march in steps until n·(p − c) changes sign,
+  // then Newton on the time (as planning::predictCrossing; here on the fixed-size model).
+  const Eigen::Vector3d& n = aim_.normal;
+  auto side = [&](const Vec6& s) { return n.dot(s.head<3>() - aim_.centre); };
+  if (!(side(x) > 0.0) || !(n.dot(x.tail<3>()) < 0.0)) return;  // not heading for the plane at this iterate
+  const double step = 0.02, horizon = 3.0;
+  double tau = 0.0;
+  Vec6 s = x;
+  while (side(s) > 0.0) {
+    if (tau >= horizon) return;
+    s = model_.propagateFixed(s, step);
+    tau += step;
+  }
+  for (int it = 0; it < 8; ++it) {
+    const double nv = n.dot(s.tail<3>());
+    if (!(nv < 0.0)) return;
+    const double dtau = -side(s) / nv;
+    tau += dtau;
+    if (!(tau > 0.0 && tau < horizon)) return;
+    s = model_.propagateFixed(x, tau);
+    if (std::abs(dtau) < 1e-9) break;
+  }
+  const double nv = n.dot(s.tail<3>());
+  if (!(tau > 0.0) || !(nv < 0.0) || !s.allFinite()) return;
+  // δc = A δp(τ), A = I − v nᵀ / (n·v): the point moves along the flight to stay in the plane.
+  const Eigen::Matrix3d A = Eigen::Matrix3d::Identity() - s.tail<3>() * n.transpose() / nv;
+  const Eigen::Matrix<double, 2, 6> Jc = E_.transpose() * A * model_.jacobianFixed(x, tau).topRows<3>();
+  const double w = 1.0 / (cfg_.aim_prior_std * cfg_.aim_prior_std);
+  H += w * Jc.transpose() * Jc;
+  b += w * Jc.transpose() * (E_.transpose() * (aim_.centre - s.head<3>()));
 }
 
 }  // namespace viewline::scenarios

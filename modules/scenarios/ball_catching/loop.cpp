@@ -13,8 +13,10 @@
 #include "viewline/core/error.h"
 #include "viewline/core/frames.h"
 #include "viewline/core/random.h"
+#include "viewline/estimation/consistency.h"
 #include "viewline/io/log.h"
 #include "viewline/runtime/delay_line.h"
+#include "viewline/scenarios/ball_catching/planner_input.h"
 #include "viewline/scenarios/ball_catching/world.h"
 #include "viewline/tracking/tracker.h"
 #include "viewline/vision/ball_detector.h"
@@ -24,18 +26,6 @@ namespace viewline::scenarios {
 namespace {
 
 using Vector6 = Eigen::Matrix<double, 6, 1>;
-
-// Gravity and drag of the flight as the planner's crossing model has them (one owner: the
-// scenario's plannerConfig()), for the flight fit.
-estimation::DragBallisticModel flightModel(const BallCatchingConfig& cfg) {
-  const planning::CrossingModel m = cfg.plannerConfig().model;
-  estimation::DragBallisticModel d;
-  d.g = m.gravity_w.norm();
-  d.up = -m.gravity_w / d.g;
-  d.k = m.kind == planning::FlightModel::Drag ? m.drag_k : 0.0;
-  d.q = 0.0;
-  return d;
-}
 
 // The tracker's verdict on one submitted image, as a gate decision (tracking::TrackGate's terms).
 tracking::GateDecision decisionOf(const tracking::MeasurementOutcome& o, bool restarted) {
@@ -54,7 +44,7 @@ public:
       : cfg_(cfg), flight_(flight), source_(source), est_cams_(std::move(est_cams)), robot_(robot),
         planner_(cfg.plannerConfig(), robot), tracker_(est_cams_, cfg.tracker), res_(res), hooks_(hooks), tel_(tel),
         noise_rng_(core::makeRng(core::deriveSeed(seed, 0xD37))),  // pixel_noise_px only
-        fit_(cfg.flight_fit, est_cams_, flightModel(cfg)) {
+        planner_input_(cfg, est_cams_) {
     planner_.reset(0.0, cfg.robot.home);
     for (const auto& c : est_cams_) detectors_.emplace_back(cfg.detector, c);
   }
@@ -125,9 +115,20 @@ private:
     if (!det.ok()) return std::nullopt;
     ++res_.detections;
     if (res_.t_first_detection < 0.0) res_.t_first_detection = frame.capture_time;
-    const double sigma_det = std::max(cfg_.sigma_px_floor, std::sqrt(0.5 * det.value().pixel_covariance.trace()));
+    // The detector's std: as measured against the truth (detector.sigma_px), else the blob's own.
+    const double sigma_det = cfg_.sigma_px > 0.0
+                                 ? cfg_.sigma_px
+                                 : std::max(cfg_.sigma_px_floor, std::sqrt(0.5 * det.value().pixel_covariance.trace()));
     const double sigma = std::hypot(sigma_det, cfg_.pixel_noise_px);  // the tracker is told the added noise
     Eigen::Vector2d px = det.value().pixel;
+    // The detector's own error as the tracker sees it: against the estimator camera's image of the
+    // true ball at the stamp (calibration, registration, blur and stamp errors included).
+    if (cfg_.object == "ball" && frame.stamp >= flight_.startTime() && frame.stamp <= flight_.endTime())
+      if (const auto uv_true = est_cams_[ci].project(flight_.state(frame.stamp).p)) {
+        res_.detection_sq_error_px2 += (px - *uv_true).squaredNorm();
+        res_.told_variance_px2 += 2.0 * sigma_det * sigma_det;
+        ++res_.detection_errors;
+      }
     if (cfg_.pixel_noise_px > 0.0)
       px += cfg_.pixel_noise_px * Eigen::Vector2d(core::gaussian(noise_rng_), core::gaussian(noise_rng_));
     const tracking::ImageMeasurement m{next_id_++, ci, frame.stamp, px, sigma};
@@ -138,23 +139,32 @@ private:
     const bool fused = o && o->fate == tracking::Fate::Fused;
     if (fused) ++res_.fused;
     else ++res_.gated;
-    if (fused && tracker_.initialised()) to_planner_.send(frame.stamp + cfg_.processing_latency, planned(m));
+    consistency(m, o, tracker_.trackState().restarts > restarts_before);
+    if (fused && tracker_.initialised())
+      to_planner_.send(frame.stamp + cfg_.processing_latency, planner_input_.after(m, tracker_));
     if (tel_ && o) report(m, *o, tracker_.trackState().restarts > restarts_before);
     return px;
   }
 
-  // The state the planner predicts from after the fused image m: the drag-model fit of the
-  // track's images once it is determined (flight_fit.h), the tracker's estimate before.
-  estimation::StateEstimate planned(const tracking::ImageMeasurement& m) {
-    if (!cfg_.flight_fit.enabled) return tracker_.state();
-    const tracking::TrackState& ts = tracker_.trackState();
-    if (ts.tracks_started != fit_track_ || ts.restarts != fit_restarts_) {  // a new track: a new fit
-      fit_.reset();
-      fit_track_ = ts.tracks_started;
-      fit_restarts_ = ts.restarts;
+  // The tracker's NIS and NEES samples (ThrowResult::nis, ::nees; counted as the tuning adapter does).
+  void consistency(const tracking::ImageMeasurement&, const std::optional<tracking::MeasurementOutcome>& o,
+                   bool restarted) {
+    if (!o) return;
+    const bool fused = o->fate == tracking::Fate::Fused;
+    const bool starts = fused && (o->seed || restarted);
+    if (fused && !starts && in_track_ >= kConsistencyBurnIn && std::isfinite(o->gate.mahalanobis))
+      res_.nis.push_back(o->gate.mahalanobis);
+    if (starts) in_track_ = 0;
+    in_track_ += fused;
+    if (fused && res_.fused == kNeesFusedImage && cfg_.object == "ball" && tracker_.initialised()) {
+      const estimation::StateEstimate& s = tracker_.state();
+      if (s.t() >= flight_.startTime() && s.t() <= flight_.endTime()) {
+        const sim::FlightState f = flight_.state(s.t());
+        Eigen::VectorXd x(6);
+        x << f.p, f.v;
+        res_.nees = estimation::nees(s, x);
+      }
     }
-    const std::optional<estimation::StateEstimate> fitted = fit_.add({m.camera, m.t, m.uv, m.sigma_px}, tracker_.state());
-    return fitted ? *fitted : tracker_.state();
   }
 
   void report(const tracking::ImageMeasurement& m, const tracking::MeasurementOutcome& o, bool restarted) {
@@ -187,8 +197,8 @@ private:
   runtime::DelayLine<estimation::StateEstimate> to_planner_;  // processing latency
   std::optional<Eigen::Vector3d> lead_prediction_;
   std::uint64_t next_id_ = 1;
-  FlightFit fit_;
-  int fit_track_ = -1, fit_restarts_ = -1;  ///< the tracker's track the fit belongs to
+  PlannerInput planner_input_;  // the fit of the track's images (planner_input.h)
+  int in_track_ = 0;  ///< fused images of the current track (consistency burn-in)
 };
 
 }  // namespace

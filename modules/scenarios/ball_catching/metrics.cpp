@@ -8,6 +8,7 @@
 
 #include "viewline/core/error.h"
 #include "viewline/core/statistics.h"
+#include "viewline/estimation/consistency.h"
 #include "viewline/planning/catch_planner.h"
 
 namespace viewline::scenarios {
@@ -68,7 +69,9 @@ CatchSummary summarise(std::vector<ThrowResult> results, std::uint64_t seed,
   for (const char* r : kMissReasons) s.miss_reasons[r] = 0;
   if (s.results.empty()) return s;
   std::vector<double> pred_lead, pred_err, decision, miss_reach, speeds, elev, flight, give_up_lead;
-  double frame_time = 0.0;
+  double frame_time = 0.0, det_sq = 0.0, told_sq = 0.0;
+  int det_axes = 0;
+  estimation::ConsistencyStats nis, nees;
   for (const ThrowResult& r : s.results) {
     s.reachable_throws += r.reachable;
     s.caught += r.caught;
@@ -89,6 +92,11 @@ CatchSummary summarise(std::vector<ThrowResult> results, std::uint64_t seed,
     s.max_acceleration = std::max(s.max_acceleration, r.max_acceleration);
     s.frames += r.frames;
     s.detections += r.detections;
+    det_sq += r.detection_sq_error_px2;
+    told_sq += r.told_variance_px2;
+    det_axes += 2 * r.detection_errors;
+    for (double v : r.nis) nis.add(v, 2.0);
+    if (r.nees >= 0.0) nees.add(r.nees, 6.0);
     speeds.push_back(r.launch_speed);
     elev.push_back(r.launch_elevation_deg);
     flight.push_back(r.t_cross);
@@ -110,6 +118,24 @@ CatchSummary summarise(std::vector<ThrowResult> results, std::uint64_t seed,
   s.miss_distance_mm_median_reachable = percentile(miss_reach, 0.5);
   s.give_up_lead_s_median = percentile(give_up_lead, 0.5);
   s.detection_rate = s.frames > 0 ? static_cast<double>(s.detections) / s.frames : 0.0;
+  s.detection_error_px_rms = det_axes > 0 ? std::sqrt(det_sq / det_axes) : 0.0;
+  s.told_sigma_px_rms = det_axes > 0 ? std::sqrt(told_sq / det_axes) : 0.0;
+  // Samples counted as independent (one NEES per throw; NIS of successive images of a track are
+  // nearly so for a filter whose innovations are white, which is what the test is about).
+  s.nis_mean = nis.mean();
+  s.nis_samples = static_cast<int>(nis.count());
+  s.nees_mean = nees.mean();
+  s.nees_samples = static_cast<int>(nees.count());
+  if (nis.count() > 0) {
+    const core::Interval b = nis.bounds(0.99);
+    s.nis_band_lo = b.lo;
+    s.nis_band_hi = b.hi;
+  }
+  if (nees.count() > 0) {
+    const core::Interval b = nees.bounds(0.99);
+    s.nees_band_lo = b.lo;
+    s.nees_band_hi = b.hi;
+  }
   s.launch_speed_min = *std::min_element(speeds.begin(), speeds.end());
   s.launch_speed_max = *std::max_element(speeds.begin(), speeds.end());
   s.launch_speed_mean = 0.0;
@@ -166,6 +192,12 @@ nlohmann::json summaryJson(const CatchSummary& s, const BallCatchingConfig& cfg)
   j["drag_k_per_m"] = cfg.throws.body.dragPerMass();
   j["frames"] = s.frames;
   j["detection_rate"] = s.detection_rate;
+  j["detection_error_px_rms"] = s.detection_error_px_rms;
+  j["told_sigma_px_rms"] = s.told_sigma_px_rms;
+  j["tracker_consistency"] = {{"nis_mean", s.nis_mean}, {"nis_samples", s.nis_samples},
+                              {"nis_band_99", {s.nis_band_lo, s.nis_band_hi}},
+                              {"nees_mean", s.nees_mean}, {"nees_samples", s.nees_samples},
+                              {"nees_band_99", {s.nees_band_lo, s.nees_band_hi}}};
   j["throw_distribution"] = {{"launch_speed_mps", {{"min", s.launch_speed_min}, {"mean", s.launch_speed_mean},
                                                    {"max", s.launch_speed_max}}},
                              {"elevation_deg", {{"min", s.elevation_deg_min}, {"max", s.elevation_deg_max}}},

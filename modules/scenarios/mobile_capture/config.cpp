@@ -70,6 +70,8 @@ void MobileCaptureConfig::validate() const {
   detector.validate();
   core::requirePositive(pixel_sigma, "pixel_sigma");
   core::requirePositive(floor_sigma, "floor_sigma");
+  core::requireNonNegative(calibration_angle_sigma, "calibration_angle_sigma_deg");
+  core::requireNonNegative(calibration_height_sigma, "calibration_height_sigma");
   core::requirePositive(object_height, "object_height");
   filter.validate("filter");
   core::requireNonNegative(max_accel_v, "max_accel_v");
@@ -195,6 +197,8 @@ MobileCaptureConfig loadMobileCaptureConfig(const io::ConfigNode& root) {
     readOpt(d, "roi_half_size_px", c.detector.roi_half_size_px);
     readOpt(d, "pixel_sigma", c.pixel_sigma);
     readOpt(d, "floor_sigma", c.floor_sigma);
+    readAngle(d, "calibration_angle_sigma_deg", c.calibration_angle_sigma);
+    readOpt(d, "calibration_height_sigma", c.calibration_height_sigma);
     readOpt(d, "object_height", c.object_height);
   }
   if (root.has("filter")) {

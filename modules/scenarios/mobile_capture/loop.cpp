@@ -1,5 +1,6 @@
 #include "viewline/scenarios/mobile_capture/loop.h"
 
+#include <Eigen/Cholesky>
 #include <cmath>
 #include <optional>
 
@@ -116,6 +117,8 @@ MobileCaptureRun runMobileCapture(const MobileCaptureConfig& cfg, std::uint64_t 
   const control::SearchPattern search(cfg.search);
   runtime::TelemetrySink* sink = hooks ? hooks->telemetry : nullptr;
 
+  Eigen::Matrix2d bias_cov = Eigen::Matrix2d::Zero();  // m², B of the last detection (floorMeasurement)
+  double track_since = -1.0, next_nees = -1.0;  // s: start of the live track; time of the next NEES sample
   double last_seen = -1.0, first_seen = -1.0, sweep_start = -1.0, last_grasp = -1e9;
   double centre_bearing = 0.0;  // robot frame, for the search
   bool have_bearing = false;
@@ -160,15 +163,20 @@ MobileCaptureRun runMobileCapture(const MobileCaptureConfig& cfg, std::uint64_t 
     }
     const auto det = detector.detect(frame.image, t, predicted_px);
     bool detected = false, fused = false;
+    std::optional<FloorMeasurement> measurement;
     double nis = std::numeric_limits<double>::quiet_NaN();
     Vector2d pixel = Vector2d::Zero();
     if (det.ok()) {
       pixel = det.value().blob_center;
       if (sink) sink->measurement({channel::kPixel, t, frame.sequence, pixel, vec({cfg.pixel_sigma, cfg.pixel_sigma})});
-      const auto exact = robots::groundPointExact(camera, pixel, plane_z);
-      const auto cov = robots::groundPointCovariance(
-          camera, pixel, cfg.pixel_sigma * cfg.pixel_sigma * Eigen::Matrix2d::Identity(), plane_z);
-      if (exact && cov) {
+      // The floor point and its noise: white pixel noise through the range-dependent
+      // ground-projection Jacobian goes into R; the calibration and centroid bias does not (the
+      // innovations cannot see a bias that barely changes between frames, so in R it would only
+      // shrink the NIS): the track estimates the apparent position s = p + b, and the object's
+      // covariance is P_s + B (floorMeasurement(), world.h).
+      const auto fm = floorMeasurement(cfg, camera, pixel, plane_z);
+      const std::optional<Vector2d> exact = fm ? std::optional<Vector2d>(fm->z) : std::nullopt;
+      if (fm) {
         detected = true;
         ++run.detections;
         if (last_seen >= 0.0) run.longest_lost = std::max(run.longest_lost, t - last_seen);
@@ -182,10 +190,17 @@ MobileCaptureRun runMobileCapture(const MobileCaptureConfig& cfg, std::uint64_t 
           run.localization.sse_horizontal += (*h - obj).squaredNorm();
           ++run.localization.count;
         }
-        const Eigen::Matrix2d R = *cov + cfg.floor_sigma * cfg.floor_sigma * Eigen::Matrix2d::Identity();
+        const Eigen::Matrix2d R = cfg.pixel_sigma * cfg.pixel_sigma * fm->unit_pixel_cov;
+        bias_cov = fm->bias_cov;
+        measurement = *fm;
+        const bool settled = track.valid() && t - track_since >= kConsistencySettle;
         const tracking::UnicycleUpdate u = track.update(t, *exact, R);
         fused = u.fused;
         nis = u.report.nis;
+        if (settled && std::isfinite(nis)) {
+          run.nis_sum += nis;
+          ++run.nis_count;
+        }
         if (sink) {
           const double nan = std::numeric_limits<double>::quiet_NaN();
           sink->measurement({channel::kFloor, t, frame.sequence, *exact, R.diagonal().cwiseSqrt()});
@@ -200,6 +215,18 @@ MobileCaptureRun runMobileCapture(const MobileCaptureConfig& cfg, std::uint64_t 
       }
     }
     track.predictTo(t);
+    if (!track.valid()) {
+      track_since = -1.0;
+    } else if (track_since < 0.0) {
+      track_since = t;
+    } else if (t - track_since >= kConsistencySettle && t >= next_nees) {
+      Eigen::Matrix2d P = track.state().P().topLeftCorner<2, 2>();
+      P += bias_cov;
+      const Vector2d e = track.state().x().head<2>() - obj;
+      run.nees_sum += e.dot(P.ldlt().solve(e));
+      ++run.nees_count;
+      next_nees = t + kNeesSpacing;
+    }
     if (track.valid()) {
       prediction = predictPath(track, cfg);
       plan = planning::planCapture(prediction, {{pose.x, pose.y}, pose.theta}, cfg.plannerParams());
@@ -210,7 +237,14 @@ MobileCaptureRun runMobileCapture(const MobileCaptureConfig& cfg, std::uint64_t 
     if (sink) {
       sink->estimate({channel::kTruthObject, t, vec({truth.x, truth.y, truth.theta, truth.v, truth.omega}), {}});
       sink->estimate({channel::kTruthRobot, t, vec({pose.x, pose.y, pose.theta, robot.q.tilt, robot.q.pan}), {}});
-      if (track.valid()) sink->estimate({channel::kObject, t, track.state().x(), track.state().P()});
+      if (track.valid()) {
+        // The object p = s − b: the bias b (independent of the track's error, never observed by it)
+        // adds its covariance to the position block (Schmidt's consider covariance of an
+        // unobservable bias state, zero gain).
+        Eigen::MatrixXd P = track.state().P();
+        P.topLeftCorner<2, 2>() += bias_cov;
+        sink->estimate({channel::kObject, t, track.state().x(), P});
+      }
       sink->command({channel::kPlan, t,
                      vec({plan.reachable ? 1.0 : 0.0, static_cast<double>(plan.steps), plan.point.x(), plan.point.y(),
                           static_cast<double>(static_cast<int>(mode))})});
@@ -225,6 +259,8 @@ MobileCaptureRun runMobileCapture(const MobileCaptureConfig& cfg, std::uint64_t 
       f.joints = robot.q;
       f.object_true = obj;
       f.fused = fused;
+      f.measurement = measurement;
+      f.bias_cov = bias_cov;
       f.nis = nis;
       f.estimate_valid = track.valid();
       if (track.valid()) f.estimate = track.state().x();

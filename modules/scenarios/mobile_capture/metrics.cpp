@@ -7,6 +7,7 @@
 #include <cmath>
 #include <mutex>
 #include <nlohmann/json.hpp>
+#include <string>
 #include <thread>
 
 #include "viewline/core/error.h"
@@ -233,6 +234,26 @@ MobileCaptureSummary runMobileCaptureBatch(const MobileCaptureConfig& cfg, int r
 namespace {
 // An empty accumulator prints 0 (as it always has), not core::rmsFromSum's NaN (JSON null).
 double rms(double sse, long n) { return n > 0 ? core::rmsFromSum(sse, n) : 0.0; }
+/// Mean of `sum` over `n` samples of `dof` degrees of freedom with its two-sided 99 % chi-square
+/// band (samples counted as independent) and the verdict.
+nlohmann::json bandJson(double sum, long n, double dof) {
+  if (n <= 0) return {{"mean", nullptr}, {"bounds", nullptr}, {"samples", 0}, {"dof", dof}, {"verdict", "n/a"}};
+  const double mean = sum / static_cast<double>(n);
+  const core::Interval b = core::averagedChiSquareInterval(dof, static_cast<double>(n), 0.99);
+  const char* verdict = mean > b.hi ? "overconfident" : mean < b.lo ? "underconfident" : "consistent";
+  return {{"mean", mean}, {"bounds", {b.lo, b.hi}}, {"samples", n}, {"dof", dof}, {"verdict", verdict}};
+}
+/// NIS and position NEES pooled over the runs (MobileCaptureRun).
+nlohmann::json consistencyJson(const MobileCaptureSummary& s) {
+  double nis = 0.0, nees = 0.0;
+  long n_nis = 0, n_nees = 0;
+  for (const auto& r : s.runs) nis += r.nis_sum, n_nis += r.nis_count, nees += r.nees_sum, n_nees += r.nees_count;
+  return {{"nis", bandJson(nis, n_nis, 2.0)},
+          {"position_nees", bandJson(nees, n_nees, 2.0)},
+          {"settle_s", kConsistencySettle},
+          {"nees_spacing_s", kNeesSpacing},
+          {"confidence", 0.99}};
+}
 nlohmann::json locJson(const LocalizationErrors& e) {
   return {{"exact_m", rms(e.sse_exact, e.count)},
           {"angle_per_pixel_printed_m", rms(e.sse_printed, e.count)},
@@ -284,6 +305,7 @@ std::string summaryJson(const MobileCaptureSummary& s, const MobileCaptureConfig
     j["ground_localization_fov_sweep"] = nullptr;
     j["filter_test"] = nullptr;
   }
+  j["consistency"] = consistencyJson(s);
   j["rig"] = cfg.rig ? nlohmann::json(cfg.rig->folder) : nlohmann::json(nullptr);
   j["wall_time_s"] = s.wall_time;
   return j.dump(indent);
@@ -334,6 +356,16 @@ std::string summaryText(const MobileCaptureSummary& s, const MobileCaptureConfig
     std::snprintf(line, sizeof line, "  capture time / oracle: not scored (no run where both captured)\n");
   }
   out += line;
+  const nlohmann::json c = consistencyJson(s);
+  for (const char* k : {"nis", "position_nees"}) {
+    const nlohmann::json& x = c[k];
+    if (x["samples"].get<long>() == 0) continue;
+    std::snprintf(line, sizeof line, "  %s %.3f in its 99 %% band [%.3f, %.3f] (%ld samples, 2 dof): %s\n",
+                  k == std::string("nis") ? "NIS" : "position NEES", x["mean"].get<double>(),
+                  x["bounds"][0].get<double>(), x["bounds"][1].get<double>(), x["samples"].get<long>(),
+                  x["verdict"].get<std::string>().c_str());
+    out += line;
+  }
   const LocalizationErrors& l = s.localization;
   std::snprintf(line, sizeof line,
                 "  ground localisation RMS in the loop: exact %.3f m, [K] angle/pixel printed %.3f m, "

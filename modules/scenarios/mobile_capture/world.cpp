@@ -178,4 +178,53 @@ std::vector<Vector2d> truePath(const sim::GroundTarget& target, double t, double
   return out;
 }
 
+std::optional<FloorMeasurement> floorMeasurement(const MobileCaptureConfig& cfg, const core::Camera& camera,
+                                                 const Vector2d& uv, double plane_z) {
+  // The exact back-projection of a pixel from a camera centre c along the world ray r, with the
+  // ray turned by a small rotation `rot` (world axes, through c) and c raised by dh.
+  const Vector3d c0 = camera.center_w();
+  const Vector3d r0 = camera.rayThroughPixel_w(uv);
+  auto project = [&](const Vector3d& r, double dh) -> std::optional<Vector2d> {
+    const Vector3d c = c0 + Vector3d(0.0, 0.0, dh);
+    if (!(r.z() < -1e-9) || !(c.z() > plane_z)) return std::nullopt;
+    return (c + (plane_z - c.z()) / r.z() * r).head<2>().eval();
+  };
+  FloorMeasurement m;
+  const auto z = project(r0, 0.0);
+  if (!z) return std::nullopt;
+  m.z = *z;
+  // White part: J = ∂z/∂(u, v), central differences over ±0.5 px.
+  Eigen::Matrix2d J;
+  for (int i = 0; i < 2; ++i) {
+    Vector2d d = Vector2d::Zero();
+    d[i] = 0.5;
+    const auto a = project(camera.rayThroughPixel_w(uv + d), 0.0), b = project(camera.rayThroughPixel_w(uv - d), 0.0);
+    if (!a || !b) return std::nullopt;
+    J.col(i) = *a - *b;
+  }
+  m.unit_pixel_cov = J * J.transpose();
+  // Bias part: ∂z/∂(rotation about world x, y, z) and ∂z/∂h, central differences over ±1 mrad and
+  // ±1 mm (the ground projection is smooth there; its curvature at grazing rays is the reason
+  // not to use the σ itself as the step).
+  m.bias_cov = cfg.floor_sigma * cfg.floor_sigma * Eigen::Matrix2d::Identity();
+  constexpr double kAngle = 1e-3, kHeight = 1e-3;
+  const double sa2 = cfg.calibration_angle_sigma * cfg.calibration_angle_sigma;
+  const double sh2 = cfg.calibration_height_sigma * cfg.calibration_height_sigma;
+  for (int axis = 0; axis < 3 && sa2 > 0.0; ++axis) {
+    const Eigen::Matrix3d Rp(Eigen::AngleAxisd(kAngle, Vector3d::Unit(axis)));
+    const Eigen::Matrix3d Rm(Eigen::AngleAxisd(-kAngle, Vector3d::Unit(axis)));
+    const auto a = project(Rp * r0, 0.0), b = project(Rm * r0, 0.0);
+    if (!a || !b) return std::nullopt;
+    const Vector2d Jk = (*a - *b) / (2.0 * kAngle);
+    m.bias_cov += sa2 * Jk * Jk.transpose();
+  }
+  if (sh2 > 0.0) {
+    const auto a = project(r0, kHeight), b = project(r0, -kHeight);
+    if (!a || !b) return std::nullopt;
+    const Vector2d Jh = (*a - *b) / (2.0 * kHeight);
+    m.bias_cov += sh2 * Jh * Jh.transpose();
+  }
+  return m;
+}
+
 }  // namespace viewline::scenarios::mobile_capture

@@ -6,6 +6,7 @@ list(APPEND scenarios_sources
   ball_catching/flight_fit.cpp
   ball_catching/loop.cpp
   ball_catching/metrics.cpp
+  ball_catching/planner_input.cpp
   ball_catching/registration.cpp
   ball_catching/world.cpp)
 list(APPEND scenarios_tests test/summary_text_test.cpp test/flight_fit_test.cpp)

@@ -59,6 +59,9 @@ void TableBallConfig::validate() const {
   core::requireNonNegative(warmup, "metrics.warmup");
   core::requirePositive(min_step, "metrics.min_step");
   core::requirePositive(settle_fraction, "metrics.settle_fraction");
+  core::requireNonNegative(settle_min_band, "metrics.settle_min_band");
+  core::requireNonNegative(nis_spacing, "metrics.nis_spacing");
+  core::requirePositive(nees_spacing, "metrics.nees_spacing");
   core::requirePositive(steady_window, "metrics.steady_window");
   core::requirePositive(push_band, "metrics.push_band");
   if (setpoints.empty()) throw core::InvalidInput("events.setpoints: expected at least one (at t = 0)");
@@ -146,10 +149,10 @@ void readObserver(const io::ConfigNode& n, TableBallConfig& c) {
   c.observer.table_pose = n.getChoiceOr("table_pose", {"corners", "apriltag"}, "corners") == "apriltag"
                               ? TablePoseSource::AprilTag
                               : TablePoseSource::Corners;
-  c.observer.ball_geometry =
-      n.getChoiceOr("ball_geometry", {"known_radius", "unknown_radius"}, "known_radius") == "unknown_radius"
-          ? BallGeometry::UnknownRadius
-          : BallGeometry::KnownRadius;
+  const std::string geometry = n.getChoiceOr("ball_geometry", {"table_plane", "known_radius", "unknown_radius"}, "table_plane");
+  c.observer.ball_geometry = geometry == "known_radius"     ? BallGeometry::KnownRadius
+                             : geometry == "unknown_radius" ? BallGeometry::UnknownRadius
+                                                            : BallGeometry::TablePlane;
   auto& m = c.observer.tracker.model;
   m.sigma_w = n.getOr<double>("sigma_w", m.sigma_w);
   m.sigma_v = n.getOr<double>("sigma_v", m.sigma_v);
@@ -157,6 +160,10 @@ void readObserver(const io::ConfigNode& n, TableBallConfig& c) {
   m.prediction_steps = n.getOr<int>("prediction_steps", m.prediction_steps);
   c.observer.tracker.stationary_gain = n.getOr<bool>("stationary_gain", c.observer.tracker.stationary_gain);
   c.observer.tracker.initial_velocity_std = n.getOr<double>("initial_velocity_std", c.observer.tracker.initial_velocity_std);
+  c.observer.tracker.impulse_nis = n.getOr<double>("impulse_nis", c.observer.tracker.impulse_nis);
+  c.observer.tracker.impulse_std = n.getOr<double>("impulse_std", c.observer.tracker.impulse_std);
+  c.observer.tracker.coloured_sigma = n.getOr<double>("coloured_sigma", c.observer.tracker.coloured_sigma);
+  c.observer.tracker.coloured_correlation = n.getOr<double>("coloured_correlation", c.observer.tracker.coloured_correlation);
   auto& gate = c.observer.tracker.gate;
   gate.probability = n.getOr<double>("gate_probability", gate.probability);
   gate.restart_after = n.getOr<int>("restart_after", gate.restart_after);
@@ -226,6 +233,9 @@ TableBallConfig tableBallConfigFromYaml(const io::ConfigNode& root) {
     c.warmup = n.getOr<double>("warmup", c.warmup);
     c.min_step = n.getOr<double>("min_step", c.min_step);
     c.settle_fraction = n.getOr<double>("settle_fraction", c.settle_fraction);
+    c.settle_min_band = n.getOr<double>("settle_min_band", c.settle_min_band);
+    c.nis_spacing = n.getOr<double>("nis_spacing", c.nis_spacing);
+    c.nees_spacing = n.getOr<double>("nees_spacing", c.nees_spacing);
     c.steady_window = n.getOr<double>("steady_window", c.steady_window);
     c.push_band = n.getOr<double>("push_band", c.push_band);
     c.compare_tunings = n.getOr<bool>("compare_tunings", c.compare_tunings);

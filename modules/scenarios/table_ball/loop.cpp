@@ -77,10 +77,15 @@ SideFilters makeSideFilters(const TableBallConfig& cfg, const tracking::RollingB
   a.model.sigma_w = 1.0;
   a.model.sigma_v = 0.005;
   a.stationary_gain = false;
+  a.impulse_nis = 0.0;  // [M]'s filters: no push model, white measurement noise
+  a.coloured_sigma = 0.0;
   b.model.sigma_w = 1.0;
   b.model.sigma_v = 1.0;
   b.stationary_gain = false;
+  b.impulse_nis = 0.0;
+  b.coloured_sigma = 0.0;
   st.stationary_gain = true;
+  st.coloured_sigma = 0.0;  // the DARE gain of the white-noise model
   side.emplace_back("M_best", tracking::RollingBallTracker(a));
   side.emplace_back("M_lag", tracking::RollingBallTracker(b));
   side.emplace_back("stationary", tracking::RollingBallTracker(st));

@@ -44,6 +44,18 @@ Eigen::Isometry3d borderAwareTablePose(const core::Camera& camera, const std::ar
   return pose;
 }
 
+std::optional<Eigen::Vector3d> ballOnTablePlane(const core::Camera& camera, const vision::Circle& circle,
+                                                const Eigen::Isometry3d& c_M_t, double ball_radius) {
+  const vision::BallOnTableGeometry cone = vision::ballViewingCone(camera, circle);
+  const Eigen::Matrix3d R = c_M_t.linear();
+  const Eigen::Vector3d t_prime = -R.transpose() * c_M_t.translation();  // camera centre, table frame
+  const Eigen::Vector3d v1 = R.transpose() * cone.ray_c;                   // cone axis, table frame
+  if (!(std::abs(v1.z()) > 1e-6)) return std::nullopt;
+  const double s = (ball_radius - t_prime.z()) / v1.z();  // (t' + s v1)_z = r
+  if (!(s > 0.0) || !std::isfinite(s)) return std::nullopt;
+  return Eigen::Vector3d(t_prime + s * v1);
+}
+
 // -------------------------------------------------------------------------------------------
 
 TableBallObserver::TableBallObserver(const core::Camera& camera, const TableBallObserverConfig& config)
@@ -135,6 +147,8 @@ const ObserverFrame& TableBallObserver::process(const cv::Mat& bgr, double t, co
   if (have_table_ && circle) {
     if (config_.ball_geometry == BallGeometry::KnownRadius) {
       y = vision::ballOnTableKnownRadius(camera_, *circle, c_M_t_, model.ball_radius).p_t.head<2>();
+    } else if (config_.ball_geometry == BallGeometry::TablePlane) {
+      if (const auto p = ballOnTablePlane(camera_, *circle, c_M_t_, model.ball_radius)) y = p->head<2>();
     } else if (const auto g = vision::ballOnTableUnknownRadius(camera_, *circle, c_M_t_)) {
       y = g->p_t.head<2>();
     }

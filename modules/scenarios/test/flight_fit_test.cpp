@@ -125,3 +125,82 @@ TEST(FlightFit, OneCameraIsNotUsedAndANewTrackStartsOver) {
   bad.min_images = 5;
   EXPECT_THROW(scenarios::FlightFit(bad, cams, ballModel()), core::InvalidInput);
 }
+
+namespace {
+
+// The prior of the test throw's envelope: the state at the first image and the aim disc around
+// the point where throwFlight's throw crosses x = 4 m (its "home").
+scenarios::FlightFitConfig priorConfig() {
+  scenarios::FlightFitConfig c;
+  c.min_images = 1;
+  c.min_cameras = 1;
+  c.prior_mean << 0.05, 0.0, 1.32, 7.6, 0.0, 2.3;
+  c.prior_std << 0.6, 0.18, 0.18, 1.0, 0.7, 1.0;
+  c.aim_prior_std = 0.15;
+  return c;
+}
+
+// In-plane crossing of the box plane x = 4 m by the drag flight from state x.
+Eigen::Vector2d crossingYZ(const Vec6& x) {
+  const estimation::DragBallisticModel m = ballModel();
+  Vec6 s = x;
+  while (s(0) < 4.0) s = m.propagateFixed(s, 0.001);
+  return s.segment<2>(1);
+}
+
+}  // namespace
+
+// With the throws' prior the fit answers from the first image on (no six-image wait), and a
+// handful of noisy images already pull the crossing from the prior's guess (the aim centre)
+// to within a few centimetres; with many exact images the prior's pull is gone.
+TEST(FlightFit, ThrowPriorGivesACrossingFromTheFirstImage) {
+  const auto cams = twoCameras();
+  const scenarios::FitAimPlane aim{Eigen::Vector3d(4.0, 0.0, 1.1), Eigen::Vector3d(-1.0, 0.0, 0.0)};
+  core::Rng rng = core::makeRng(4);
+  const Flight exact = throwFlight(cams, 0.0, rng);
+  const Eigen::Vector2d truth = crossingYZ(exact.truth.front());
+  ASSERT_GT((truth - Eigen::Vector2d(0.0, 1.1)).norm(), 0.05) << "the throw must not aim at the prior's centre";
+  {
+    scenarios::FlightFit fit(priorConfig(), cams, ballModel(), aim);
+    const auto first = fit.add(exact.images[0], roughGuess(exact.truth[0], exact.images[0].t));
+    ASSERT_TRUE(first.has_value()) << "the prior determines the state from the first image";
+    std::optional<estimation::StateEstimate> est;
+    for (std::size_t i = 1; i < exact.images.size(); ++i)
+      est = fit.add(exact.images[i], roughGuess(exact.truth[i], exact.images[i].t));
+    ASSERT_TRUE(est.has_value());
+    EXPECT_LT((est->x().head<3>() - exact.truth.back().head<3>()).norm(), 1e-3);  // 45 exact images outweigh it
+  }
+  // Eight images with 0.3 px noise (80 ms): the crossing has moved most of the way from the prior's
+  // guess (0.26 m off) to the truth, and the truth is within the fit's own 3 σ.
+  double err = 0.0;
+  int inside = 0;
+  const int trials = 20;
+  for (int k = 0; k < trials; ++k) {
+    const Flight f = throwFlight(cams, 0.3, rng);
+    scenarios::FlightFit fit(priorConfig(), cams, ballModel(), aim);
+    std::optional<estimation::StateEstimate> est;
+    for (std::size_t i = 0; i < 8; ++i) est = fit.add(f.images[i], roughGuess(f.truth[i], f.images[i].t));
+    ASSERT_TRUE(est.has_value());
+    const Eigen::Vector2d c = crossingYZ(est->x());
+    err += (c - truth).norm() / trials;
+    // Crossing-point spread from the estimate's covariance (sampled: the fit's own belief).
+    core::Rng s_rng = core::makeRng(100 + static_cast<std::uint64_t>(k));
+    const Eigen::LLT<Eigen::Matrix<double, 6, 6>> L(est->P());
+    Eigen::Vector2d mean = Eigen::Vector2d::Zero(), sq = Eigen::Vector2d::Zero();
+    const int draws = 30;
+    for (int j = 0; j < draws; ++j) {
+      Vec6 z;
+      for (int i = 0; i < 6; ++i) z(i) = core::gaussian(s_rng);
+      const Eigen::Vector2d cj = crossingYZ(est->x() + L.matrixL() * z);
+      mean += cj / draws;
+      sq += cj.cwiseProduct(cj) / draws;
+    }
+    const Eigen::Vector2d sd = (sq - mean.cwiseProduct(mean)).cwiseMax(0.0).cwiseSqrt();
+    inside += std::abs(c(0) - truth(0)) <= 3.0 * sd(0) + 1e-3 && std::abs(c(1) - truth(1)) <= 3.0 * sd(1) + 1e-3;
+  }
+  EXPECT_LT(err, 0.2 * (truth - Eigen::Vector2d(0.0, 1.1)).norm());
+  EXPECT_GE(inside, trials - 2);
+  scenarios::FlightFitConfig bad = priorConfig();
+  bad.prior_std(2) = -1.0;
+  EXPECT_THROW(scenarios::FlightFit(bad, cams, ballModel(), aim), core::InvalidInput);
+}

@@ -68,6 +68,42 @@ TEST(TableBallObserver, BorderAwarePnpRemovesTheOcclusionBias) {
   EXPECT_LT((fixed.translation() - c_M_t.translation()).norm(), 1e-4);
 }
 
+// The table-plane depth uses the cone's axis only: for the exact image of a ball resting on a
+// tilted table it returns the ball, and an edge found 0.05 px inside the limb all round (what
+// shading and blur do to the detected outline) leaves it within 0.01 mm, while the known-radius depth
+// d = r / sin α moves by millimetres along the viewing ray.
+TEST(TableBallObserver, TablePlaneDepthIgnoresTheCircleSizeBias) {
+  const core::Camera cam = headCamera();
+  const double r = 0.025;
+  Eigen::Isometry3d w_M_t = Eigen::Isometry3d::Identity();
+  w_M_t.linear() = core::rotation(Eigen::Vector3d::UnitX(), 0.08) * core::rotation(Eigen::Vector3d::UnitY(), -0.05);
+  const Eigen::Isometry3d c_M_t = cam.c_M_w * w_M_t;
+  const Eigen::Vector2d ball(0.06, -0.04);  // on the table, m
+  const Eigen::Vector3d pc = c_M_t * Eigen::Vector3d(ball.x(), ball.y(), r);
+  // The sphere's outline: the two tangent rays in the plane of the optical axis and the centre
+  // ray project to the ends of the outline's radial diameter.
+  const Eigen::Vector3d u = pc.normalized();
+  const Eigen::Vector3d n = Eigen::Vector3d::UnitZ().cross(u).normalized();
+  const double alpha = std::asin(r / pc.norm());
+  auto project = [&](double angle) {
+    const Eigen::Vector3d ray = Eigen::AngleAxisd(angle, n) * u;
+    return cam.normalizedToPixel(ray.head<2>() / ray.z());
+  };
+  const Eigen::Vector2d a = project(alpha), b = project(-alpha);
+  vision::Circle circle{0.5 * (a + b), 0.5 * (a - b).norm()};
+  const auto exact = scenarios::ballOnTablePlane(cam, circle, c_M_t, r);
+  ASSERT_TRUE(exact.has_value());
+  EXPECT_LT((exact->head<2>() - ball).norm(), 1e-9);
+  EXPECT_NEAR(exact->z(), r, 1e-12);
+  const double known_exact = (vision::ballOnTableKnownRadius(cam, circle, c_M_t, r).p_t.head<2>() - ball).norm();
+  EXPECT_LT(known_exact, 1e-6);
+  circle.radius -= 0.05;  // the edge a little inside the limb
+  const auto plane = scenarios::ballOnTablePlane(cam, circle, c_M_t, r);
+  ASSERT_TRUE(plane.has_value());
+  EXPECT_LT((plane->head<2>() - ball).norm(), 1e-5);  // 2 µm: the pixel-symmetric shrink is not angle-symmetric
+  EXPECT_GT((vision::ballOnTableKnownRadius(cam, circle, c_M_t, r).p_t.head<2>() - ball).norm(), 0.001);
+}
+
 // The AprilTag table pose. A tagged table rendered at a known tilt must come back at
 // that pose. The layout has to be in vpDetectorAprilTag's tag frame (z out of the tag); with the
 // simulator's tag frame (z into the table) every tag's corners are mirrored and the pose came out

@@ -2,6 +2,7 @@
 
 #include <Eigen/Cholesky>
 #include <algorithm>
+#include <cmath>
 #include <limits>
 
 #include "viewline/core/checks.h"
@@ -13,6 +14,13 @@ void RollingBallTrackerConfig::validate() const {
   model.validate();
   core::requirePositive(nominal_period, "RollingBallTrackerConfig.nominal_period");
   core::requirePositive(initial_velocity_std, "RollingBallTrackerConfig.initial_velocity_std");
+  core::requireNonNegative(impulse_nis, "RollingBallTrackerConfig.impulse_nis");
+  core::requirePositive(impulse_std, "RollingBallTrackerConfig.impulse_std");
+  core::requireNonNegative(coloured_sigma, "RollingBallTrackerConfig.coloured_sigma");
+  if (!(coloured_correlation >= 0.0 && coloured_correlation < 1.0))
+    throw core::InvalidInput("RollingBallTrackerConfig.coloured_correlation: expected in [0, 1)");
+  if (coloured_sigma > 0.0 && stationary_gain)
+    throw core::InvalidInput("RollingBallTrackerConfig.coloured_sigma: not with the stationary gain");
   gate.validate("RollingBallTrackerConfig.gate");
 }
 
@@ -23,7 +31,7 @@ RollingBallTracker::RollingBallTracker(const RollingBallTrackerConfig& config)
 
 Eigen::MatrixXd RollingBallTracker::P() const {
   if (stationary_) return stationary_->Pf;
-  return initialized_ ? state_.P() : Eigen::MatrixXd::Zero(6, 6);
+  return initialized_ ? Eigen::MatrixXd(state_.P().topLeftCorner(6, 6)) : Eigen::MatrixXd::Zero(6, 6);
 }
 
 void RollingBallTracker::start(double t, const Eigen::Vector2d& a_xy, const Eigen::Vector2d& y, GateDecision why) {
@@ -34,9 +42,18 @@ void RollingBallTracker::start(double t, const Eigen::Vector2d& a_xy, const Eige
   model.clamp(x_);
   const double sv = model.sigma_v, sp = config_.initial_velocity_std;
   const double sw = std::max(model.sigma_w, 1e-3);
-  Eigen::VectorXd d(6);
-  d << sv * sv, sp * sp, sv * sv, sp * sp, sw * sw, sw * sw;
-  state_ = estimation::StateEstimate(x_, d.asDiagonal(), t);
+  const double se = config_.coloured_sigma;
+  Eigen::VectorXd d(stateDim());
+  d.head(6) << sv * sv + se * se, sp * sp, sv * sv + se * se, sp * sp, sw * sw, sw * sw;
+  if (stateDim() > 6) d.tail(2).setConstant(se * se);  // the first measurement's coloured error
+  Eigen::VectorXd xa = Eigen::VectorXd::Zero(stateDim());
+  xa.head(6) = x_;
+  Eigen::MatrixXd P0 = d.asDiagonal();
+  if (stateDim() > 6) {
+    // p̂ = y = p + e + v and ê = 0: the two errors are e + v and −e, covariance −σe².
+    for (int i : {0, 1}) P0(2 * i, 6 + i) = P0(6 + i, 2 * i) = -se * se;
+  }
+  state_ = estimation::StateEstimate(xa, P0, t);
   t_ = t;
   initialized_ = true;
   missed_ = 0;
@@ -61,8 +78,8 @@ void RollingBallTracker::step(double t, const Eigen::Vector2d& a_xy, const std::
   const double dt = t - t_;
   const estimation::LinearTransition tr = model.transition(dt, a_xy);  // rediscretised every frame
   if (!stationary_) {
-    estimation::predict(state_, tr);
-    model.clampEstimate(state_);
+    estimation::predict(state_, augmented(tr));
+    clampState(state_);
   }
   bool fused = false;
   if (y) {
@@ -74,7 +91,22 @@ void RollingBallTracker::step(double t, const Eigen::Vector2d& a_xy, const std::
       rep = stationaryInnovation(tr, *y);
     } else {
       trial = state_;
-      rep = estimation::update(trial, model.measurement(*y));
+      rep = estimation::update(trial, measurement(*y));
+      if (config_.impulse_nis > 0.0 && rep.nis > config_.impulse_nis) {
+        // A push: Δv ~ N(0, q I) at a time τ uniform in the interval, so the position moves by
+        // Δv (t − τ) too: var p += q dt²/3, cov(p, v) += q dt/2, var v += q per axis.
+        Eigen::MatrixXd P = state_.P();
+        const double q = config_.impulse_std * config_.impulse_std;
+        for (int i : {0, 2}) {
+          P(i, i) += q * dt * dt / 3.0;
+          P(i, i + 1) += q * dt / 2.0;
+          P(i + 1, i) += q * dt / 2.0;
+          P(i + 1, i + 1) += q;
+        }
+        trial = estimation::StateEstimate(state_.x(), P, state_.t());
+        rep = estimation::update(trial, measurement(*y));
+        ++impulses_;
+      }
     }
     const GateDecision d = gate_.decide(t, rep.nis);
     if (d == GateDecision::Restart) {
@@ -89,12 +121,12 @@ void RollingBallTracker::step(double t, const Eigen::Vector2d& a_xy, const std::
         x_ = model.stationaryStep(*stationary_, tr, x_, *y);
       } else {
         state_ = std::move(trial);
-        model.clampEstimate(state_);
+        clampState(state_);
       }
     }
   }
   if (!stationary_) {
-    x_ = state_.x();
+    x_ = state_.x().head(6);
   } else if (!fused) {
     x_ = tr.Phi * x_ + tr.Gamma * tr.u;
     model.clamp(x_);
@@ -103,6 +135,48 @@ void RollingBallTracker::step(double t, const Eigen::Vector2d& a_xy, const std::
   t_ = t;
   last_dt_ = dt;
   predictions_ = model.predictPositions(x_, dt, a_xy);
+}
+
+Eigen::Index RollingBallTracker::stateDim() const { return config_.coloured_sigma > 0.0 ? 8 : 6; }
+
+estimation::LinearTransition RollingBallTracker::augmented(const estimation::LinearTransition& tr) const {
+  if (stateDim() == 6) return tr;
+  // e_k = φ^(dt/T) e_{k−1} + η, var η = (1 − φ^(2 dt/T)) σe²: a stationary AR(1) of std σe whose
+  // correlation per nominal period T is φ.
+  const double phi = std::pow(config_.coloured_correlation, tr.dt / config_.nominal_period);
+  const double se = config_.coloured_sigma;
+  estimation::LinearTransition a;
+  a.dt = tr.dt;
+  a.Phi = Eigen::MatrixXd::Zero(8, 8);
+  a.Phi.topLeftCorner(6, 6) = tr.Phi;
+  a.Phi.bottomRightCorner(2, 2) = phi * Eigen::Matrix2d::Identity();
+  a.Q = Eigen::MatrixXd::Zero(8, 8);
+  a.Q.topLeftCorner(6, 6) = tr.Q;
+  a.Q.bottomRightCorner(2, 2) = (1.0 - phi * phi) * se * se * Eigen::Matrix2d::Identity();
+  a.u = tr.u;
+  if (tr.Gamma.size() > 0) {
+    a.Gamma = Eigen::MatrixXd::Zero(8, tr.Gamma.cols());
+    a.Gamma.topRows(6) = tr.Gamma;
+  }
+  return a;
+}
+
+estimation::LinearMeasurement RollingBallTracker::measurement(const Eigen::Vector2d& y) const {
+  estimation::LinearMeasurement m = config_.model.measurement(y);
+  if (stateDim() == 6) return m;
+  Eigen::MatrixXd C = Eigen::MatrixXd::Zero(2, 8);
+  C.leftCols(6) = m.C;
+  C.rightCols(2) = Eigen::Matrix2d::Identity();  // y = p + e + v
+  m.C = C;
+  return m;
+}
+
+void RollingBallTracker::clampState(estimation::StateEstimate& s) const {
+  Eigen::VectorXd x = s.x();
+  Eigen::VectorXd head = x.head(6);
+  if (!config_.model.clamp(head)) return;
+  x.head(6) = head;
+  s.setMean(x);
 }
 
 estimation::UpdateReport RollingBallTracker::stationaryInnovation(const estimation::LinearTransition& tr,

@@ -2,11 +2,14 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Dense>
+
 #include <cmath>
 
 #include "viewline/core/error.h"
 #include "viewline/core/random.h"
 #include "viewline/core/statistics.h"
+#include "viewline/estimation/consistency.h"
 
 using namespace viewline;
 
@@ -101,4 +104,81 @@ TEST(RollingBallTracker, RefusesAnInvalidGate) {
   } catch (const core::InvalidInput& e) {
     EXPECT_NE(std::string(e.what()).find("gate.restart_after"), std::string::npos);
   }
+}
+
+// A push (a velocity jump between two frames) is taken up within a few frames when the filter
+// models it (impulse_nis), while the filter tuned for the smooth rolling between pushes lags.
+TEST(RollingBallTracker, APushIsTakenUpWithinAFewFrames) {
+  auto run = [](double impulse_nis, int& impulses) {
+    tracking::RollingBallTrackerConfig cfg;
+    cfg.model.sigma_w = 0.01;
+    cfg.model.sigma_v = 0.0003;
+    cfg.impulse_nis = impulse_nis;
+    tracking::RollingBallTracker trk(cfg);
+    core::Rng rng = core::makeRng(5);
+    const double dt = 0.02, t_push = 1.0, v = 0.25;
+    Eigen::Vector2d velocity_after = Eigen::Vector2d::Zero();
+    for (int k = 0; k <= 55; ++k) {
+      const double t = k * dt;
+      const double x = t > t_push ? v * (t - t_push) - 0.05 : -0.05;  // at rest, then pushed along +x
+      trk.step(t, Eigen::Vector2d::Zero(), Eigen::Vector2d(x + core::gaussian(rng, 0.0003), core::gaussian(rng, 0.0003)));
+      if (k == 53) velocity_after = trk.velocity();  // three frames after the push
+      if (k == 49) {
+        EXPECT_EQ(trk.impulses(), 0);  // no jump assumed while the ball rests
+      }
+    }
+    impulses = trk.impulses();
+    return velocity_after.x();
+  };
+  int with = 0, without = 0;
+  const double v_with = run(13.8, with), v_without = run(0.0, without);
+  EXPECT_GE(with, 1);
+  EXPECT_EQ(without, 0);
+  EXPECT_NEAR(v_with, 0.25, 0.03);
+  EXPECT_LT(v_without, 0.15);
+}
+
+// Measurement error with a frame-to-frame correlated part: the filter that models it as AR(1)
+// states is consistent (position NEES in its 99 % band over independent seeded runs), the one
+// treating it as white of the same total variance is overconfident (it averages correlated
+// errors as if they were independent).
+TEST(RollingBallTracker, ColouredMeasurementErrorKeepsThePositionNeesInItsBand) {
+  const double se = 0.0002, phi = 0.55, sv = 0.0001;
+  auto nees = [&](bool coloured) {
+    tracking::RollingBallTrackerConfig cfg;
+    cfg.model.sigma_w = 1e-4;  // the ball rests: (almost) no process noise
+    cfg.model.sigma_v = coloured ? sv : std::sqrt(sv * sv + se * se);
+    cfg.coloured_sigma = coloured ? se : 0.0;
+    cfg.coloured_correlation = phi;
+    estimation::ConsistencyStats stats;
+    for (std::uint64_t run = 0; run < 150; ++run) {  // independent runs: one sample each
+      tracking::RollingBallTracker trk(cfg);
+      core::Rng rng = core::makeRng(100 + run);
+      Eigen::Vector2d e(core::gaussian(rng, se), core::gaussian(rng, se));
+      for (int k = 0; k < 60; ++k) {
+        e = phi * e + std::sqrt(1.0 - phi * phi) * Eigen::Vector2d(core::gaussian(rng, se), core::gaussian(rng, se));
+        trk.step(0.02 * k, Eigen::Vector2d::Zero(), e + Eigen::Vector2d(core::gaussian(rng, sv), core::gaussian(rng, sv)));
+      }
+      EXPECT_EQ(trk.x().size(), 6);
+      const Eigen::MatrixXd P = trk.P();
+      Eigen::Matrix2d Pp;
+      Pp << P(0, 0), P(0, 2), P(2, 0), P(2, 2);
+      const Eigen::Vector2d d = trk.position();  // the ball rests at the origin
+      stats.add(d.dot(Pp.ldlt().solve(d)), 2.0);
+    }
+    return stats;
+  };
+  const estimation::ConsistencyStats coloured = nees(true), white = nees(false);
+  EXPECT_TRUE(coloured.consistent(0.99)) << coloured.mean();
+  EXPECT_GT(white.mean(), white.bounds(0.99).hi) << white.mean();
+}
+
+TEST(RollingBallTracker, RefusesAColouredErrorWithTheStationaryGain) {
+  tracking::RollingBallTrackerConfig cfg;
+  cfg.stationary_gain = true;
+  cfg.coloured_sigma = 0.0002;
+  EXPECT_THROW(tracking::RollingBallTracker{cfg}, core::InvalidInput);
+  cfg.stationary_gain = false;
+  cfg.coloured_correlation = 1.0;
+  EXPECT_THROW(tracking::RollingBallTracker{cfg}, core::InvalidInput);
 }

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 
 #include "viewline/core/error.h"
 #include "viewline/io/config_edit.h"
@@ -12,6 +13,11 @@ namespace {
 
 double get(const nlohmann::json& j, const char* k) {
   return j.contains(k) && j[k].is_number() ? j[k].get<double>() : std::nan("");
+}
+
+/// Element i of a JSON array of numbers (NaN for null: an empty band).
+double element(const nlohmann::json& a, std::size_t i) {
+  return a.is_array() && i < a.size() && a[i].is_number() ? a[i].get<double>() : std::nan("");
 }
 
 }  // namespace
@@ -65,14 +71,31 @@ TuneCommandLine::TuneCommandLine(CLI::App& app) {
   autotune_->add_option("--record-seed", ao.record_seed, "seed of the live recording");
   autotune_->add_option("--record-runs", ao.record_runs, "live runs recorded");
   autotune_->add_option("--start-scale", ao.start_scale, "start from the config's noise values times this");
+  autotune_->add_option("--start-value", start_values_,
+                        "key=value: start this noise parameter (config key) here, e.g. one the config sets to 0");
   autotune_->add_option("--outlier-prior", ao.outlier_prior, "prior outlier probability in the likelihood");
   autotune_->add_option("--span-decades", ao.span_decades, "grid half-width in decades");
   autotune_->add_option("--grid-points", ao.grid_points, "grid points per parameter");
-  autotune_->add_option("--verify-runs", ao.verify_runs, "live runs with the start and the tuned noise (NEES/NIS)");
+  autotune_->add_option("--verify-runs", ao.verify_runs,
+                        "live runs with the start and the tuned noise from the verify seed (NEES/NIS)");
+  autotune_->add_option("--verify-seed", ao.verify_seed,
+                        "seed of the fresh-seed NIS check and the live runs (default: record seed + 1)");
   autotune_->add_option("--out", ao.out_dir, "output folder");
   autotune_->add_option("--option", autotune_adapter_options_, "adapter option name=value");
   autotune_->add_option("--workers", workers_, "threads (0: all cores)");
   autotune_->add_flag("--quiet", quiet_, "no progress output");
+
+  check_ = app.add_subcommand("check", "NIS/NEES of a config's filter on seeded runs: means, 99 % bands, verdicts");
+  CheckOptions& co = check_options_;
+  check_->add_option("--scenario", co.scenario, "scenario adapter (viewline_tune list)")->required();
+  check_->add_option("--config", co.config, "scenario YAML")->required();
+  check_->add_option("--set", co.set, io::kSetOptionHelp)->take_all();
+  check_->add_option("--seeds", co.seeds, "seeded runs pooled");
+  check_->add_option("--seed", co.seed, "base seed (run i: deriveSeed(seed, i)); pick one the noise was not tuned on");
+  check_->add_option("--out", co.out_dir, "folder for summary.json (default: none)");
+  check_->add_option("--option", check_adapter_options_, "adapter option name=value");
+  check_->add_option("--workers", workers_, "threads (0: all cores)");
+  check_->add_flag("--quiet", quiet_, "no progress output");
 
   list_ = app.add_subcommand("list", "the scenarios of this build, their metrics and options");
 }
@@ -86,6 +109,7 @@ int TuneCommandLine::run(const AdapterRegistry& registry, const std::atomic<bool
   if (sweep_->parsed()) return runSweep(registry, stop);
   if (run_->parsed()) return runSingle(registry, live_view);
   if (autotune_->parsed()) return runAutotune(registry);
+  if (check_->parsed()) return runCheck(registry);
   return 0;
 }
 
@@ -147,6 +171,12 @@ int TuneCommandLine::runSingle(const AdapterRegistry& registry, const LiveViewFa
 int TuneCommandLine::runAutotune(const AdapterRegistry& registry) {
   AutotuneSessionOptions ao = autotune_options_;
   ao.adapter_options = parseAdapterOptions(autotune_adapter_options_);
+  for (const auto& [k, v] : parseAdapterOptions(start_values_)) {
+    char* end = nullptr;
+    const double x = std::strtod(v.c_str(), &end);
+    if (end == v.c_str() || *end != '\0') throw core::InvalidInput("--start-value " + k + "=" + v + ": expected a number");
+    ao.start_values[k] = x;
+  }
   ao.workers = workers_;
   ao.quiet = quiet_;
   const nlohmann::json j = runAutotuneSession(registry, ao);
@@ -162,8 +192,31 @@ int TuneCommandLine::runAutotune(const AdapterRegistry& registry) {
     std::printf("  live NEES with the tuned noise %.3f in [%.3f, %.3f]: %s\n", get(j, "autotune_nees_mean"),
                 j["autotune_nees_bounds"][0].get<double>(), j["autotune_nees_bounds"][1].get<double>(),
                 j["autotune_nees_inside"].get<bool>() ? "inside" : "OUTSIDE");
+  std::printf("  fresh seed %llu (%s): NIS %.3f in [%.3f, %.3f] (%s)\n",
+              static_cast<unsigned long long>(j["autotune_verify_seed"].get<std::uint64_t>()),
+              j["autotune_verify_data"].get<std::string>().c_str(), get(j, "autotune_verify_nis_mean"),
+              element(j["autotune_verify_nis_bounds"], 0), element(j["autotune_verify_nis_bounds"], 1),
+              j["autotune_verify_nis_verdict"].get<std::string>().c_str());
   std::printf("  tuned config: %s\n  report: %s\n", j["autotuned_config"].get<std::string>().c_str(),
               j["report"].get<std::string>().c_str());
+  return 0;
+}
+
+int TuneCommandLine::runCheck(const AdapterRegistry& registry) {
+  CheckOptions co = check_options_;
+  co.adapter_options = parseAdapterOptions(check_adapter_options_);
+  co.workers = workers_;
+  co.quiet = quiet_;
+  const nlohmann::json j = runCheckSession(registry, co);
+  std::printf("viewline_tune check: %s %s, %d seed(s) from %llu (confidence %.2f)\n", co.scenario.c_str(),
+              co.config.c_str(), co.seeds, static_cast<unsigned long long>(co.seed), get(j, "confidence"));
+  for (const char* k : {"check_nis", "check_nees"}) {
+    const nlohmann::json& c = j[k];
+    std::printf("  %-4s mean %-9.4g band [%.4g, %.4g]  %zu samples, %g dof  %s\n", k + 6, get(c, "mean"),
+                element(c["bounds"], 0), element(c["bounds"], 1), c["samples"].get<std::size_t>(), get(c, "dof"),
+                c["verdict"].get<std::string>().c_str());
+  }
+  std::printf("  verdict: %s\n", j["check_verdict"].get<std::string>().c_str());
   return 0;
 }
 

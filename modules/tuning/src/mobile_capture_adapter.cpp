@@ -4,17 +4,21 @@
 // config read by the scenario's own loader (loadMobileCaptureConfig: strict keys), so a config the
 // tuning tool accepts or writes is one mobile_capture reads. One run = one chase (seed).
 //
-// Consistency, from the run's telemetry (a runtime::MemorySink; no files). NEES: per vision step
-// the sink has the true object (x, y, θ, v, ω) and the track's estimate with its covariance;
-// every `nees_spacing_s` seconds (nearly independent samples) one 1-dof marginal sample
-// e_i² / P_ii (χ²(1) for a consistent filter) is taken, cycling through x, y, θ (wrapped), v, ω,
-// once the track has been valid for `settle_s`. NIS: the track's own innovation records (2 dof,
-// accepted or gated out), once the track has been valid for `settle_s`.
+// Consistency: the run's own position NEES (2 dof, against P_s + B, one sample every
+// scenarios::kNeesSpacing s once the track has been valid kConsistencySettle s: MobileCaptureRun),
+// and the NIS from the run's telemetry (a runtime::MemorySink; no files): the track's own
+// innovation records (2 dof, accepted or gated out) once the track has been valid for `settle_s`
+// (default the loop's kConsistencySettle, so the two agree).
 //
-// Noise auto-tuning is not offered: the head points the camera at the filter's own prediction, so
-// which frames see the object depends on the filter being tuned (the measurements cannot be
-// replayed honestly). Sweeps of filter.q_v, filter.q_w, filter.gate_probability, the planner and
-// control keys work, with NEES and NIS beside the metrics.
+// Noise auto-tuning: the noise parameters are the track's random walks q_v, q_w and the white
+// blob-centre noise σ_px (R = σ_px² J Jᵀ, J the ground-projection Jacobian of each detection). A
+// recording keeps every detection's floor point, J Jᵀ and time stamp; the replay runs a fresh
+// unicycle track (same start, gate and restart rule) on them. The head aims the camera at the
+// filter's prediction, so which frames see the object depends on the filter that ran: the
+// likelihood of the recorded innovations is still the prediction-error decomposition of what was
+// measured (the camera's aim is a function of earlier measurements only), but a noise far from the
+// recording's would have aimed the camera differently; hence the fresh-seed check of the session,
+// a live run of the tuned config.
 
 #include <cmath>
 #include <limits>
@@ -26,6 +30,7 @@
 #include "viewline/runtime/telemetry.h"
 #include "viewline/scenarios/mobile_capture.h"
 #include "viewline/tuning/scenario.h"
+#include "viewline/tracking/unicycle_tracker.h"
 // The camera view lives in the viz module; it is shown when this library links viz.
 #if __has_include("viewline/viz/mobile_capture_display.h")
 #include "viewline/viz/mobile_capture_display.h"
@@ -36,13 +41,10 @@ namespace viewline::tuning {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
 /// The adapter options (declared with their defaults and ranges in registerMobileCaptureAdapter).
 struct MobileOptions {
   double max_time;      ///< s; 0: the config's world.max_time
-  double nees_spacing;  ///< s between NEES samples
-  double settle;        ///< s of valid track before NEES samples
+  double settle;        ///< s of valid track before NIS samples
 };
 
 /// The adapter options: type, range, default and help of each, bound to its field.
@@ -50,12 +52,20 @@ detail::OptionTable<MobileOptions> mobileOptions() {
   detail::OptionTable<MobileOptions> options;
   options.number("max_time", &MobileOptions::max_time, "0", 0.0, detail::kUnbounded,
                  "s, time limit of a chase (0: the config's world.max_time)")
-      .number("nees_spacing_s", &MobileOptions::nees_spacing, "1", 1e-9, detail::kUnbounded,
-              "s between the 1-dof NEES samples (nearly independent)")
       .number("settle_s", &MobileOptions::settle, "2", 0.0, detail::kUnbounded,
-              "s a track must have been valid before its NEES samples count");
+              "s a track must have been valid before its NIS samples count");
   return options;
 }
+
+/// One detection as the track saw it (the replay's input).
+struct Detection {
+  double t = 0.0;                                          ///< s, capture time
+  Eigen::Vector2d z = Eigen::Vector2d::Zero();             ///< m, floor point
+  Eigen::Matrix2d unit_pixel_cov = Eigen::Matrix2d::Zero();  ///< m²/px², J Jᵀ
+};
+using Chase = std::vector<Detection>;
+using MobileReplayData = detail::Recording<Chase>;
+std::size_t chaseDetections(const Chase& c) { return c.size(); }
 
 const detail::SeriesLabels kLabels{"t [s]", "object position error |p_hat - p| [m]", "t [s]", 2.0, "floor x [m]",
                                    "floor y [m] (black: object and robot paths)"};
@@ -67,10 +77,51 @@ public:
     if (opt_.max_time > 0.0) cfg_.max_time = opt_.max_time;
   }
 
-  std::string autotuneUnsupported() const override {
-    return "the head aims the camera at the mobile-capture EKF's own prediction, so the measurements depend on the "
-           "filter being tuned and cannot be replayed honestly; sweep filter.q_v / filter.q_w instead (NEES and NIS "
-           "are reported per setting)";
+  std::vector<NoiseParameter> noiseParameters() const override {
+    return {{"process", "q_v", "m^2/s^3", "filter.q_v", "random-walk intensity of the object's speed", cfg_.filter.model.q_v},
+            {"process_turn", "q_w", "rad^2/s^3", "filter.q_w", "random-walk intensity of the object's turn rate",
+             cfg_.filter.model.q_w},
+            {"measurement", "sigma_px", "px", "detector.pixel_sigma", "white blob-centre noise (R = sigma^2 J J')",
+             cfg_.pixel_sigma}};
+  }
+
+  std::unique_ptr<ReplayData> record(std::uint64_t seed, int runs) const override {
+    auto d = std::make_unique<MobileReplayData>("chases", "detections", &chaseDetections);
+    for (int i = 0; i < runs; ++i) {
+      d->items.emplace_back();
+      Chase& chase = d->items.back();
+      scenarios::MobileCaptureHooks hooks;
+      hooks.on_frame = [&](const scenarios::MobileCaptureFrame& f) {
+        if (f.measurement) chase.push_back({f.t, f.measurement->z, f.measurement->unit_pixel_cov});
+      };
+      scenarios::runMobileCapture(cfg_, core::deriveSeed(seed, static_cast<std::uint64_t>(i)), &hooks);
+    }
+    d->source = detail::liveSource(runs, seed);
+    return d;
+  }
+
+  std::unique_ptr<ReplayData> loadLog(const std::string&) const override {
+    throw core::InvalidInput(
+        "mobile_capture: auto-tuning from a --log folder is not supported (the log has no ground-projection Jacobian "
+        "of each detection); record live runs instead (viewline_tune autotune without --log, --record-seed N)");
+  }
+
+  ReplayResult replay(const ReplayData& data, const std::vector<double>& noise, double outlier_prior,
+                      bool want_series) const override {
+    return detail::replayRecording<Chase, detail::InnovationTally>(
+        data, noise, 3, "mobile_capture", want_series, kLabels,
+        [&](const MobileReplayData& d, detail::InnovationTally& a, RunSeries* series) {
+          for (const Chase& c : d.items) replayChase(c, noise, outlier_prior, a, series);
+        });
+  }
+
+  std::unique_ptr<ScenarioInstance> withNoise(const std::vector<double>& noise) const override {
+    if (noise.size() != 3) throw core::InvalidInput("mobile_capture: expected (q_v, q_w, sigma_px)");
+    scenarios::MobileCaptureConfig c = cfg_;
+    c.filter.model.q_v = noise[0];
+    c.filter.model.q_w = noise[1];
+    c.pixel_sigma = noise[2];
+    return std::make_unique<MobileInstance>(c, opt_);
   }
 
   RunResult run(std::uint64_t seed, const RunOptions& ro) const override {
@@ -134,7 +185,10 @@ public:
     const scenarios::MobileCaptureRun res = scenarios::runMobileCapture(cfg_, seed, &hooks);
     RunResult r;
     r.seed = seed;
-    consistency(memory, r.nees, r.nis, series.get());
+    consistency(memory, r.nis, series.get());
+    r.nees.sum = res.nees_sum;
+    r.nees.dof_sum = 2.0 * static_cast<double>(res.nees_count);
+    r.nees.count = static_cast<std::size_t>(res.nees_count);
     auto& m = r.metrics;
     m["captured"] = res.captured ? 1.0 : 0.0;
     m["capture_time_s"] = res.capture_time;
@@ -161,33 +215,40 @@ public:
   }
 
 private:
-  /// NEES: one 1-dof marginal sample every nees_spacing s, cycling over (x, y, θ, v, ω). NIS: the
-  /// track's innovation records. Both once the track has been valid for settle s (a track is
+  /// The track of the loop on one chase's detections with noise (q_v, q_w, σ_px): the NIS of every
+  /// tested detection once its track has been valid for settle_s, and its cost term (a gross
+  /// outlier is uniform over the image: density 1 / (W H |det J|) on the floor).
+  void replayChase(const Chase& chase, const std::vector<double>& noise, double eps, detail::InnovationTally& a,
+                   RunSeries* series) const {
+    tracking::UnicycleTrackerConfig tc = cfg_.filter;
+    tc.model.q_v = noise[0];
+    tc.model.q_w = noise[1];
+    tracking::UnicycleTracker track(tc);
+    const double log_image = std::log(static_cast<double>(cfg_.width) * static_cast<double>(cfg_.height));
+    double since = 0.0;
+    for (const Detection& m : chase) {
+      const bool was_valid = track.valid();
+      const tracking::UnicycleUpdate u = track.update(m.t, m.z, noise[2] * noise[2] * m.unit_pixel_cov);
+      if (!was_valid && track.valid()) since = m.t;
+      if (!was_valid || !std::isfinite(u.report.nis) || m.t - since < opt_.settle) continue;
+      const double log_u = -log_image - 0.5 * std::log(m.unit_pixel_cov.determinant());
+      a.addCost(u.report.nis, std::log(u.report.S.determinant()), 2, eps, log_u);
+      detail::addNis(a.nis, u.report.nis, 2.0, m.t, series);
+    }
+  }
+
+  /// NIS: the track's innovation records once the track has been valid for settle s (a track is
   /// valid at the times it has an estimate record; a gap of more than a frame is a restart).
-  void consistency(const runtime::MemorySink& mem, Consistency& nees, Consistency& nis, RunSeries* series) const {
+  void consistency(const runtime::MemorySink& mem, Consistency& nis, RunSeries* series) const {
     namespace channel = scenarios::mobile_capture::channel;
-    std::map<double, const Eigen::VectorXd*> truth;  // by time (both records carry the frame's stamp)
-    for (const auto& e : mem.estimates)
-      if (e.channel == channel::kTruthObject) truth[e.t] = &e.x;
     std::map<double, double> valid_since;  // frame time -> start of the track valid then
-    double since = -1.0, last_t = -1e300, next = -1e300;
-    std::size_t component = 0;
+    double since = -1.0, last_t = -1e300;
     for (const auto& e : mem.estimates) {
       if (e.channel != channel::kObject) continue;
       const double t = e.t;
       if (t - last_t > 1.5 * cfg_.vision_period) since = t;  // the track (re)started
       last_t = t;
       valid_since[t] = since;
-      const auto it = truth.find(t);
-      if (it == truth.end() || t - since < opt_.settle || t < next) continue;
-      const std::size_t k = component % 5;
-      double err = e.x[static_cast<Eigen::Index>(k)] - (*it->second)[static_cast<Eigen::Index>(k)];
-      if (k == 2) err = std::remainder(err, 2.0 * kPi);
-      const double var = e.P(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(k));
-      if (!(var > 0.0)) continue;
-      nees.add(err * err / var, 1.0);
-      ++component;
-      next = t + opt_.nees_spacing;
     }
     for (const auto& i : mem.innovationsOf(channel::kObject)) {
       const auto v = valid_since.find(i.t);

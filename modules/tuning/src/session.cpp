@@ -6,8 +6,11 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <optional>
 #include <set>
 #include <sstream>
+#include <stdexcept>
 
 #include "adapter_util.h"
 #include "viewline/core/error.h"
@@ -221,6 +224,7 @@ void autotuneTable(HtmlReport& rep, const AutotuneResult& a, double confidence) 
 struct AutotuneOutcome {
   AutotuneResult result;
   SettingResult live_before, live_after;
+  Consistency verify_nis;  // NIS of the fresh-seed recording at the tuned noise
   std::string config_file;
   nlohmann::json json;
 };
@@ -228,14 +232,30 @@ struct AutotuneOutcome {
 AutotuneOutcome doAutotune(const ScenarioInstance& base, const ScenarioFile& file, const std::string& out_dir,
                            double start_scale, const ReplayData* given_data, std::uint64_t record_seed, int record_runs,
                            const AutotuneOptions& ao, std::uint64_t verify_seed, int verify_runs, bool quiet,
-                           const std::string& source_name) {
+                           const std::string& source_name, const std::map<std::string, double>& start_values = {},
+                           std::optional<std::uint64_t> live_seed = std::nullopt) {
+  const std::uint64_t live = live_seed.value_or(verify_seed);
+  if (given_data == nullptr && (verify_seed == record_seed || live == record_seed))
+    throw core::InvalidInput(source_name + ": the verification seed " + std::to_string(verify_seed) +
+                             " is the recording's seed: the fresh-seed NIS check needs another one");
   AutotuneOutcome o;
   const std::vector<NoiseParameter> params = base.noiseParameters();
   std::vector<double> start;
+  for (const auto& [key, v] : start_values) {
+    if (std::none_of(params.begin(), params.end(), [&](const NoiseParameter& p) { return p.config_key == key; }))
+      throw core::InvalidInput("--start-value " + key + ": not a noise parameter of this scenario");
+    if (!(v > 0.0) || !std::isfinite(v)) throw core::InvalidInput("--start-value " + key + ": expected a positive number");
+  }
   for (const auto& p : params) {
+    // A given start is used as it is; else the config's value times the scale.
+    if (const auto it = start_values.find(p.config_key); it != start_values.end()) {
+      start.push_back(it->second);
+      continue;
+    }
     if (!(p.value > 0.0))
       throw core::InvalidInput(source_name + ": noise parameter '" + p.config_key + "' is " + fmt(p.value) +
-                               ": the log-space search needs a positive starting value");
+                               ": the log-space search needs a positive starting value (give one: --start-value " +
+                               p.config_key + "=<value>)");
     start.push_back(p.value * start_scale);
   }
   const std::unique_ptr<ScenarioInstance> start_instance = base.withNoise(start);
@@ -248,11 +268,28 @@ AutotuneOutcome doAutotune(const ScenarioInstance& base, const ScenarioFile& fil
   o.result = autotuneNoise(*start_instance, *given_data, start, ao);
   const std::unique_ptr<ScenarioInstance> tuned_instance = base.withNoise(o.result.tuned);
   o.json = o.result.toJson(ao.confidence);
+  // The NIS above comes from the data the noise was fitted on; the check that counts is on a fresh
+  // seed: a new recording made with the tuned noise (so a closed loop aims its camera with the
+  // tuned filter), replayed at the tuned noise.
+  {
+    say(quiet, "auto-tune: fresh-seed check, recording " + std::to_string(record_runs) + " run(s) from seed " +
+                   std::to_string(verify_seed) + " with the tuned noise");
+    const std::unique_ptr<ReplayData> fresh = tuned_instance->record(verify_seed, record_runs);
+    const ReplayResult v = tuned_instance->replay(*fresh, o.result.tuned, ao.outlier_prior, false);
+    o.verify_nis = v.nis;
+    o.json["autotune_verify_seed"] = verify_seed;
+    o.json["autotune_verify_data"] = fresh->describe();
+    o.json["autotune_verify_nis_mean"] = num(v.nis.mean());
+    o.json["autotune_verify_nis_bounds"] = interval(v.nis.bounds(ao.confidence));
+    o.json["autotune_verify_nis_verdict"] = v.nis.verdict(ao.confidence);
+    o.json["autotune_verify_nis_samples"] = v.nis.count;
+  }
   if (verify_runs > 0) {
     say(quiet, "auto-tune: " + std::to_string(verify_runs) + " live runs with the start and the tuned noise");
-    o.live_before = evaluate(*start_instance, verify_seed, verify_runs, ao.workers, ao.confidence);
-    o.live_after = evaluate(*tuned_instance, verify_seed, verify_runs, ao.workers, ao.confidence);
+    o.live_before = evaluate(*start_instance, live, verify_runs, ao.workers, ao.confidence);
+    o.live_after = evaluate(*tuned_instance, live, verify_runs, ao.workers, ao.confidence);
     o.json["autotune_live_runs"] = verify_runs;
+    o.json["autotune_live_seed"] = live;
     o.json["autotune_live_nees_before"] = consistencyJson(o.live_before.nees, ao.confidence);
     o.json["autotune_live_nis_before"] = consistencyJson(o.live_before.nis, ao.confidence);
     o.json["autotune_live_nees"] = consistencyJson(o.live_after.nees, ao.confidence);
@@ -261,6 +298,10 @@ AutotuneOutcome doAutotune(const ScenarioInstance& base, const ScenarioFile& fil
     o.json["autotune_nees_bounds"] = interval(o.live_after.nees.bounds(ao.confidence));
     o.json["autotune_nees_inside"] = o.live_after.nees.count > 0 &&
                                      o.live_after.nees.bounds(ao.confidence).contains(o.live_after.nees.mean());
+    o.json["autotune_verify_nees_mean"] = num(o.live_after.nees.mean());
+    o.json["autotune_verify_nees_bounds"] = interval(o.live_after.nees.bounds(ao.confidence));
+    o.json["autotune_verify_nees_verdict"] = o.live_after.nees.verdict(ao.confidence);
+    o.json["autotune_verify_nees_samples"] = o.live_after.nees.count;
     o.json["autotune_live_verdict_before"] = o.live_before.verdict;
     o.json["autotune_live_verdict"] = o.live_after.verdict;
   }
@@ -646,8 +687,12 @@ nlohmann::json runAutotuneSession(const AdapterRegistry& registry, const Autotun
   ao.workers = o.workers;
   ao.confidence = base->confidence();
   if (!o.quiet) ao.progress = [](const std::string& s) { std::fprintf(stderr, "%s\n", s.c_str()); };
+  const std::uint64_t verify_seed = o.verify_seed != 0 ? o.verify_seed : o.record_seed + 1;
+  // The live runs keep base seed 1 unless a verification seed is given (seed 1 differs from the
+  // default recording seed, 1000, too).
+  const std::uint64_t live_seed = o.verify_seed != 0 ? o.verify_seed : 1;
   const AutotuneOutcome at = doAutotune(*base, file, o.out_dir, o.start_scale, data.get(), o.record_seed, o.record_runs, ao,
-                                        1, o.verify_runs, o.quiet, o.config);
+                                        verify_seed, o.verify_runs, o.quiet, o.config, o.start_values, live_seed);
   nlohmann::json j = at.json;
   j["scenario"] = o.scenario;
   j["config"] = o.config;
@@ -658,8 +703,12 @@ nlohmann::json runAutotuneSession(const AdapterRegistry& registry, const Autotun
   rep.paragraph(htmlEscape(at.json["method"].get<std::string>()) + ". Data: " + htmlEscape(at.result.data_description) +
                 ". Tuned config: <code>" + htmlEscape(at.config_file) + "</code>. " + describeConsistency());
   autotuneTable(rep, at.result, ao.confidence);
+  rep.table({"fresh-seed check (seed " + std::to_string(verify_seed) + ", tuned noise)", "NIS mean [band]", "samples",
+             "verdict"},
+            {{htmlEscape(j["autotune_verify_data"].get<std::string>()), consistencyCell(at.verify_nis, ao.confidence),
+              std::to_string(at.verify_nis.count), at.verify_nis.verdict(ao.confidence)}});
   if (!at.live_after.runs.empty()) {
-    rep.table({"live runs", "NEES mean [band]", "NIS mean [band]", "verdict"},
+    rep.table({"live runs (seed " + std::to_string(live_seed) + ")", "NEES mean [band]", "NIS mean [band]", "verdict"},
               {{"start noise", consistencyCell(at.live_before.nees, ao.confidence),
                 consistencyCell(at.live_before.nis, ao.confidence), at.live_before.verdict},
                {"tuned noise", consistencyCell(at.live_after.nees, ao.confidence),
@@ -667,6 +716,39 @@ nlohmann::json runAutotuneSession(const AdapterRegistry& registry, const Autotun
   }
   autotunePlots(rep, at.result, ao.confidence);
   return writeOutputs(rep, std::move(j), o.out_dir);
+}
+
+nlohmann::json runCheckSession(const AdapterRegistry& registry, const CheckOptions& o) {
+  if (o.seeds < 1) throw core::InvalidInput("check: --seeds must be >= 1");
+  const ScenarioAdapter& adapter = registry.get(o.scenario);
+  const ScenarioFile file = readScenarioFile(o.config, o.set);
+  const std::unique_ptr<ScenarioInstance> inst =
+      adapter.loadConfig(file.node, withOptions(adapter, o.scenario, o.adapter_options));
+  const double c = inst->confidence();
+  say(o.quiet, "check: " + std::to_string(o.seeds) + " run(s) of " + o.config + " from seed " + std::to_string(o.seed));
+  const SettingResult r = evaluate(*inst, o.seed, o.seeds, o.workers, c);
+  if (!r.error.empty()) throw std::runtime_error("check: a run failed: " + r.error);
+  nlohmann::json j;
+  j["scenario"] = o.scenario;
+  j["config"] = o.config;
+  if (!o.set.empty()) j["config_set"] = o.set;
+  j["base_seed"] = o.seed;
+  j["seeds"] = o.seeds;
+  j["seed_rule"] = "run i uses deriveSeed(base_seed, i)";
+  j["confidence"] = c;
+  j["check_nis"] = consistencyJson(r.nis, c);
+  j["check_nis"]["dof"] = num(r.nis.meanDof());
+  j["check_nees"] = consistencyJson(r.nees, c);
+  j["check_nees"]["dof"] = num(r.nees.meanDof());
+  j["check_verdict"] = r.verdict;
+  nlohmann::json m = nlohmann::json::object();
+  for (const auto& [k, v] : r.metrics) m[k] = {{"mean", num(v.mean)}, {"std", num(v.std)}};
+  j["metrics"] = m;
+  if (!o.out_dir.empty()) {
+    fs::create_directories(o.out_dir);
+    io::writeSummaryFile((fs::path(o.out_dir) / "summary.json").string(), j);
+  }
+  return j;
 }
 
 }  // namespace viewline::tuning

@@ -1,7 +1,8 @@
 // The scenario adapters for table ball, ball catching and mobile capture: a tiny sweep
 // of each (2 settings x 1 seed, short runs) through the full session, checking the report, the
 // summary and that the metrics a user optimises and the consistency statistics exist and are
-// finite; the adapters without noise auto-tuning must say so (not crash, not pretend), and so must
+// finite; the adapters without noise auto-tuning must say so (not crash, not pretend; mobile
+// capture tunes from live recordings and says why not from a --log folder), and so must
 // the pan-tilt adapter for a filter without process noise.
 // Runs from the source root (ctest's working directory), so config/ paths resolve.
 
@@ -120,7 +121,7 @@ TEST(ScenarioAdapters, MobileCaptureTinySweep) {
 
 TEST(ScenarioAdapters, AutotuneSaysWhenAnAdapterDoesNotSupportIt) {
   const AdapterRegistry reg = makeBuiltinAdapters();
-  for (const std::string sc : {"ball_catching", "mobile_capture"}) {
+  for (const std::string sc : {"ball_catching"}) {
     const fs::path dir = scratch("unsupported_" + sc);
     AutotuneSessionOptions a;
     a.scenario = sc;
@@ -137,6 +138,22 @@ TEST(ScenarioAdapters, AutotuneSaysWhenAnAdapterDoesNotSupportIt) {
     o.quiet = true;
     EXPECT_TRUE(hasInvalidInput([&] { runSweepSession(reg, sweep, o); }, "sweep.yaml: section 'autotune'")) << sc;
   }
+}
+
+TEST(ScenarioAdapters, MobileCaptureAutotunesFromLiveRecordingsNotFromLogs) {
+  const AdapterRegistry reg = makeBuiltinAdapters();
+  const fs::path dir = scratch("mobile_capture_log");
+  AutotuneSessionOptions a;
+  a.scenario = "mobile_capture";
+  a.config = configPath("mobile_capture.yaml");
+  a.log_dir = dir.string();
+  a.out_dir = (dir / "out").string();
+  a.quiet = true;
+  EXPECT_TRUE(hasInvalidInput([&] { runAutotuneSession(reg, a); }, "record live runs instead"));
+  const auto inst = reg.get("mobile_capture").loadConfig(io::ConfigNode::loadFile(a.config), readAdapterOptions(reg.get("mobile_capture"), nullptr));
+  EXPECT_EQ(inst->autotuneUnsupported(), "");
+  ASSERT_EQ(inst->noiseParameters().size(), 3u);
+  EXPECT_EQ(inst->noiseParameters()[2].config_key, "detector.pixel_sigma");
 }
 
 TEST(ScenarioAdapters, PanTiltAutotuneRefusesTheParticleFilter) {

@@ -1,9 +1,14 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
 
 #include "toy_scenario.h"
+#include "viewline/core/error.h"
 #include "viewline/tuning/autotune.h"
+#include "viewline/tuning/session.h"
 
 using namespace viewline;
 using namespace viewline::tuning;
@@ -32,4 +37,47 @@ TEST(Autotune, RecoversProcessAndMeasurementNoiseFrom10xOff) {
   EXPECT_EQ(r.before.nis.verdict(0.99), "underconfident");
   EXPECT_EQ(r.after.nis.verdict(0.99), "consistent") << r.after.nis.mean();
   EXPECT_LT(r.after.cost, r.before.cost);
+}
+
+TEST(Autotune, SessionChecksTheNisOnAFreshSeed) {
+  // The session fits the noise on the recording of record_seed, then checks the NIS on a new
+  // recording (verify seed, the tuned filter) replayed at the tuned noise; the recording's own
+  // seed is refused as the verification seed.
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / "viewline_autotune_fresh_seed";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string config = (dir / "toy.yaml").string();
+  std::ofstream(config) << "q_true: 0.02\nr_true: 0.5\nsteps: 1000\nfilter:\n  q: 0.2\n  r: 5.0\n";
+  const AdapterRegistry reg = toy::registry();
+  AutotuneSessionOptions a;
+  a.scenario = "toy";
+  a.config = config;
+  a.record_seed = 11;
+  a.grid_points = 7;
+  a.workers = 2;
+  a.verify_runs = 2;
+  a.out_dir = (dir / "out").string();
+  a.quiet = true;
+  const nlohmann::json j = runAutotuneSession(reg, a);
+  EXPECT_EQ(j.at("autotune_verify_seed").get<std::uint64_t>(), 12u);  // record seed + 1
+  EXPECT_EQ(j.at("autotune_verify_nis_verdict").get<std::string>(), "consistent") << j.dump();
+  const double fresh = j.at("autotune_verify_nis_mean").get<double>();
+  const auto band = j.at("autotune_verify_nis_bounds");
+  EXPECT_GE(fresh, band[0].get<double>());
+  EXPECT_LE(fresh, band[1].get<double>());
+  // Another data set: not the fitted replay's NIS.
+  EXPECT_NE(fresh, j.at("autotune_nis_mean").get<double>());
+  EXPECT_GT(j.at("autotune_verify_nis_samples").get<std::size_t>(), 900u);
+  // Where the simulator knows the truth: NEES of the live runs at the verification seed.
+  EXPECT_GT(j.at("autotune_verify_nees_samples").get<std::size_t>(), 20u);
+  EXPECT_TRUE(j.at("autotune_verify_nees_mean").is_number());
+  // The recording's seed as the verification seed is refused.
+  a.verify_seed = 11;
+  try {
+    runAutotuneSession(reg, a);
+    FAIL() << "the recording's seed accepted as the verification seed";
+  } catch (const core::InvalidInput& e) {
+    EXPECT_NE(std::string(e.what()).find("fresh-seed NIS check needs another one"), std::string::npos) << e.what();
+  }
 }

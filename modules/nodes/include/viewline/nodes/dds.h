@@ -14,8 +14,10 @@
 // QoS per stream (Qos::..., one function each; the reason is on each):
 //   detections  best-effort, keep-last, volatile; camera writers also assert liveliness
 //               (automatic, lease Qos::kCameraLeaseS) so the tracker notices a camera leaving;
-//   set points  reliable, keep-last 1, with a deadline on both ends: the robot halts when the
-//               tracker goes silent for longer than the deadline;
+//   set points  reliable, keep-last 64, with a deadline on both ends: every set point reaches the
+//               robot in order (it interpolates its path between them: one dropped would bend
+//               the path), and the robot halts when the tracker goes silent for longer than the
+//               deadline;
 //   state       reliable keep-last (clock, truth, track, robot state): a late sample is still
 //               better than none, the reader keeps the newest few;
 //   health      reliable, transient-local, keep-last 1: a node that joins late still sees every
@@ -87,7 +89,7 @@ public:
   static Qos detections(int depth = 64);
   /// A camera's detection writer: detections() with automatic liveliness (kCameraLeaseS).
   static Qos cameraWriter();
-  /// Set points: reliable keep-last 1 with a deadline, s (the robot halts past it).
+  /// Set points: reliable keep-last 64 (none dropped) with a deadline, s (the robot halts past it).
   static Qos setpoints(double deadline_s);
   /// Clock, truth, track and robot state: reliable keep-last `depth`.
   static Qos state(int depth = 16);

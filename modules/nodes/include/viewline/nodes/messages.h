@@ -25,6 +25,7 @@ inline constexpr const char* kTrack = "rt/viewline/track";              ///< Tra
 inline constexpr const char* kSetPoint = "rt/viewline/setpoint";        ///< SetPoint_, tracker node
 inline constexpr const char* kRobotState = "rt/viewline/robot_state";   ///< RobotState_, robot node
 inline constexpr const char* kHealth = "rt/viewline/health";            ///< NodeHealth_, every node
+inline constexpr const char* kEpisode = "rt/viewline/episode";          ///< Episode_, world node (sessions of throws)
 }  // namespace topic
 
 /// Generated message types under short names.
@@ -35,6 +36,7 @@ using SetPointMsg = viewline_msg_dds__SetPoint_;         ///< the planner's set 
 using RobotStateMsg = viewline_msg_dds__RobotState_;     ///< the robot's state
 using ObjectTruthMsg = viewline_msg_dds__ObjectTruth_;   ///< the world's true object
 using NodeHealthMsg = viewline_msg_dds__NodeHealth_;     ///< a node's health and rig hash
+using EpisodeMsg = viewline_msg_dds__Episode_;           ///< a throw of a simulated session
 using TimeMsg = builtin_interfaces_msg_dds__Time_;       ///< builtin_interfaces/Time
 
 /// Track status in TrackState_.status.

@@ -3,17 +3,24 @@
 //
 //   world    simulated time on rt/clock (ticks of tick_s, paced at `realtime` x wall clock) and
 //            the true ball on rt/viewline/truth; waits until `expect` nodes follow its clock, runs
-//            `duration_s` of simulated time, then publishes Finished in its health (every node ends)
+//            `throws` episodes of `duration_s` of simulated time (throw i of the session is the
+//            in-process session's throw i, released release_s into its episode, announced on
+//            rt/viewline/episode), then publishes Finished in its health (every node ends). It
+//            scores each throw as the in-process loop does (scenarios::scoreThrow's rules): the
+//            robot's state at the true crossing against the clearance, and the reachability
+//            oracle from the first detection of the ball
 //   camera   a free-running camera over the world's truth publishing rt/viewline/detections: the
 //            generator's noisy projection (nodes::DetectionGenerator), or (render) the image
 //            rendered by the simulator and the scenario's ball detector; its writer asserts
 //            liveliness (lease dds::Qos::kCameraLeaseS)
-//   tracker  viewline's multi-view tracker and the catch planner, built from the scenario config
-//            as the ball-catching loop builds them; publishes rt/viewline/track and, every control
+//   tracker  viewline's multi-view tracker, the flight fit and the catch planner, built from the
+//            scenario config as the ball-catching loop builds them, afresh for every episode;
+//            publishes rt/viewline/track and, every control
 //            period of simulated time, rt/viewline/setpoint; reports each camera's delivery delay
 //            and notes a camera that leaves (liveliness lost)
-//   robot    the scenario's simulated Cartesian robot executing the set points; publishes
-//            rt/viewline/robot_state; halts when set points miss their deadline
+//   robot    the scenario's simulated Cartesian robot executing the set points, back at home at
+//            each episode's start; publishes rt/viewline/robot_state; halts when set points miss
+//            their deadline
 //
 // Time: every node follows the world's simulated clock (the latest rt/clock sample, advanced by
 // the wall time elapsed since it times `realtime`). Every node publishes its health on
@@ -39,7 +46,8 @@ struct NodeOptions {
   int domain = -1;               ///< DDS domain id (< 0: the one CYCLONEDDS_URI configures)
   double realtime = 1.0;         ///< simulated seconds per wall second
   double tick_s = 0.002;         ///< world: simulated clock period, s
-  double duration_s = 1.5;       ///< world: simulated time to run, s
+  double duration_s = 1.5;       ///< world: simulated time to run per throw (one episode), s
+  int throws = 1;                ///< world: throws in the session, one episode of duration_s each
   double release_s = 0.2;        ///< world: release time of the throw on the simulated clock, s
   int expect = 0;                ///< world: nodes that must follow the clock before it starts
   double pixel_sigma = 0.5;      ///< camera: pixel noise std, px
@@ -51,6 +59,10 @@ struct NodeOptions {
   double setpoint_deadline_s = 0.1;  ///< set-point deadline, s of wall time (robot halts past it)
   double max_wall_s = 60.0;      ///< any node ends after this much wall time, s
   std::string summary_path;      ///< JSON summary written here at the end ("" : none)
+  /// tracker: CSV written here with one row per fused detection ("" : none): the update time and
+  /// the detection's camera, capture stamp and delay (s of simulated time), the ball's estimated
+  /// world position (m) and its standard deviation (m, root of the position covariance's trace)
+  std::string track_log_path;
 };
 
 /// The world node (header comment); returns its summary.

@@ -41,6 +41,17 @@
 // displacement is stopped while the motion along it proceeds), never faster than the true optimum.
 // When |v0| = V exactly the weights are forced to w_k = |v0·e_k| / V, which is still feasible:
 // axis 1 keeps at most its current speed and axis 2 only has to stop and come back.
+// That family turns slowly: at full speed the weights pin axis 1 to V cos θ and axis 2 brakes at
+// A sin θ, so a re-plan that turns the goal by θ loses ~(1 − cos θ) V/A and more per re-plan.
+// planEuclidean therefore also tries a second family and keeps the faster: the velocity chord.
+//   phase 1  0 <= t < t1:  constant acceleration A (V u − v0) / |V u − v0| (the straight chord in
+//                          velocity space from v0 to the cruise velocity V u; the chord stays in the
+//                          disc |v| <= V, which is convex), t1 = |V u − v0| / A;
+//   phase 2:               cruise at V u;   phase 3: brake at −A u for V / A.
+// The direction u must make the straight cruise line hit the goal: u = (pf − p1) / |pf − p1| with
+// p1 = p0 + (v0 + V u) t1 / 2 (fixed-point iteration; it contracts while |pf − p1| is large against
+// the ≤ 2 V² / A of phase 1). It applies when |pf − p1| >= V² / (2A) (the cruise is reached);
+// from rest it is the same straight bang-coast-bang line.
 
 #include <Eigen/Core>
 #include <optional>
@@ -69,6 +80,9 @@ public:
   double duration() const { return T_; }
   /// Cruise velocity vc of phase 2 (m/s, signed).
   double cruiseVelocity() const { return vc_; }
+  /// A profile of given phases: acceleration s1 for t1 (m/s², s), cruise at v0 + s1 t1 for tc,
+  /// acceleration s3 for t3, then at rest where it ends up (the caller keeps it within limits).
+  static AxisProfile fromPhases(double p0, double v0, double s1, double t1, double tc, double s3, double t3);
 
 private:
   double p0_ = 0.0, v0_ = 0.0, pf_ = 0.0, a_ = 1.0, vc_ = 0.0;

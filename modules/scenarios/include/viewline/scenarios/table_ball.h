@@ -42,12 +42,17 @@
 //   per set-point step (|Δ| >= min_step): overshoot_pct = 100 · max over the window of the
 //     position's excursion past the new set point along the step direction / |Δ|;
 //     settling_time_s = time after the change until the stepped coordinate (p − ref)·Δ/|Δ| stays
-//     within 2 % of |Δ| (the classic step-response definition; settling_time_2d_s uses |p − ref|
-//     and so also counts cross-axis errors);
+//     within 2 % of |Δ| (the classic step-response definition); settling_time_2d_s: until |p − ref|
+//     stays within max(2 % of |Δ|, settle_min_band = 2 mm), so it counts cross-axis errors too;
 //     steady_state_error_mm = mean |p − ref| over the last `steady_window` s before the next
 //     event. The summary reports the worst step.
 //   push_recovery_s         time after a push until |p − ref| stays within `push_band`
 //                           (worst push).
+//   nis_sampled             the filter's NIS every `nis_spacing` s (2 dof; the measurement errors
+//                           decorrelate within about 5 frames) against its two-sided 99 % band
+//   nees_position_velocity  (p, v) error against the truth in units of the filter's covariance
+//                           (4 dof) every `nees_spacing` s, against its band; a sample due in the
+//                           frame of a push waits two frames (no image has shown the push yet).
 //   frame_time_ratio_to_reference  mean per-frame cost of the observer (detection + filter)
 //     divided by that of the plain OpenCV reference of [M]'s steps (vision::referenceTableScene,
 //     full frame, fresh buffers) + the same filter step, both timed on every frame of the run

@@ -13,6 +13,7 @@
 
 #include <atomic>
 #include <functional>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -72,10 +73,17 @@ struct AutotuneSessionOptions {
   std::uint64_t record_seed = 1000;  ///< seed of the live recording
   int record_runs = 1;        ///< runs of the live recording
   double start_scale = 1.0;   ///< start from the config's noise values times this
+  /// Start values by config key, used as given (e.g. for a noise the config sets to 0, which a
+  /// log-space search cannot start from).
+  std::map<std::string, double> start_values;
   double outlier_prior = 0.05;  ///< AutotuneOptions::outlier_prior
   double span_decades = 2.5;  ///< AutotuneOptions::span_decades
   int grid_points = 11;       ///< AutotuneOptions::grid_points
-  int verify_runs = 0;        ///< > 0: live runs of the tuned config for NEES/NIS (seeds 1..n)
+  int verify_runs = 0;        ///< > 0: live runs of the start and tuned configs for NEES/NIS (base seed below)
+  /// Seed of the fresh-seed check (a new recording replayed at the tuned noise) and base seed of the
+  /// live runs; 0: record_seed + 1 for the check, 1 for the live runs. Must differ from record_seed
+  /// when the data are recorded live.
+  std::uint64_t verify_seed = 0;
   int workers = 0;            ///< threads; 0: all cores
   std::string out_dir = "tune_autotune";  ///< folder of every output (created)
   std::vector<std::string> set;  ///< --set edits of the config (see SessionOptions::set)
@@ -84,6 +92,23 @@ struct AutotuneSessionOptions {
 };
 /// Noise auto-tuning with its report and tuned config; returns the summary (also summary.json).
 nlohmann::json runAutotuneSession(const AdapterRegistry& registry, const AutotuneSessionOptions& options);
+
+/// What a consistency check runs: a config as it is, on fresh seeds.
+struct CheckOptions {
+  std::string scenario;        ///< adapter name
+  std::string config;          ///< scenario YAML (as shipped, or with --set edits)
+  std::uint64_t seed = 2;      ///< base seed: runs use deriveSeed(seed, 0..seeds-1)
+  int seeds = 3;               ///< seeded runs pooled
+  int workers = 0;             ///< threads; 0: all cores
+  std::string out_dir;         ///< "" : no files; else summary.json there
+  std::vector<std::string> set;  ///< --set edits of the config (see SessionOptions::set)
+  AdapterOptions adapter_options;  ///< --option values (checked against the adapter's declarations)
+  bool quiet = false;          ///< no progress lines on stderr
+};
+/// NIS and NEES of the config's filter pooled over seeded runs, each mean with its two-sided
+/// chi-square band at the scenario's confidence and a verdict (Consistency); returns the summary
+/// (keys check_nis / check_nees {mean, bounds, samples, verdict}, check_verdict, metrics).
+nlohmann::json runCheckSession(const AdapterRegistry& registry, const CheckOptions& options);
 
 /// "1.23 0.98 0.50" (the 1, 5, 15 minute load averages) or "" when unavailable.
 std::string loadAverage();

@@ -124,6 +124,10 @@ struct BallCatchingConfig {
   double prediction_lead_s = 0.2;    ///< the early-prediction metric uses the last prediction this long before the crossing
   vision::BallDetectorConfig detector;  ///< colour segmentation of the ball in every frame
   double sigma_px_floor = 0.3;       ///< px, floor of the measurement std given to the tracker
+  /// px per axis: the detector's measured std (the summary's detection_error_px_rms on seeds the
+  /// tracker is not scored on), told to the tracker instead of the blob's own covariance; 0: the
+  /// blob covariance floored by sigma_px_floor.
+  double sigma_px = 0.0;
   /// px per axis: white Gaussian noise added to every detected pixel (pixel-noise table; 0: none).
   /// The tracker is told: its σ is the detector's σ and this one added in quadrature. Drawn from
   /// its own stream (deriveSeed(throw seed, 0xD37)), so the rest of a throw is unchanged.

@@ -21,6 +21,19 @@
 // The fit is used once it has min_images images from min_cameras cameras (before that the
 // depth along a single viewline is not determined); the tracker still gates every image, and a
 // new track (tracker seed or restart) starts a new fit.
+//
+// Prior of the throws (optional; what the catcher knows about throws before any image): a
+// Gaussian on the state at the first image, x_ref ~ N(x0, diag(σ_p², σ_v²)) (the release region
+// and the launch velocities), and one on where the flight crosses the box plane, c(x_ref) ~
+// N(aim centre, σ_aim² I) in the plane (the aim disc). Both enter the normal equations as
+// pseudo-measurements (maximum a posteriori Gauss-Newton):
+//     H = Σ J_iᵀ J_i / σ_i² + P0⁻¹ + J_cᵀ J_c / σ_aim²,
+//     b = Σ J_iᵀ r_i / σ_i² + P0⁻¹ (x0 − x_ref) + J_cᵀ Eᵀ (c0 − c(x_ref)) / σ_aim²,
+// with E the plane's in-plane basis, J_c = Eᵀ A Φ(τ, t_ref)_{p rows}, A = I − v nᵀ / (n·v) the
+// oblique projection onto the plane along the crossing velocity v (planning/crossing.h), τ the
+// crossing time. With the prior the six unknowns are determined from the first image on, so the
+// fit can be used at once (min_images 1, min_cameras 1): the first images give a crossing with an
+// honest covariance instead of waiting for a determined track.
 
 #include <Eigen/Core>
 #include <cstddef>
@@ -39,6 +52,20 @@ struct FlightFitConfig {
   int min_images = 8;    ///< fused images before the fit is used
   int min_cameras = 2;   ///< distinct cameras among them
   int max_iterations = 3;  ///< Gauss-Newton iterations per new image (warm-started)
+  /// Prior mean of the state at the first image: position (m, world) and velocity (m/s, world).
+  Eigen::Matrix<double, 6, 1> prior_mean = Eigen::Matrix<double, 6, 1>::Zero();
+  /// Prior std per state component (m, m/s); all zero: no state prior.
+  Eigen::Matrix<double, 6, 1> prior_std = Eigen::Matrix<double, 6, 1>::Zero();
+  /// Std per in-plane axis of where throws cross the box plane around the aim centre, m (0: no aim prior).
+  double aim_prior_std = 0.0;
+  /// True when any prior is configured (then fewer than six images may be used).
+  bool hasPrior() const { return aim_prior_std > 0.0 || prior_std.maxCoeff() > 0.0; }
+};
+
+/// The plane the throws aim at (the box plane through the hole's home) and its centre.
+struct FitAimPlane {
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();  ///< aim centre (the hole's home), world, m
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitX();  ///< unit normal towards the thrower, world
 };
 
 /// One fused image of the track: camera, capture stamp, pixel and its std.
@@ -54,7 +81,9 @@ class FlightFit {
 public:
   /// `cameras`: the estimator's cameras (calibrated / registered), indexed by FitImage::camera;
   /// `model`: gravity and drag of the flight (its q is ignored).
-  FlightFit(FlightFitConfig cfg, std::vector<core::Camera> cameras, estimation::DragBallisticModel model);
+  /// `aim`: the plane of the aim prior (used when cfg.aim_prior_std > 0).
+  FlightFit(FlightFitConfig cfg, std::vector<core::Camera> cameras, estimation::DragBallisticModel model,
+            FitAimPlane aim = {});
   /// Forget the track (a new one starts).
   void reset();
   /// Adds a fused image; `guess` (the tracker's estimate, x = (p, v)) seeds the first solve.
@@ -65,7 +94,11 @@ public:
 
 private:
   bool solve();
+  void addPrior(const Eigen::Matrix<double, 6, 1>& x, Eigen::Matrix<double, 6, 6>& H,
+                Eigen::Matrix<double, 6, 1>& b) const;
   FlightFitConfig cfg_;
+  FitAimPlane aim_;
+  Eigen::Matrix<double, 3, 2> E_ = Eigen::Matrix<double, 3, 2>::Zero();  ///< in-plane basis of the aim plane
   std::vector<core::Camera> cams_;
   estimation::DragBallisticModel model_;
   std::vector<FitImage> images_;  ///< sorted by stamp

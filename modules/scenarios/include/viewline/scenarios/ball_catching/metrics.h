@@ -37,6 +37,11 @@
 
 namespace viewline::scenarios {
 
+/// Fused images of a track before its accepted images count in the NIS statistics.
+constexpr int kConsistencyBurnIn = 4;
+/// A throw's NEES sample is taken after this many fused images.
+constexpr int kNeesFusedImage = 8;
+
 /// Everything one throw measured: the draw, the truth, what the tracker and planner did, the
 /// outcome (world frame, s and m unless the name says otherwise).
 struct ThrowResult {
@@ -59,6 +64,18 @@ struct ThrowResult {
       detections = 0,  ///< images in which the detector found the ball
       fused = 0,       ///< detections the tracker fused
       gated = 0;       ///< detections the tracker's gate rejected
+  /// Sum over the detections of the squared per-axis pixel error (before the extra detection
+  /// noise) against the estimator camera's projection of the true ball at the stamp, px².
+  double detection_sq_error_px2 = 0.0;
+  /// Sum over the detections of the per-axis std the tracker was told, squared, px².
+  double told_variance_px2 = 0.0;
+  int detection_errors = 0;  ///< detections in detection_sq_error_px2 (each contributes 2 axes)
+  /// The tracker's NIS (dᵀ S⁻¹ d, 2 dof) of every accepted image once its track has
+  /// kConsistencyBurnIn fused images (the tuning adapter's count).
+  std::vector<double> nis;
+  /// The tracker's NEES (position and velocity, 6 dof) against the true flight after the
+  /// kNeesFusedImage-th fused image (-1: the throw had fewer, or the object is not a ball).
+  double nees = -1.0;
   double t_first_detection = -1.0;                      ///< s, first detection's stamp (-1: none)
   double t_first_move = -1.0;                           ///< planner's first move towards a target
   bool had_target = false,  ///< the planner had a crossing target at some point
@@ -109,6 +126,19 @@ struct CatchSummary {
   int frames = 0,      ///< images over all throws and cameras
       detections = 0;  ///< of which the ball was detected in
   double detection_rate = 0.0;  ///< detections / frames
+  /// RMS per pixel axis of the detections against the estimator cameras' projection of the true
+  /// ball (before the extra detection noise): the detector's own error as the tracker sees it, px.
+  double detection_error_px_rms = 0.0;
+  /// RMS per pixel axis of the std the tracker was told, without the extra noise's share, px.
+  double told_sigma_px_rms = 0.0;
+  double nis_mean = 0.0;  ///< mean of every throw's NIS samples (2 dof)
+  int nis_samples = 0;    ///< how many
+  double nis_band_lo = 0.0;  ///< lower end of the two-sided 99 % chi-square band of nis_mean
+  double nis_band_hi = 0.0;  ///< upper end of that band
+  double nees_mean = 0.0;  ///< mean of the throws' NEES samples (6 dof)
+  int nees_samples = 0;    ///< how many (one per throw)
+  double nees_band_lo = 0.0;  ///< lower end of the two-sided 99 % chi-square band of nees_mean
+  double nees_band_hi = 0.0;  ///< upper end of that band
   std::optional<RegistrationResult> registration;  ///< the camera registration, when enabled
   double launch_speed_min = 0.0,   ///< m/s, over the throws
          launch_speed_max = 0.0,   ///< m/s

@@ -78,8 +78,14 @@ struct MobileCaptureConfig {
 
   // Detection.
   vision::BallDetectorConfig detector;  ///< red HSV range etc. (set in defaults())
-  double pixel_sigma = 1.0;             ///< px, blob centre noise used for the measurement covariance
-  double floor_sigma = 0.01;            ///< m, added floor-position std (blob centroid vs centre)
+  double pixel_sigma = 1.0;             ///< px, white blob-centre noise: R = σ² J Jᵀ (J the ground-projection Jacobian)
+  /// m, std of the blob centroid's offset from the box centre on the floor: a bias (it follows the
+  /// view, not the frame), reported in the object's covariance, not in R.
+  double floor_sigma = 0.01;
+  /// rad, std of the calibrated camera-to-ground rotation about each world axis (a bias of every
+  /// floor point, through ∂z/∂pose; reported in the object's covariance, not in R).
+  double calibration_angle_sigma = 0.0;
+  double calibration_height_sigma = 0.0;  ///< m, std of the calibrated camera height (a bias, as above)
   double object_height = 0.05;          ///< m: measurements on the plane z = height / 2
 
   // Estimation: the target track (keys filter.q_v, q_w, init_speed_sigma, init_turn_sigma,

@@ -6,12 +6,14 @@
 #include <cstdint>
 #include <functional>
 #include <limits>
+#include <optional>
 #include <opencv2/core.hpp>
 #include <vector>
 
 #include "viewline/runtime/scheduler.h"
 #include "viewline/runtime/telemetry.h"
 #include "viewline/scenarios/mobile_capture/config.h"
+#include "viewline/scenarios/mobile_capture/world.h"
 #include "viewline/tracking/track_gate.h"
 
 namespace viewline::scenarios {
@@ -38,6 +40,10 @@ struct MobileCaptureFrame {
   robots::PanTiltJoints joints;             ///< head joints (tilt, pan), rad
   Eigen::Vector2d object_true = Eigen::Vector2d::Zero();  ///< true object position, m (world floor)
   bool fused = false;  ///< this frame's measurement is in the track (Start or Accept)
+  /// The floor measurement of the detection with its white and bias parts (empty: none this frame).
+  std::optional<mobile_capture::FloorMeasurement> measurement;
+  /// m², bias covariance B of the latest detection: the object's position covariance is P_s + B.
+  Eigen::Matrix2d bias_cov = Eigen::Matrix2d::Zero();
   /// NIS of this frame's measurement from the track's update report (2 dof, S = R + P_pos),
   /// fused or gated out; NaN without a measurement or without a live track to test it against.
   double nis = std::numeric_limits<double>::quiet_NaN();
@@ -83,8 +89,20 @@ struct MobileCaptureRun {
   double longest_lost = 0.0;           ///< s, longest gap between detections after the first one
   LocalizationErrors localization;     ///< ground-localisation errors over the run's detections
   tracking::GateCounts gate;           ///< the track's gate decisions
+  /// Consistency of the track once it has been valid for kConsistencySettle s: NIS (2 dof) of every
+  /// tested detection, and position NEES (2 dof, e = p̂ − p against P_s + B) every kNeesSpacing s.
+  double nis_sum = 0.0;
+  long nis_count = 0;     ///< NIS samples in nis_sum
+  double nees_sum = 0.0;  ///< Σ of the position NEES samples
+  long nees_count = 0;    ///< NEES samples in nees_sum
   bool interrupted = false;            ///< a stop request (signal, closed view) ended the run early: not scored
 };
+
+/// s a track must have been valid before its NIS and NEES samples count (the two-point start's
+/// prior still dominates before).
+inline constexpr double kConsistencySettle = 2.0;
+/// s between position NEES samples of a run (errors of one track are correlated over time).
+inline constexpr double kNeesSpacing = 1.0;
 
 /// One run of our loop and of the oracle with the same object path (seed). A stop request
 /// (core::interruptRequested(), the view's quit) ends it early with `interrupted` set and no oracle run.

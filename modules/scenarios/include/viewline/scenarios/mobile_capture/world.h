@@ -45,6 +45,25 @@ sim::GroundTargetParams targetParams(const MobileCaptureConfig& cfg, sim::Ground
 /// How long the capture runs' object path must last (the run plus the planner's horizon).
 double targetDuration(const MobileCaptureConfig& cfg);
 
+/// The floor measurement of one detected blob and its two noise parts (see floorMeasurement()).
+struct FloorMeasurement {
+  Eigen::Vector2d z = Eigen::Vector2d::Zero();  ///< m, the pixel back-projected onto the plane (world floor)
+  /// m²/px², J Jᵀ with J = ∂z/∂(u, v) (the ground-projection Jacobian): the white noise is σ_px² J Jᵀ.
+  Eigen::Matrix2d unit_pixel_cov = Eigen::Matrix2d::Zero();
+  /// m², covariance of the slowly varying bias of z: the camera-to-ground calibration (rotation
+  /// and height errors through ∂z/∂(pose)) and the blob centroid's offset from the box centre.
+  Eigen::Matrix2d bias_cov = Eigen::Matrix2d::Zero();
+};
+
+/// The floor point of pixel `uv` seen by `camera` on the plane z = plane_z with its noise model:
+/// white pixel noise mapped by the range-dependent Jacobian J = ∂z/∂(u, v), and a bias
+/// B = Σ_k σ_k² J_k J_kᵀ over the calibrated pose's errors (a rotation of the camera about each world
+/// axis through its centre, σ = calibration_angle_sigma; its height, σ = calibration_height_sigma)
+/// plus floor_sigma² I (centroid offset). Both Jacobians by central differences of the exact
+/// back-projection. Empty when the ray (or a perturbed one) misses the plane.
+std::optional<FloorMeasurement> floorMeasurement(const MobileCaptureConfig& cfg, const core::Camera& camera,
+                                                 const Eigen::Vector2d& uv, double plane_z);
+
 /// A floor point in the robot frame (x forward, y left).
 Eigen::Vector2d toRobot(const robots::BasePose& pose, const Eigen::Vector2d& p_w);
 

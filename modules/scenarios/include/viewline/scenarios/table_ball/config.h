@@ -81,6 +81,9 @@ struct TableBallConfig {
   double warmup = 1.0;                                         ///< s, excluded from the RMSEs
   double min_step = 0.05;                                      ///< m, set-point changes scored as steps
   double settle_fraction = 0.02;                               ///< settling band, fraction of the step size
+  double settle_min_band = 0.002;                              ///< m, the settling band is at least this wide
+  double nis_spacing = 0.1;                                    ///< s between the NIS samples of the consistency band
+  double nees_spacing = 0.5;                                   ///< s between the NEES samples (position, velocity)
   double steady_window = 1.0;                                  ///< s
   double push_band = 0.005;                                    ///< m
   bool compare_tunings = true;                                 ///< run the side filters

@@ -11,6 +11,7 @@
 #include <utility>
 #include <vector>
 
+#include "viewline/estimation/consistency.h"
 #include "viewline/scenarios/table_ball/config.h"
 #include "viewline/scenarios/table_ball/observer.h"
 #include "viewline/sim/physics.h"
@@ -23,7 +24,7 @@ struct StepMetrics {
   double size_m = 0.0;            ///< m, distance between the old and the new set point
   double overshoot_pct = 0.0;     ///< max travel past the new set point along the step, % of size_m
   double settling_time_s = 0.0;   ///< step axis (the stepped coordinate); +inf when it never settles
-  double settling_time_2d_s = 0.0;  ///< same with the 2-D distance (includes the cross axis)
+  double settling_time_2d_s = 0.0;  ///< 2-D distance |p − set point| within max(fraction · step, settle_min_band)
   double steady_state_error_mm = 0.0;  ///< mean |p − set point| over the window's last steady_window, mm
 };
 /// One scored push: how far the ball was knocked from its set point and how long recovery took.
@@ -52,10 +53,17 @@ struct TableBallResult {
   double prediction_rmse_mm_10 = 0.0;           ///< 10-step (0.2 s) prediction vs truth
   double tilt_rmse_deg = 0.0;                   ///< measured table tilt vs truth
   double nis_mean = 0.0;                         ///< mean NIS of the ball measurements after warmup (2 dof: 2 expected)
+  /// NIS of the ball updates sampled every metrics.nis_spacing after warmup (2 dof each): the
+  /// sample mean and its two-sided 99 % chi-square band (samples spaced to be nearly independent).
+  estimation::ConsistencyStats nis_sampled;
+  /// NEES of the ball position and velocity (4 dof) against the truth, one sample every
+  /// metrics.nees_spacing after warmup (a sample due in the frame of a push waits two frames).
+  estimation::ConsistencyStats nees;
   std::vector<StepMetrics> steps;    ///< every scored step, in time order
   std::vector<PushMetrics> pushes;   ///< every scored push, in time order
   double overshoot_pct = 0.0,          ///< worst step overshoot, %
          settling_time_s = 0.0,        ///< worst step settling time, s (+inf: one never settled)
+         settling_time_2d_s = 0.0,     ///< worst step 2-D settling time, s (+inf: one never settled)
          steady_state_error_mm = 0.0,  ///< worst step steady-state error, mm
          push_recovery_s = 0.0;        ///< worst push recovery time, s (+inf: one never recovered)
   double observer_frame_ms = 0.0,              ///< mean wall-clock per frame of the observer, ms
@@ -124,6 +132,7 @@ private:
   Accumulator obs_, meas_, pred_, tilt_;
   std::vector<Accumulator> side_;
   std::vector<std::pair<double, Eigen::Vector2d>> pending_pred_;  // (time, predicted position N frames ahead)
+  double next_nis_ = 0.0, next_nees_ = 0.0;
   double nis_sum_ = 0.0;
   int nis_n_ = 0;
   double obs_time_ = 0.0, ref_time_ = 0.0, obs_cpu_ = 0.0, ref_cpu_ = 0.0;

@@ -14,9 +14,15 @@
 //     same along the whole side; the object corners are moved accordingly and the pose is
 //     re-solved (Gauss-Newton on the reprojection error from the previous solution, twice).
 //     Without it a 2 cm border seen from a head 0.45 m away tilts the pose by about a degree.
-//  2. ball on the table from its image circle: cone half-angle α, d = r / sin α (the corrected
-//     [M] eq 4.12), p_t = t' + d v1 with t' = −Rᵀ t, v1 = Rᵀ v̂ (vision::ballOnTableKnownRadius);
-//     the unknown-radius variant solves r from z = r first;
+//  2. ball on the table from its image circle, three models: known_radius, cone half-angle α,
+//     d = r / sin α (the corrected [M] eq 4.12), p_t = t' + d v1 with t' = −Rᵀ t, v1 = Rᵀ v̂
+//     (vision::ballOnTableKnownRadius); unknown_radius solves r from z = r first; table_plane
+//     (shipped; ours) uses the cone's axis only: the centre of a ball resting on the table lies
+//     on the plane z = r of the table frame, so p_t = t' + s v1 with s = (r − t'_z) / v1_z
+//     (ballOnTablePlane). The depth then comes from the table pose, not from the circle's size:
+//     α is 0.05 px of a 9 px radius off per 0.5 % (the edge of a shaded, blurred sphere sits a
+//     little inside its limb), and 0.5 % of d ≈ 0.45 m is the 1.5-2 mm depth bias the known-radius
+//     model had; the axis (the mid-point of the radial diameter) is unbiased by such an edge;
 //  3. measured tilt: table_R_world = c_R_tᵀ c_R_w, input a_xy = (5/7)[table_R_world g_w]_xy
 //     (estimation::rollingBallAcceleration). Without a table pose the last one is kept;
 //  4-5. tracking::RollingBallTracker: the rolling-ball filter (estimation::RollingBallModel)
@@ -48,6 +54,13 @@ Eigen::Isometry3d borderAwareTablePose(const core::Camera& camera, const std::ar
                                        const Eigen::Isometry3d& c_M_t, double side, double border_height,
                                        int iterations = 2);
 
+/// Ball centre on the table (m, table frame; z = r) from its image circle by the table-plane
+/// model (step 2): the cone axis through the circle's radial diameter meets the plane z = r of
+/// the table pose c_M_t. Nullopt when the axis is parallel to the table or meets it behind the
+/// camera.
+std::optional<Eigen::Vector3d> ballOnTablePlane(const core::Camera& camera, const vision::Circle& circle,
+                                                const Eigen::Isometry3d& c_M_t, double ball_radius);
+
 /// Tilt angles (θx, θy) of a table whose orientation in the world is w_R_t = Rx(θx) Ry(θy)
 /// (robots::TableTilt convention): θx = atan2(R21, R11), θy = atan2(R02, R00).
 Eigen::Vector2d tiltFromTableRotation(const Eigen::Matrix3d& w_R_t);
@@ -61,12 +74,13 @@ enum class TablePoseSource {
 enum class BallGeometry {
   KnownRadius,    ///< d = r / sin α with the configured radius ([M] eq 4.12, corrected)
   UnknownRadius,  ///< r solved from the contact condition z = r first
+  TablePlane,     ///< the cone's axis meets the plane z = r of the table (depth from the table pose)
 };
 
 /// Settings of TableBallObserver.
 struct TableBallObserverConfig {
   TablePoseSource table_pose = TablePoseSource::Corners;  ///< corners ([M]) or AprilTags
-  BallGeometry ball_geometry = BallGeometry::KnownRadius;  ///< known or unknown ball radius
+  BallGeometry ball_geometry = BallGeometry::TablePlane;  ///< how the ball's depth is found
   vision::TableDetectorConfig detector;               ///< colours, kernels, refine, L, r
   double border_height = 0.02;                        ///< m, raised border above the surface (0: plain [M] PnP)
   std::vector<vision::TagOnTable> tag_layout;         ///< AprilTag alternative: tags in the table frame

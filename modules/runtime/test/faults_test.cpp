@@ -1,0 +1,167 @@
+// The fault-injecting source decorator: each fault kind changes exactly the frames of its camera
+// and window, counts them, and leaves every other frame as the inner source made it.
+#include <gtest/gtest.h>
+
+#include <opencv2/core.hpp>
+
+#include "viewline/core/error.h"
+#include "viewline/io/config.h"
+#include "viewline/runtime/faults.h"
+
+namespace viewline::runtime {
+namespace {
+
+// Two cameras at 50 Hz, interleaved (camera 1 half a period after camera 0); each image is
+// filled with its frame's sequence number, and the stamp is the capture time plus 1 ms.
+class TwoCameras : public FrameSource {
+public:
+  explicit TwoCameras(int frames_per_camera) : n_(2 * frames_per_camera) {}
+  std::size_t cameraCount() const override { return 2; }
+  std::optional<core::Timestamp> nextReadyTime() const override {
+    if (i_ >= n_) return std::nullopt;
+    return time(i_);
+  }
+  std::optional<Frame> grab() override {
+    Frame f;
+    f.camera = static_cast<std::size_t>(i_ % 2);
+    f.sequence = static_cast<std::uint64_t>(i_ / 2);
+    f.capture_time = time(i_);
+    f.stamp = f.capture_time + 0.001;
+    f.image = cv::Mat(4, 4, CV_8UC1, cv::Scalar(static_cast<double>(f.sequence % 256)));
+    ++i_;
+    return f;
+  }
+
+private:
+  static double time(int i) { return 0.01 * i; }  // 0.02 s per camera, 0.01 s apart
+  int n_, i_ = 0;
+};
+
+std::vector<Frame> drain(FrameSource& s, int* lost = nullptr) {
+  std::vector<Frame> out;
+  while (s.nextReadyTime()) {
+    if (auto f = s.grab()) out.push_back(*f);
+    else if (lost) ++*lost;
+  }
+  return out;
+}
+
+TEST(FaultInjectingSource, WithoutFaultsEveryFrameIsTheInnerOne) {
+  TwoCameras inner(50), ref(50);
+  FaultInjectingSource s(inner, {}, 1);
+  const std::vector<Frame> got = drain(s), want = drain(ref);
+  ASSERT_EQ(got.size(), want.size());
+  for (std::size_t i = 0; i < got.size(); ++i) {
+    EXPECT_EQ(got[i].stamp, want[i].stamp);
+    EXPECT_EQ(cv::countNonZero(got[i].image != want[i].image), 0);
+  }
+  EXPECT_EQ(s.counters().touched, 0u);
+}
+
+TEST(FaultInjectingSource, FreezeRepeatsTheLastGoodImageOfThatCameraWithNewStamps) {
+  TwoCameras inner(50);
+  // Camera 0 frames at 0.40, 0.42, ..., 0.58 s (sequence 20-29) frozen: they show sequence 19.
+  FaultInjectingSource s(inner, {{FaultKind::Freeze, 0, 0.40, 0.60}}, 1);
+  for (const Frame& f : drain(s)) {
+    const int shown = f.image.at<unsigned char>(0, 0);
+    if (f.camera == 0 && f.sequence >= 20 && f.sequence < 30) {
+      EXPECT_EQ(shown, 19) << f.sequence;
+    } else {
+      EXPECT_EQ(shown, static_cast<int>(f.sequence)) << f.camera << " " << f.sequence;
+    }
+    EXPECT_DOUBLE_EQ(f.stamp, f.capture_time + 0.001);  // new stamps
+  }
+  EXPECT_EQ(s.counters().of(FaultKind::Freeze), 10u);
+  EXPECT_EQ(s.counters().touched, 10u);
+}
+
+TEST(FaultInjectingSource, StampFaultsRepeatOrGoBackFromTheCamerasPreviousStamp) {
+  TwoCameras inner(50);
+  FaultInjectingSource s(inner, {{FaultKind::StampRepeat, 1, 0.205, 0.25}, {FaultKind::StampBackwards, 0, 0.60, 0.61, 0.005}}, 1);
+  double prev1 = -1.0, prev0 = -1.0;
+  for (const Frame& f : drain(s)) {
+    if (f.camera == 1 && f.capture_time >= 0.205 && f.capture_time < 0.25) {
+      EXPECT_DOUBLE_EQ(f.stamp, prev1);  // repeated: the stamp handed out last (also a repeat)
+    } else if (f.camera == 0 && f.capture_time >= 0.60 && f.capture_time < 0.61) {
+      EXPECT_DOUBLE_EQ(f.stamp, prev0 - 0.005);
+      EXPECT_LT(f.stamp, prev0);
+    } else {
+      EXPECT_DOUBLE_EQ(f.stamp, f.capture_time + 0.001);
+    }
+    (f.camera == 0 ? prev0 : prev1) = f.stamp;
+  }
+  // Camera 1 captures at 0.21, 0.23 (odd hundredths); camera 0 at 0.60.
+  EXPECT_EQ(s.counters().of(FaultKind::StampRepeat), 2u);
+  EXPECT_EQ(s.counters().of(FaultKind::StampBackwards), 1u);
+}
+
+TEST(FaultInjectingSource, BlackoutLosesThoseFramesAndTheCameraComesBack) {
+  TwoCameras inner(100);
+  FaultInjectingSource s(inner, {{FaultKind::Blackout, 1, 1.0, 1.5}}, 1);
+  int lost = 0;
+  const std::vector<Frame> got = drain(s, &lost);
+  EXPECT_EQ(lost, 25);  // camera 1 at 1.01, 1.03, ..., 1.49
+  EXPECT_EQ(s.counters().of(FaultKind::Blackout), 25u);
+  bool after = false;
+  for (const Frame& f : got) {
+    EXPECT_FALSE(f.camera == 1 && f.capture_time >= 1.0 && f.capture_time < 1.5);
+    after = after || (f.camera == 1 && f.capture_time >= 1.5);
+  }
+  EXPECT_TRUE(after);  // it came back
+}
+
+TEST(FaultInjectingSource, CorruptImagesAreSeededNoiseOnEveryCameraWithoutACameraIndex) {
+  auto run = [](std::uint64_t seed) {
+    TwoCameras inner(20);
+    FaultInjectingSource s(inner, {{FaultKind::Corrupt, std::nullopt, 0.1, 0.14}}, seed);
+    std::vector<Frame> frames = drain(s);
+    EXPECT_EQ(s.counters().of(FaultKind::Corrupt), 4u);  // 0.10, 0.11, 0.12, 0.13
+    return frames;
+  };
+  const std::vector<Frame> a = run(7), b = run(7), c = run(8);
+  int corrupted = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(cv::countNonZero(a[i].image != b[i].image), 0);  // same seed, same garbage
+    if (a[i].capture_time >= 0.1 && a[i].capture_time < 0.14) {
+      ++corrupted;
+      EXPECT_GT(cv::countNonZero(a[i].image != c[i].image), 0);
+    }
+  }
+  EXPECT_EQ(corrupted, 4);
+}
+
+TEST(FaultInjectingSource, RefusesBadWindowsAndCameras) {
+  TwoCameras inner(5);
+  EXPECT_THROW(FaultInjectingSource(inner, {{FaultKind::Freeze, 0, 1.0, 1.0}}, 1), core::InvalidInput);
+  EXPECT_THROW(FaultInjectingSource(inner, {{FaultKind::Freeze, 2, 0.0, 1.0}}, 1), core::InvalidInput);
+  EXPECT_THROW(FaultInjectingSource(inner, {{FaultKind::StampBackwards, 0, 0.0, 1.0, 0.0}}, 1), core::InvalidInput);
+}
+
+TEST(FaultConfig, ReadsTheListAndNamesTheBadKey) {
+  const io::ConfigNode root = io::ConfigNode::fromString(
+      "faults:\n"
+      "  - {kind: freeze, camera: 0, from_s: 2.0, to_s: 2.2}\n"
+      "  - {kind: stamp_backwards, from_s: 4.0, to_s: 4.05, step_s: 0.02}\n",
+      "faults.yaml");
+  const std::vector<FaultSpec> f = readFaultConfig(root);
+  ASSERT_EQ(f.size(), 2u);
+  EXPECT_EQ(f[0].kind, FaultKind::Freeze);
+  EXPECT_EQ(f[0].camera, std::optional<std::size_t>(0));
+  EXPECT_DOUBLE_EQ(f[0].to_s, 2.2);
+  EXPECT_EQ(f[1].kind, FaultKind::StampBackwards);
+  EXPECT_FALSE(f[1].camera.has_value());
+  EXPECT_DOUBLE_EQ(f[1].step_s, 0.02);
+  EXPECT_TRUE(readFaultConfig(io::ConfigNode::fromString("a: 1\n", "none.yaml")).empty());
+  try {
+    readFaultConfig(io::ConfigNode::fromString("faults:\n  - {kind: freeze, from_s: 2.0, to_s: 1.0}\n", "bad.yaml"));
+    FAIL() << "a window ending before it starts was accepted";
+  } catch (const core::InvalidInput& e) {
+    EXPECT_NE(std::string(e.what()).find("bad.yaml"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("to_s"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(readFaultConfig(io::ConfigNode::fromString("faults:\n  - {kind: melt, from_s: 0, to_s: 1}\n", "k.yaml")),
+               core::InvalidInput);
+}
+
+}  // namespace
+}  // namespace viewline::runtime
