@@ -433,3 +433,49 @@ TEST(PlanarTargetFilter, MixtureFavoursTheTurnOnACircleAndTheLegsOnASquare) {
   EXPECT_EQ(f.stateDim(), 4);
   EXPECT_EQ(f.estimate().x().size(), 4);
 }
+
+TEST(PlanarTargetFilter, MixtureGatesEveryPartOnTheMixturesPrediction) {
+  // One gate for the mixture: a 1 m outlier it rejects is fused by no part (the estimate stays the
+  // prediction, within the chain's small shift of the probabilities), and reinit_after rejections in a
+  // row restart every part at the measurement.
+  tracking::TargetFilterConfig c;
+  c.model = tracking::TargetModel::Mixture;
+  c.q = 1e-5;
+  c.ct_q_accel = c.ct_q_omega = 1e-6;
+  c.init_velocity_sigma = 0.3;
+  c.jump_window = 3.0;
+  c.jump_min_samples = 8;
+  c.jump_rate = 1.0;
+  c.jump_decision = "posterior";
+  c.jump_evidence = "legs";
+  c.constant_speed = true;
+  c.jump_corner_sigma = 0.01;
+  c.reinit_after = 3;
+  const auto circle = [](double t) { return Eigen::Vector2d(0.3 * std::cos(0.5 * t), 0.3 * std::sin(0.5 * t)); };
+  const Eigen::Matrix2d R = 0.03 * 0.03 * Eigen::Matrix2d::Identity();
+  for (const Eigen::Vector2d& offset : {Eigen::Vector2d(1.0, 0.0), Eigen::Vector2d(0.0, -1.0)}) {
+    tracking::PlanarTargetFilter f(c);
+    core::Rng rng = core::makeRng(5);
+    const auto noisy = [&](double t) {
+      return Eigen::Vector2d(circle(t) + Eigen::Vector2d(core::gaussian(rng, 0.03), core::gaussian(rng, 0.03)));
+    };
+    int k = 0;
+    for (; k < 240; ++k) f.update(k / 30.0, noisy(k / 30.0), R);
+    const double t_o = k / 30.0;
+    const Eigen::Vector2d predicted = f.at(t_o).p;
+    const tracking::PlanarTargetFilter::Update u = f.update(t_o, noisy(t_o) + offset, R);
+    ASSERT_TRUE(u.decision.has_value());
+    EXPECT_EQ(*u.decision, tracking::GateDecision::Reject);
+    EXPECT_FALSE(u.accepted);
+    EXPECT_GT(u.nis, f.gateThreshold());
+    EXPECT_LT((f.at(t_o).p - predicted).norm(), 0.005) << "the rejected outlier moved the estimate";
+    for (++k; k < 270; ++k) EXPECT_TRUE(f.update(k / 30.0, noisy(k / 30.0), R).accepted) << k;
+    // The target jumps by `offset` for good: two rejections, then the restart at the third.
+    std::vector<tracking::GateDecision> seen;
+    for (int i = 0; i < 3; ++i, ++k) seen.push_back(*f.update(k / 30.0, noisy(k / 30.0) + offset, R).decision);
+    EXPECT_EQ(seen, (std::vector<tracking::GateDecision>{tracking::GateDecision::Reject, tracking::GateDecision::Reject,
+                                                         tracking::GateDecision::Restart}));
+    EXPECT_LT((f.at((k - 1) / 30.0).p - (circle((k - 1) / 30.0) + offset)).norm(), 0.15);
+    EXPECT_EQ(f.gateCounts().restarts, 1u);
+  }
+}

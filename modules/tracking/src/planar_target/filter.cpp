@@ -141,6 +141,8 @@ void PlanarTargetFilter::setParticleState() {
 void PlanarTargetFilter::reset(core::Timestamp t, const Eigen::Vector2d& z, const Eigen::Matrix2d& R) {
   if (!parts_.empty()) {  // the model probabilities are kept: a lost target has not changed its motion
     for (PlanarTargetFilter& f : parts_) f.reset(t, z, R);
+    gate_.drop();  // the mixture's gate, the one that decides for every part, starts at t
+    gate_.decide(t, 0.0);
     initialized_ = true;
     setMixtureState(t);
   } else {
@@ -185,6 +187,12 @@ void PlanarTargetFilter::start(core::Timestamp t, const Eigen::Vector2d& z, cons
 
 PlanarTargetFilter::Update PlanarTargetFilter::update(core::Timestamp t, const Eigen::Vector2d& z,
                                                       const Eigen::Matrix2d& R) {
+  return updateUnder(t, z, R, std::nullopt);
+}
+
+PlanarTargetFilter::Update PlanarTargetFilter::updateUnder(core::Timestamp t, const Eigen::Vector2d& z,
+                                                           const Eigen::Matrix2d& R,
+                                                           std::optional<GateDecision> decided) {
   output_.reset();
   if (!parts_.empty()) return updateMixture(t, z, R);
   if (config_.model == TargetModel::WaypointParticles) {
@@ -209,7 +217,7 @@ PlanarTargetFilter::Update PlanarTargetFilter::update(core::Timestamp t, const E
     return out;
   }
   corners_.note(t, R);
-  Update out = step(t, z, R);
+  Update out = step(t, z, R, decided);
   count(out);
   if (out.accepted) region_.check(z, R);
   // Gated-out measurements are kept for the jump test too: after a sharp corner the first
@@ -218,6 +226,12 @@ PlanarTargetFilter::Update PlanarTargetFilter::update(core::Timestamp t, const E
   history_.push_back(snapshot(t, z, R));
   while (history_.size() > 1 && history_.front().t < t - config_.jump_window) history_.erase(history_.begin());
   out.jump = detectJump();
+  // A mixture part under a rejection (the mixture's gate took the measurement for an outlier): the soft
+  // jump mixture would re-run its corner hypotheses through it and move the estimate, so the estimate
+  // stays the coasted prediction. The measurement stays in the history: if later measurements confirm
+  // a corner, it is part of that evidence; a declared jump (above) re-processes it under this filter's
+  // own gate, as for a cv filter alone.
+  if (decided && *decided == GateDecision::Reject && !out.jump) output_.reset();
   return out;
 }
 
@@ -243,8 +257,8 @@ void PlanarTargetFilter::count(const Update& u) {
 }
 
 bool PlanarTargetFilter::admit(Update& out, core::Timestamp t, const Eigen::Vector2d& z, const Eigen::Matrix2d& R,
-                               const estimation::StateEstimate* coast) {
-  out.decision = gate_.decide(t, out.nis);
+                               const estimation::StateEstimate* coast, std::optional<GateDecision> decided) {
+  out.decision = decided ? *decided : gate_.decide(t, out.nis);
   if (*out.decision == GateDecision::Accept) return true;
   if (coast != nullptr) state_ = *coast;
   if (*out.decision != GateDecision::Reject) {  // Restart (Start cannot happen: the track is live)
@@ -255,7 +269,7 @@ bool PlanarTargetFilter::admit(Update& out, core::Timestamp t, const Eigen::Vect
 }
 
 PlanarTargetFilter::Update PlanarTargetFilter::step(core::Timestamp t, const Eigen::Vector2d& z,
-                                                    const Eigen::Matrix2d& R) {
+                                                    const Eigen::Matrix2d& R, std::optional<GateDecision> decided) {
   Update out;
   if (!initialized_) {
     start(t, z, R);
@@ -274,7 +288,7 @@ PlanarTargetFilter::Update PlanarTargetFilter::step(core::Timestamp t, const Eig
     if (dt > 1e-9) imm_->predict(t);
     state_ = imm_->combined();
     out.nis = imm_->combinedNis(m);
-    if (!admit(out, t, z, R)) return out;
+    if (!admit(out, t, z, R, nullptr, decided)) return out;
     imm_->update(m);
     state_ = imm_->combined();
     out.accepted = true;
@@ -290,7 +304,7 @@ PlanarTargetFilter::Update PlanarTargetFilter::step(core::Timestamp t, const Eig
     const Eigen::Matrix2d S = pred.P().block(0, 0, 2, 2) + R;
     const Eigen::Vector2d d = z - pred.x().head<2>();
     out.nis = d.dot(S.ldlt().solve(d));
-    if (!admit(out, t, z, R, &pred)) return out;
+    if (!admit(out, t, z, R, &pred, decided)) return out;
     auto leg = std::make_shared<ConstantSpeedLeg>(*leg_);
     leg->add(t, z, R);
     leg_ = leg;
@@ -306,7 +320,7 @@ PlanarTargetFilter::Update PlanarTargetFilter::step(core::Timestamp t, const Eig
   const Eigen::MatrixXd S = estimation::innovationCovariance(state_, m.C, m.R);
   const Eigen::Vector2d d = z - state_.x().head<2>();
   out.nis = d.dot(S.ldlt().solve(d));
-  if (!admit(out, t, z, R)) return out;
+  if (!admit(out, t, z, R, nullptr, decided)) return out;
   estimation::update(state_, m);
   out.accepted = true;
   return out;
@@ -387,6 +401,8 @@ PlanarTargetFilter::Update PlanarTargetFilter::updateMixture(core::Timestamp t, 
   Update out;
   if (!initialized_) {
     for (PlanarTargetFilter& f : parts_) f.update(t, z, R);
+    gate_.drop();
+    gate_.decide(t, 0.0);  // Start
     initialized_ = true;
     setMixtureState(t);
     out.accepted = out.reinitialized = true;
@@ -400,8 +416,7 @@ PlanarTargetFilter::Update PlanarTargetFilter::updateMixture(core::Timestamp t, 
   const double e = 0.5 * (1.0 - std::exp(-2.0 * config_.mixture_switch_rate * dt));
   Eigen::Vector2d prior(part_probability_(0) * (1.0 - e) + part_probability_(1) * e,
                         part_probability_(1) * (1.0 - e) + part_probability_(0) * e);
-  // The predictive likelihood of each part, N(z; p̂ᵢ(t), Pᵢ + R), and the mixture's own NIS: against at(t),
-  // the prediction a consumer (the telemetry's innovation record) sees before the update.
+  // The predictive likelihood of each part, N(z; p̂ᵢ(t), Pᵢ + R).
   Eigen::Vector2d log_like;
   std::vector<Kinematics> ks;
   for (const PlanarTargetFilter& f : parts_) ks.push_back(f.at(t));
@@ -410,24 +425,35 @@ PlanarTargetFilter::Update PlanarTargetFilter::updateMixture(core::Timestamp t, 
     const Eigen::Vector2d d = z - ks[static_cast<std::size_t>(i)].p;
     log_like(i) = -0.5 * d.dot(S.ldlt().solve(d)) - 0.5 * std::log(S.determinant());
   }
+  // ONE gate for the mixture: the NIS of the measurement against the mixture's prediction at(t) (the
+  // prediction a consumer, e.g. the telemetry's innovation record, sees before the update), and every
+  // part takes that decision. Gating each part on its own prediction would let the wider part (ct)
+  // fuse an outlier the leading part rejects, and the mixture's estimate would move by that part's
+  // share although the mixture reports the measurement as rejected (a 1 m outlier moved it 0.28 m).
   const Kinematics mix = mixtureAt(t);
   const Eigen::Vector2d innovation = z - mix.p;
   const double nis = innovation.dot((mix.P_pos + R).ldlt().solve(innovation));
+  const GateDecision decision = gate_.decide(t, nis);
+  // A rejected measurement still goes to each part, without being fused: the cv part keeps it in its
+  // corner history, as a cv filter does with its gated-out measurements (after a sharp corner the first
+  // measurements of the new leg are the ones the gate rejects, and they are the evidence of the corner);
+  // a detected corner then re-processes them under the cv part's own gate. A restart re-initialises
+  // every part at the measurement.
   std::vector<Update> ups;
-  for (PlanarTargetFilter& f : parts_) ups.push_back(f.update(t, z, R));
-  // A measurement every part's gate rejected (an outlier) says nothing about the motion: the
-  // probabilities only take the chain's prediction (otherwise the wider part would win it).
-  const bool evidence = std::any_of(ups.begin(), ups.end(), [](const Update& u) { return u.accepted; });
-  const double top = log_like.maxCoeff();
-  Eigen::Vector2d post = evidence ? Eigen::Vector2d(prior.array() * (log_like.array() - top).exp()) : prior;
-  // Floor: neither model is ever ruled out beyond recovery by one outlier (a corner's first measurements).
+  for (PlanarTargetFilter& f : parts_) ups.push_back(f.updateUnder(t, z, R, decision));
+  // Only a fused measurement is evidence about the motion: a rejected one (an outlier) or a restart
+  // leaves the probabilities at the chain's prediction (otherwise the wider part would win it).
+  Eigen::Vector2d post = prior;
+  if (decision == GateDecision::Accept)
+    post = Eigen::Vector2d(prior.array() * (log_like.array() - log_like.maxCoeff()).exp());
+  // Floor: neither model is ever ruled out beyond recovery by one measurement (a corner's first ones).
   post = (post / post.sum()).cwiseMax(1e-6);
   part_probability_ = post / post.sum();
   setMixtureState(t);
-  // The gate's decision, the corner report and "accepted" are the more probable part's.
-  const std::size_t lead = part_probability_(0) >= part_probability_(1) ? 0 : 1;
-  out = ups[lead];
-  out.jump = ups.front().jump;
+  out.decision = decision;
+  out.accepted = uses(decision);
+  out.reinitialized = decision == GateDecision::Restart;
+  out.jump = ups.front().jump;  // the corner report is the cv part's
   out.nis = nis;
   count(out);
   return out;

@@ -36,9 +36,11 @@
 // N(z; p̂ᵢ, Pᵢ + R) (Bar-Shalom, Li, Kirubarajan 2001, §11.6, the multiple-model estimator without
 // interaction: the cv filter's corner history cannot be mixed). The output (at(), estimate()) is the
 // Gaussian mixture's mean and covariance (spread of the means included); the NIS that update() reports
-// is the measurement's against that mixture's prediction; a measurement every part's gate rejects leaves
-// the probabilities at the chain's prediction. Corner diagnostics (jumps, speed, turns, region) are the
-// cv part's.
+// is the measurement's against that mixture's prediction, and the mixture's gate (gate_probability,
+// reinit_after) decides on it for every part: a measurement it rejects is fused by no part (the cv part
+// keeps it in its corner history, as a cv filter keeps its gated-out measurements) and leaves the
+// probabilities at the chain's prediction; a restart re-initialises every part and keeps the
+// probabilities. Corner diagnostics (jumps, speed, turns, region) are the cv part's.
 
 #include <Eigen/Core>
 #include <cstdint>
@@ -137,11 +139,16 @@ private:
   using Snapshot = PlanarSnapshot;
   /// The old state is dropped: x = (z, 0...), P = diag(R, the motion prior), the gate started at t.
   void start(core::Timestamp t, const Eigen::Vector2d& z, const Eigen::Matrix2d& R);
-  Update step(core::Timestamp t, const Eigen::Vector2d& z, const Eigen::Matrix2d& R);
-  /// The gate on out.nis: true to fuse. Otherwise the state becomes `coast` (if given) and a restart
-  /// re-initialises at the measurement.
+  /// update() under the gate's decision `decided` (a mixture part: the mixture's), or its own gate's (nullopt).
+  Update updateUnder(core::Timestamp t, const Eigen::Vector2d& z, const Eigen::Matrix2d& R,
+                     std::optional<GateDecision> decided);
+  /// One predict-gate-fuse step; `decided` as in updateUnder.
+  Update step(core::Timestamp t, const Eigen::Vector2d& z, const Eigen::Matrix2d& R,
+              std::optional<GateDecision> decided = std::nullopt);
+  /// The gate on out.nis (or the decision `decided`, if given): true to fuse. Otherwise the state becomes
+  /// `coast` (if given) and a restart re-initialises at the measurement.
   bool admit(Update& out, core::Timestamp t, const Eigen::Vector2d& z, const Eigen::Matrix2d& R,
-             const estimation::StateEstimate* coast = nullptr);
+             const estimation::StateEstimate* coast = nullptr, std::optional<GateDecision> decided = std::nullopt);
   void count(const Update& u);
   Snapshot snapshot(core::Timestamp t, const Eigen::Vector2d& z, const Eigen::Matrix2d& R) const;
   bool detectJump();
