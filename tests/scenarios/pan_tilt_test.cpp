@@ -68,22 +68,14 @@ TEST(PanTiltScenario, EachShippedPathTracksForAFewSeconds) {
     } else {
       EXPECT_NEAR(m.noise_sigma_cm.x(), full, 1e-3) << name;
     }
-    // The corner settings in force: none on the circle (no jump detection), the rectangle's as configured,
-    // the random path's "auto" ones from the noise (0.34 σ, σ the per-axis RMS) and the target's step.
+    // The corner settings in force: one filter for the three paths, its "auto" ones from the noise (0.34 σ,
+    // σ the per-axis RMS) and the target's step, the circle included (its cv-legs part runs there too).
     EXPECT_EQ(m.toJson()["filter_corner_settings"]["min_samples"].get<int>(), m.filter_min_samples) << name;
-    if (name == "circle") {
-      EXPECT_EQ(cfg.control.filter.jump_window, 0.0);
-      EXPECT_EQ(m.filter_min_samples, 0);
-      EXPECT_EQ(m.filter_corner_sigma, 0.0);
-    } else if (name == "random") {
-      EXPECT_FALSE(cfg.control.filter.jump_min_samples.has_value());
-      EXPECT_NEAR(m.filter_corner_sigma, 0.34 * std::sqrt(0.5 * m.noise_sigma_cm.squaredNorm()) / 100.0, 1e-9);
-      EXPECT_GE(m.filter_min_samples, 2);
-      EXPECT_LE(m.filter_min_samples, tracking::kAutoJumpSamplesMax);
-    } else {
-      EXPECT_EQ(m.filter_min_samples, *cfg.control.filter.jump_min_samples) << name;
-      EXPECT_EQ(m.filter_corner_sigma, *cfg.control.filter.jump_corner_sigma) << name;
-    }
+    EXPECT_EQ(cfg.control.filter.model, tracking::TargetModel::Mixture) << name;
+    EXPECT_FALSE(cfg.control.filter.jump_min_samples.has_value()) << name;
+    EXPECT_NEAR(m.filter_corner_sigma, 0.34 * std::sqrt(0.5 * m.noise_sigma_cm.squaredNorm()) / 100.0, 1e-9) << name;
+    EXPECT_GE(m.filter_min_samples, 2) << name;
+    EXPECT_LE(m.filter_min_samples, tracking::kAutoJumpSamplesMax) << name;
   }
 }
 

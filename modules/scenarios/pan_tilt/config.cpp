@@ -198,7 +198,7 @@ PanTiltScenarioConfig loadPanTiltScenarioConfig(const io::ConfigNode& root) {
     const auto f = root.child("filter");
     c.control.filter.model = tracking::targetModelFromString(
         f.getChoice("model", {"constant_velocity", "cv", "constant_acceleration", "ca", "singer", "coordinated_turn",
-                              "ct", "imm", "waypoint_particles"}));
+                              "ct", "imm", "waypoint_particles", "mixture"}));
     c.control.filter.q = f.getOr<double>("q", c.control.filter.q);
     c.control.filter.singer_tau = f.getOr<double>("singer_tau", c.control.filter.singer_tau);
     c.control.filter.singer_sigma = f.getOr<double>("singer_sigma", c.control.filter.singer_sigma);
@@ -229,6 +229,8 @@ PanTiltScenarioConfig loadPanTiltScenarioConfig(const io::ConfigNode& root) {
     c.control.filter.turn_prior_sigma_deg =
         f.getOr<double>("turn_prior_sigma_deg", c.control.filter.turn_prior_sigma_deg);
     c.control.filter.imm_sojourn = f.getOr<Eigen::Vector3d>("imm_sojourn", c.control.filter.imm_sojourn);
+    c.control.filter.mixture_switch_rate =
+        f.getOr<double>("mixture_switch_rate", c.control.filter.mixture_switch_rate);
     const int particles = f.getOr<int>("particles", static_cast<int>(c.control.filter.particles));
     if (particles < 100) f.fail("particles", "at least 100 particles");
     c.control.filter.particles = static_cast<std::size_t>(particles);

@@ -165,6 +165,14 @@ PanTiltRunMetrics runPanTilt(const PanTiltScenarioConfig& cfg, std::uint64_t see
       const tracking::GateDecision d = decisionOf(u, started);
       score.decision(d);
       used = u.accepted;
+      if (has_truth && (d == tracking::GateDecision::Accept || d == tracking::GateDecision::Reject)) {
+        // NIS of every tested measurement; NEES of x(k|k) when it was fused (the path knows v).
+        const estimation::StateEstimate& est = ours->filter().estimate();
+        Eigen::Vector4d truth;
+        truth << p.truth.plane, world.path().velocity(tc);
+        score.consistency(tc, u.nis, d == tracking::GateDecision::Accept, est.x().head<4>(),
+                          est.P().topLeftCorner<4, 4>(), truth);
+      }
       // The filtered estimate scored on every detected frame: a measurement the gate rejected
       // still counts, with the filter's own estimate at that time (its prediction).
       if (ours->filter().initialized())

@@ -61,7 +61,43 @@ nlohmann::json PanTiltRunMetrics::toJson() const {
           {"filter_corner_settings", {{"min_samples", filter_min_samples}, {"corner_sigma_m", filter_corner_sigma}}},
           {"wall_ms_per_frame", wall_ms_per_frame}};
   if (!scored) j["truth"] = "not scored (the frame source has no truth)";  // only then: reference summaries unchanged
+  if (consistency.nis.count() > 0) j["consistency"] = consistency.toJson();
   return j;
+}
+
+void FilterConsistency::addNis(double value) {
+  if (std::isfinite(value)) nis.add(value, 2.0);
+}
+
+void FilterConsistency::addNees(const Eigen::Vector4d& estimate, const Eigen::Matrix4d& P, const Eigen::Vector4d& truth) {
+  const estimation::StateEstimate s(Eigen::VectorXd(estimate), Eigen::MatrixXd(P), 0.0);
+  const double v = estimation::nees(s, Eigen::VectorXd(truth));
+  if (std::isfinite(v)) nees.add(v, 4.0);
+}
+
+core::Interval FilterConsistency::nisBand() const {
+  if (nis.count() == 0) return {std::nan(""), std::nan("")};
+  return core::averagedChiSquareInterval(2.0, static_cast<double>(nis.count()), 0.99);
+}
+
+core::Interval FilterConsistency::neesBand() const {
+  const double n = std::floor(static_cast<double>(nees.count()) / fps);
+  if (n < 1.0) return {std::nan(""), std::nan("")};
+  return core::averagedChiSquareInterval(4.0, n, 0.99);
+}
+
+nlohmann::json FilterConsistency::toJson() const {
+  auto num = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); };
+  const core::Interval a = nisBand(), b = neesBand();
+  return {{"nis_mean", num(nis.mean())},
+          {"nis_samples", nis.count()},
+          {"nis_band_99", {num(a.lo), num(a.hi)}},
+          {"nis_inside", nis.count() > 0 && a.contains(nis.mean())},
+          {"nees_mean", num(nees.mean())},
+          {"nees_samples", nees.count()},
+          {"nees_band_99", {num(b.lo), num(b.hi)}},
+          {"nees_band_samples", std::floor(static_cast<double>(nees.count()) / fps)},
+          {"nees_inside", nees.count() > 0 && std::isfinite(b.lo) && b.contains(nees.mean())}};
 }
 
 nlohmann::json PanTiltComparison::toJson(const PanTiltScenarioConfig& cfg) const {
@@ -165,6 +201,14 @@ void Scorer::command(const robots::PanTiltLimits& limits, const Vector2d& q, con
     m_.min_limit_distance_deg(i) =
         std::min(m_.min_limit_distance_deg(i), core::rad2deg(std::min(q(i) - limits.q_min(i), limits.q_max(i) - q(i))));
   }
+}
+
+void Scorer::consistency(double tc, double nis, bool fused, const Eigen::Vector4d& estimate, const Eigen::Matrix4d& P,
+                         const Eigen::Vector4d& truth) {
+  if (!(tc >= cfg_.metrics_start && !(tc >= occ0_ && tc < occ1_ + 2.0))) return;
+  m_.consistency.fps = cfg_.fps;
+  m_.consistency.addNis(nis);
+  if (fused) m_.consistency.addNees(estimate, P, truth);
 }
 
 void Scorer::decision(tracking::GateDecision d) {

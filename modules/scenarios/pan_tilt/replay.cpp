@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <iomanip>
 #include <optional>
 #include <sstream>
 #include <tuple>
@@ -30,7 +31,31 @@ nlohmann::json PanTiltReplayMetrics::toJson() const {
           {"frame_horizon_s", frame_horizon_s},
           {"frame_predicted_error_px", frame_predicted_error_px},
           {"region_dropped", region_dropped},
-          {"corner_settings", {{"min_samples", min_samples}, {"corner_sigma_m", corner_sigma}}}};
+          {"corner_settings", {{"min_samples", min_samples}, {"corner_sigma_m", corner_sigma}}},
+          {"consistency", consistency.toJson()}};
+}
+
+void writeSyntheticPanTiltFrames(const PanTiltScenarioConfig& cfg, std::uint64_t seed, const std::string& frames_csv) {
+  cfg.validate();
+  const sim::ScreenPath path = pan_tilt::makePath(cfg, seed);
+  const Vector2d sigma = pan_tilt::noiseSigma(cfg, path);
+  core::Rng rng(core::deriveSeed(seed, 79));  // not the closed loop's noise stream: a study of its own
+  std::ofstream out(frames_csv);
+  if (!out) throw core::InvalidInput(frames_csv + ": cannot write");
+  out << std::setprecision(17) << "t,truth_x,truth_y,detected,meas_x,meas_y\n";
+  const double occ0 = cfg.occlusion_start >= 0.0 ? cfg.occlusion_start : 1e300;
+  const double occ1 = occ0 + cfg.occlusion_duration;
+  const auto frames = static_cast<std::size_t>(std::floor(cfg.duration * cfg.fps));
+  for (std::size_t k = 0; k < frames; ++k) {
+    const double t = static_cast<double>(k) / cfg.fps;
+    const Vector2d p = path.position(t);
+    const Vector2d n(core::gaussian(rng, sigma.x()), core::gaussian(rng, sigma.y()));  // drawn every frame
+    const bool seen = !(t >= occ0 && t < occ1);
+    out << t << "," << p.x() << "," << p.y() << "," << (seen ? 1 : 0) << ",";
+    if (seen) out << p.x() + n.x() << "," << p.y() + n.y() << "\n";
+    else out << "nan,nan\n";
+  }
+  if (!out) throw core::IoError(frames_csv + ": write failed");
 }
 
 PanTiltReplayMetrics replayPanTiltFilter(const PanTiltScenarioConfig& cfg, std::uint64_t seed,
@@ -195,8 +220,23 @@ PanTiltReplayMetrics replayPanTiltFilter(const PanTiltScenarioConfig& cfg, std::
         filtered = accepted ? Vector2d(oracle->estimate().x().head<2>()) : Vector2d(oracle->at(t).p);
       }
     } else {
+      const bool had_track = ctrl.filter().initialized();
+      const std::size_t restarts = ctrl.reacquisitions();
       ctrl.observe(obs);
       accepted = ctrl.lastUpdate().accepted;
+      const auto& u = ctrl.lastUpdate();
+      if (obs.detected && had_track && ctrl.reacquisitions() == restarts && u.decision &&
+          (*u.decision == tracking::GateDecision::Accept || *u.decision == tracking::GateDecision::Reject) &&
+          t >= cfg.metrics_start && !(t >= occ0 && t < occ1 + 2.0)) {
+        // As the closed loop's Scorer::consistency: NIS of every tested measurement, NEES when fused.
+        const estimation::StateEstimate& est = ctrl.filter().estimate();
+        Eigen::Vector4d truth;
+        truth << path.position(t), path.velocity(t);
+        out.consistency.fps = cfg.fps;
+        out.consistency.addNis(u.nis);
+        if (*u.decision == tracking::GateDecision::Accept)
+          out.consistency.addNees(est.x().head<4>(), est.P().topLeftCorner<4, 4>(), truth);
+      }
       if (obs.detected && ctrl.filter().initialized())
         filtered = accepted ? ctrl.filteredPlane() : Vector2d(ctrl.filter().at(t).p);
     }

@@ -17,3 +17,5 @@ list(APPEND scenarios_tests test/pan_tilt_footage_test.cpp)
 list(APPEND scenarios_tests test/pan_tilt_sources_test.cpp)
 # A rig that is only calibrated (no truth.yaml): pan-tilt on a recording and on images, sim refused.
 list(APPEND scenarios_tests test/calibrated_rig_test.cpp)
+# Guard of the headline figures: the shipped filter replayed on each path's synthetic measurements.
+list(APPEND scenarios_tests test/pan_tilt_headline_test.cpp)

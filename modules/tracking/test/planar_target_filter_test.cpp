@@ -386,3 +386,96 @@ TEST(PlanarTargetFilter, AnExtrapolationStopsAtTheWaypointRegionsEdge) {
   EXPECT_EQ(far.v.norm(), 0.0);
   EXPECT_GT(without.at(t + 1.0).p.x(), 0.48);
 }
+
+TEST(PlanarTargetFilter, MixtureFavoursTheTurnOnACircleAndTheLegsOnASquare) {
+  // The shipped pan-tilt block's essentials: cv legs with corners beside ct. On a circle the ct part
+  // must take the probability and the mixture must track as well as ct alone (within 10 %); on the
+  // square the legs must (their corners), and the mixture within 10 % of the legs alone.
+  tracking::TargetFilterConfig legs;
+  legs.model = tracking::TargetModel::ConstantVelocity;
+  legs.q = 1e-5;
+  legs.ct_q_accel = legs.ct_q_omega = 1e-6;
+  legs.init_velocity_sigma = 0.3;
+  legs.jump_window = 3.0;
+  legs.jump_threshold = 15.0;
+  legs.jump_min_samples = 8;
+  legs.jump_rate = 1.0;
+  legs.jump_prior_sigma = 0.2;
+  legs.jump_decision = "posterior";
+  legs.jump_evidence = "legs";
+  legs.constant_speed = true;
+  legs.constant_speed_sigma = 0.005;
+  legs.jump_corner_sigma = 0.01;
+  tracking::TargetFilterConfig mixture = legs;
+  mixture.model = tracking::TargetModel::Mixture;
+  tracking::TargetFilterConfig ct;
+  ct.model = tracking::TargetModel::CoordinatedTurn;
+  ct.ct_q_accel = ct.ct_q_omega = 1e-6;
+  ct.init_velocity_sigma = 0.3;
+  const auto circle = [](double t) { return Eigen::Vector2d(0.3 * std::cos(0.5 * t), 0.3 * std::sin(0.5 * t)); };
+
+  const TrackScore on_circle = scoreTrack(mixture, circle, -1.0, 5), ct_circle = scoreTrack(ct, circle, -1.0, 5);
+  EXPECT_LT(on_circle.rms, 1.1 * ct_circle.rms) << on_circle.rms << " vs ct " << ct_circle.rms;
+  const TrackScore on_square = scoreTrack(mixture, squareTrack, 3.0, 5), legs_square = scoreTrack(legs, squareTrack, 3.0, 5);
+  EXPECT_LT(on_square.rms, 1.1 * legs_square.rms) << on_square.rms << " vs legs " << legs_square.rms;
+  EXPECT_GE(on_square.jumps, 2u);  // the corner diagnostics are the legs part's
+
+  tracking::PlanarTargetFilter f(mixture);
+  core::Rng rng = core::makeRng(3);
+  const Eigen::Matrix2d R = 0.04 * 0.04 * Eigen::Matrix2d::Identity();
+  for (int k = 0; k < 360; ++k) {
+    const double t = k / 30.0;
+    f.update(t, circle(t) + Eigen::Vector2d(core::gaussian(rng, 0.04), core::gaussian(rng, 0.04)), R);
+  }
+  ASSERT_EQ(f.modeProbabilities().size(), 2);
+  EXPECT_GT(f.modeProbabilities()(1), 0.9);  // ct
+  EXPECT_NEAR(f.modeProbabilities().sum(), 1.0, 1e-12);
+  EXPECT_EQ(f.stateDim(), 4);
+  EXPECT_EQ(f.estimate().x().size(), 4);
+}
+
+TEST(PlanarTargetFilter, MixtureGatesEveryPartOnTheMixturesPrediction) {
+  // One gate for the mixture: a 1 m outlier it rejects is fused by no part (the estimate stays the
+  // prediction, within the chain's small shift of the probabilities), and reinit_after rejections in a
+  // row restart every part at the measurement.
+  tracking::TargetFilterConfig c;
+  c.model = tracking::TargetModel::Mixture;
+  c.q = 1e-5;
+  c.ct_q_accel = c.ct_q_omega = 1e-6;
+  c.init_velocity_sigma = 0.3;
+  c.jump_window = 3.0;
+  c.jump_min_samples = 8;
+  c.jump_rate = 1.0;
+  c.jump_decision = "posterior";
+  c.jump_evidence = "legs";
+  c.constant_speed = true;
+  c.jump_corner_sigma = 0.01;
+  c.reinit_after = 3;
+  const auto circle = [](double t) { return Eigen::Vector2d(0.3 * std::cos(0.5 * t), 0.3 * std::sin(0.5 * t)); };
+  const Eigen::Matrix2d R = 0.03 * 0.03 * Eigen::Matrix2d::Identity();
+  for (const Eigen::Vector2d& offset : {Eigen::Vector2d(1.0, 0.0), Eigen::Vector2d(0.0, -1.0)}) {
+    tracking::PlanarTargetFilter f(c);
+    core::Rng rng = core::makeRng(5);
+    const auto noisy = [&](double t) {
+      return Eigen::Vector2d(circle(t) + Eigen::Vector2d(core::gaussian(rng, 0.03), core::gaussian(rng, 0.03)));
+    };
+    int k = 0;
+    for (; k < 240; ++k) f.update(k / 30.0, noisy(k / 30.0), R);
+    const double t_o = k / 30.0;
+    const Eigen::Vector2d predicted = f.at(t_o).p;
+    const tracking::PlanarTargetFilter::Update u = f.update(t_o, noisy(t_o) + offset, R);
+    ASSERT_TRUE(u.decision.has_value());
+    EXPECT_EQ(*u.decision, tracking::GateDecision::Reject);
+    EXPECT_FALSE(u.accepted);
+    EXPECT_GT(u.nis, f.gateThreshold());
+    EXPECT_LT((f.at(t_o).p - predicted).norm(), 0.005) << "the rejected outlier moved the estimate";
+    for (++k; k < 270; ++k) EXPECT_TRUE(f.update(k / 30.0, noisy(k / 30.0), R).accepted) << k;
+    // The target jumps by `offset` for good: two rejections, then the restart at the third.
+    std::vector<tracking::GateDecision> seen;
+    for (int i = 0; i < 3; ++i, ++k) seen.push_back(*f.update(k / 30.0, noisy(k / 30.0) + offset, R).decision);
+    EXPECT_EQ(seen, (std::vector<tracking::GateDecision>{tracking::GateDecision::Reject, tracking::GateDecision::Reject,
+                                                         tracking::GateDecision::Restart}));
+    EXPECT_LT((f.at((k - 1) / 30.0).p - (circle((k - 1) / 30.0) + offset)).norm(), 0.15);
+    EXPECT_EQ(f.gateCounts().restarts, 1u);
+  }
+}

@@ -223,8 +223,16 @@ public:
                                " has one process noise per mode; auto-tuning supports constant_velocity, "
                                "constant_acceleration and singer (e.g. config/sweeps/scenarios/pan_tilt_circle_ca.yaml); "
                                "sweeps work with every model");
-    return {{"process", "q", cfg_.control.filter.model == tracking::TargetModel::ConstantVelocity ? "m^2/s^3" : "m^2/s^5",
-             "filter.q", "process noise density of the target filter", cfg_.control.filter.q},
+    // The mixture (the shipped model) tunes its cv part's q (acceleration density, as constant_velocity):
+    // the density of its plain CV steps before the first constant-speed leg (the legs have no process
+    // noise); the ct part's ct_q_accel and ct_q_omega are left as configured.
+    const tracking::TargetModel model = cfg_.control.filter.model;
+    const bool mixture = model == tracking::TargetModel::Mixture;
+    return {{"process", "q",
+             model == tracking::TargetModel::ConstantVelocity || mixture ? "m^2/s^3" : "m^2/s^5", "filter.q",
+             mixture ? "process noise density of the mixture's cv part (before its first constant-speed leg)"
+                     : "process noise density of the target filter",
+             cfg_.control.filter.q},
             {"measurement", "R_scale", "x", "",
              "filter R = R_scale^2 x the scenario's R (estimated; no config key: see the adapter's note)", r_scale_}};
   }

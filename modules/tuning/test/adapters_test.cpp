@@ -177,3 +177,21 @@ TEST(ScenarioAdapters, PanTiltAutotuneRefusesTheParticleFilter) {
   a.quiet = true;
   EXPECT_TRUE(hasInvalidInput([&] { runAutotuneSession(reg, a); }, "waypoint_particles has no process noise"));
 }
+
+TEST(ScenarioAdapters, PanTiltAutotuneTakesTheShippedMixture) {
+  // The three shipped pan-tilt configs share filter.model mixture: auto-tuning is supported and tunes
+  // the cv part's acceleration density q (m²/s³, as constant_velocity) and the R scale.
+  const AdapterRegistry reg = makeBuiltinAdapters();
+  if (!reg.has("pan_tilt")) GTEST_SKIP() << "no pan_tilt adapter in this build";
+  for (const std::string path : {"rectangle", "circle", "random"}) {
+    const std::string config = configPath("pan_tilt_" + path + ".yaml");
+    const auto inst =
+        reg.get("pan_tilt").loadConfig(io::ConfigNode::loadFile(config), readAdapterOptions(reg.get("pan_tilt"), nullptr));
+    EXPECT_EQ(inst->autotuneUnsupported(), "") << path;
+    const std::vector<NoiseParameter> noise = inst->noiseParameters();
+    ASSERT_EQ(noise.size(), 2u) << path;
+    EXPECT_EQ(noise[0].config_key, "filter.q") << path;
+    EXPECT_EQ(noise[0].unit, "m^2/s^3") << path;
+    EXPECT_GT(noise[0].value, 0.0) << path;
+  }
+}

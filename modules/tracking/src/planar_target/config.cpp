@@ -15,8 +15,9 @@ TargetModel targetModelFromString(const std::string& name) {
   if (name == "coordinated_turn" || name == "ct") return TargetModel::CoordinatedTurn;
   if (name == "imm") return TargetModel::Imm;
   if (name == "waypoint_particles") return TargetModel::WaypointParticles;
+  if (name == "mixture") return TargetModel::Mixture;
   throw core::InvalidInput("target model: expected constant_velocity (cv), constant_acceleration (ca), singer, "
-                           "coordinated_turn (ct), imm or waypoint_particles, got '" + name + "'");
+                           "coordinated_turn (ct), imm, waypoint_particles or mixture, got '" + name + "'");
 }
 
 const char* toString(TargetModel model) {
@@ -27,6 +28,7 @@ const char* toString(TargetModel model) {
     case TargetModel::CoordinatedTurn: return "coordinated_turn";
     case TargetModel::Imm: return "imm";
     case TargetModel::WaypointParticles: return "waypoint_particles";
+    case TargetModel::Mixture: return "mixture";
   }
   return "?";
 }
@@ -44,6 +46,8 @@ void TargetFilterConfig::validate() const {
   if (!(ct_q_omega >= 0.0) || !std::isfinite(ct_q_omega)) throw core::InvalidInput("filter.ct_q_omega must be >= 0");
   if (!(maneuver_q >= 0.0) || !std::isfinite(maneuver_q)) throw core::InvalidInput("filter.maneuver_q must be >= 0");
   for (int i = 0; i < 3; ++i) core::requirePositive(imm_sojourn(i), "filter.imm_sojourn");
+  if (!(mixture_switch_rate >= 0.0) || !std::isfinite(mixture_switch_rate))
+    throw core::InvalidInput("filter.mixture_switch_rate must be >= 0");
   if (!(jump_window >= 0.0) || !std::isfinite(jump_window)) throw core::InvalidInput("filter.jump_window must be >= 0");
   core::requirePositive(jump_threshold, "filter.jump_threshold");
   if (jump_min_samples && *jump_min_samples < 2)
@@ -74,8 +78,9 @@ void TargetFilterConfig::validate() const {
       throw core::InvalidInput("filter.particle_min_leg must be in [0, half the region's smaller side)");
     return;
   }
-  if (constant_speed && (model != TargetModel::ConstantVelocity || !(jump_window > 0.0)))
-    throw core::InvalidInput("filter.constant_speed needs model constant_velocity and jump detection "
+  const bool cv = model == TargetModel::ConstantVelocity || model == TargetModel::Mixture;  // mixture: its cv part
+  if (constant_speed && (!cv || !(jump_window > 0.0)))
+    throw core::InvalidInput("filter.constant_speed needs model constant_velocity (or mixture) and jump detection "
                              "(filter.jump_window > 0): the speed is learnt from the legs between detected jumps");
   if (hasRegion() && !constant_speed)
     throw core::InvalidInput("filter.region needs filter.constant_speed (the region is where the legs' waypoints lie)");

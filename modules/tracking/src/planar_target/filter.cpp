@@ -2,6 +2,7 @@
 #include "viewline/tracking/planar_target/filter.h"
 
 #include <Eigen/Cholesky>
+#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -34,7 +35,8 @@ estimation::NonlinearTransition cvWithOmega(double q, double q_omega, double dt)
 int PlanarTargetFilter::stateDim() const {
   switch (config_.model) {
     case TargetModel::ConstantVelocity:
-    case TargetModel::WaypointParticles: return 4;
+    case TargetModel::WaypointParticles:
+    case TargetModel::Mixture: return 4;
     case TargetModel::CoordinatedTurn:
     case TargetModel::Imm: return 5;
     default: return 6;
@@ -43,6 +45,7 @@ int PlanarTargetFilter::stateDim() const {
 
 Eigen::VectorXd PlanarTargetFilter::modeProbabilities() const {
   if (imm_ && imm_->initialized()) return imm_->probabilities();
+  if (!parts_.empty()) return part_probability_;
   return {};
 }
 
@@ -59,6 +62,20 @@ PlanarTargetFilter::PlanarTargetFilter(const TargetFilterConfig& config)
       corners_(config_.jump_min_samples, config_.jump_corner_sigma),
       turns_(config_.turn_prior_weight > 0.0),
       region_(config_.region_center, config_.region_size) {
+  if (config_.model == TargetModel::Mixture) {
+    TargetFilterConfig legs = config_;  // every corner key applies to the cv part
+    legs.model = TargetModel::ConstantVelocity;
+    TargetFilterConfig turn = config_;  // the ct part: none of the corner keys (they are cv's)
+    turn.model = TargetModel::CoordinatedTurn;
+    turn.jump_window = turn.jump_rate = turn.turn_prior_weight = 0.0;
+    turn.constant_speed = false;
+    turn.jump_evidence = "kink";
+    turn.jump_decision = "test";
+    turn.region_size.setZero();
+    parts_.emplace_back(legs);
+    parts_.emplace_back(turn);
+    return;
+  }
   const int n = stateDim();
   const Eigen::Matrix2d I = Eigen::Matrix2d::Identity();
   model_.A = Eigen::MatrixXd::Zero(n, n);
@@ -122,7 +139,15 @@ void PlanarTargetFilter::setParticleState() {
 }
 
 void PlanarTargetFilter::reset(core::Timestamp t, const Eigen::Vector2d& z, const Eigen::Matrix2d& R) {
-  start(t, z, R);
+  if (!parts_.empty()) {  // the model probabilities are kept: a lost target has not changed its motion
+    for (PlanarTargetFilter& f : parts_) f.reset(t, z, R);
+    gate_.drop();  // the mixture's gate, the one that decides for every part, starts at t
+    gate_.decide(t, 0.0);
+    initialized_ = true;
+    setMixtureState(t);
+  } else {
+    start(t, z, R);
+  }
   Update u;
   u.decision = GateDecision::Start;
   count(u);
@@ -162,7 +187,14 @@ void PlanarTargetFilter::start(core::Timestamp t, const Eigen::Vector2d& z, cons
 
 PlanarTargetFilter::Update PlanarTargetFilter::update(core::Timestamp t, const Eigen::Vector2d& z,
                                                       const Eigen::Matrix2d& R) {
+  return updateUnder(t, z, R, std::nullopt);
+}
+
+PlanarTargetFilter::Update PlanarTargetFilter::updateUnder(core::Timestamp t, const Eigen::Vector2d& z,
+                                                           const Eigen::Matrix2d& R,
+                                                           std::optional<GateDecision> decided) {
   output_.reset();
+  if (!parts_.empty()) return updateMixture(t, z, R);
   if (config_.model == TargetModel::WaypointParticles) {
     Update out;
     if (!initialized_) {
@@ -185,7 +217,7 @@ PlanarTargetFilter::Update PlanarTargetFilter::update(core::Timestamp t, const E
     return out;
   }
   corners_.note(t, R);
-  Update out = step(t, z, R);
+  Update out = step(t, z, R, decided);
   count(out);
   if (out.accepted) region_.check(z, R);
   // Gated-out measurements are kept for the jump test too: after a sharp corner the first
@@ -194,6 +226,12 @@ PlanarTargetFilter::Update PlanarTargetFilter::update(core::Timestamp t, const E
   history_.push_back(snapshot(t, z, R));
   while (history_.size() > 1 && history_.front().t < t - config_.jump_window) history_.erase(history_.begin());
   out.jump = detectJump();
+  // A mixture part under a rejection (the mixture's gate took the measurement for an outlier): the soft
+  // jump mixture would re-run its corner hypotheses through it and move the estimate, so the estimate
+  // stays the coasted prediction. The measurement stays in the history: if later measurements confirm
+  // a corner, it is part of that evidence; a declared jump (above) re-processes it under this filter's
+  // own gate, as for a cv filter alone.
+  if (decided && *decided == GateDecision::Reject && !out.jump) output_.reset();
   return out;
 }
 
@@ -219,8 +257,8 @@ void PlanarTargetFilter::count(const Update& u) {
 }
 
 bool PlanarTargetFilter::admit(Update& out, core::Timestamp t, const Eigen::Vector2d& z, const Eigen::Matrix2d& R,
-                               const estimation::StateEstimate* coast) {
-  out.decision = gate_.decide(t, out.nis);
+                               const estimation::StateEstimate* coast, std::optional<GateDecision> decided) {
+  out.decision = decided ? *decided : gate_.decide(t, out.nis);
   if (*out.decision == GateDecision::Accept) return true;
   if (coast != nullptr) state_ = *coast;
   if (*out.decision != GateDecision::Reject) {  // Restart (Start cannot happen: the track is live)
@@ -231,7 +269,7 @@ bool PlanarTargetFilter::admit(Update& out, core::Timestamp t, const Eigen::Vect
 }
 
 PlanarTargetFilter::Update PlanarTargetFilter::step(core::Timestamp t, const Eigen::Vector2d& z,
-                                                    const Eigen::Matrix2d& R) {
+                                                    const Eigen::Matrix2d& R, std::optional<GateDecision> decided) {
   Update out;
   if (!initialized_) {
     start(t, z, R);
@@ -250,7 +288,7 @@ PlanarTargetFilter::Update PlanarTargetFilter::step(core::Timestamp t, const Eig
     if (dt > 1e-9) imm_->predict(t);
     state_ = imm_->combined();
     out.nis = imm_->combinedNis(m);
-    if (!admit(out, t, z, R)) return out;
+    if (!admit(out, t, z, R, nullptr, decided)) return out;
     imm_->update(m);
     state_ = imm_->combined();
     out.accepted = true;
@@ -266,7 +304,7 @@ PlanarTargetFilter::Update PlanarTargetFilter::step(core::Timestamp t, const Eig
     const Eigen::Matrix2d S = pred.P().block(0, 0, 2, 2) + R;
     const Eigen::Vector2d d = z - pred.x().head<2>();
     out.nis = d.dot(S.ldlt().solve(d));
-    if (!admit(out, t, z, R, &pred)) return out;
+    if (!admit(out, t, z, R, &pred, decided)) return out;
     auto leg = std::make_shared<ConstantSpeedLeg>(*leg_);
     leg->add(t, z, R);
     leg_ = leg;
@@ -282,7 +320,7 @@ PlanarTargetFilter::Update PlanarTargetFilter::step(core::Timestamp t, const Eig
   const Eigen::MatrixXd S = estimation::innovationCovariance(state_, m.C, m.R);
   const Eigen::Vector2d d = z - state_.x().head<2>();
   out.nis = d.dot(S.ldlt().solve(d));
-  if (!admit(out, t, z, R)) return out;
+  if (!admit(out, t, z, R, nullptr, decided)) return out;
   estimation::update(state_, m);
   out.accepted = true;
   return out;
@@ -290,6 +328,7 @@ PlanarTargetFilter::Update PlanarTargetFilter::step(core::Timestamp t, const Eig
 
 PlanarTargetFilter::Kinematics PlanarTargetFilter::at(core::Timestamp t) const {
   if (!initialized_) throw core::Error("PlanarTargetFilter::at: filter not initialised");
+  if (!parts_.empty()) return mixtureAt(t);
   Kinematics k;
   if (particles_) {
     const WaypointParticleFilter::Moments m = particles_->moments(std::max(t, particles_->t()));
@@ -323,6 +362,101 @@ PlanarTargetFilter::Kinematics PlanarTargetFilter::at(core::Timestamp t) const {
   k.P_pos = P.block(0, 0, 2, 2);
   if (region_.active() && dt > 1e-9) region_.stopAtBoundary(est.x().head<2>(), k.p, k.v, k.a);
   return k;
+}
+
+PlanarTargetFilter::Kinematics PlanarTargetFilter::mixtureAt(core::Timestamp t) const {
+  Kinematics k;
+  std::vector<Kinematics> ks;
+  for (const PlanarTargetFilter& f : parts_) ks.push_back(f.at(t));
+  for (std::size_t i = 0; i < ks.size(); ++i) {
+    const double w = part_probability_(static_cast<int>(i));
+    k.p += w * ks[i].p;
+    k.v += w * ks[i].v;
+    k.a += w * ks[i].a;
+  }
+  for (std::size_t i = 0; i < ks.size(); ++i) {
+    const Eigen::Vector2d d = ks[i].p - k.p;
+    k.P_pos += part_probability_(static_cast<int>(i)) * (ks[i].P_pos + d * d.transpose());
+  }
+  return k;
+}
+
+void PlanarTargetFilter::setMixtureState(core::Timestamp t) {
+  // Each part's (p, v) block (the ct part carries ω after them), moment-matched.
+  Eigen::Vector4d x = Eigen::Vector4d::Zero();
+  Eigen::Matrix4d P = Eigen::Matrix4d::Zero();
+  for (std::size_t i = 0; i < parts_.size(); ++i)
+    x += part_probability_(static_cast<int>(i)) * parts_[i].estimate().x().head<4>();
+  for (std::size_t i = 0; i < parts_.size(); ++i) {
+    const estimation::StateEstimate& e = parts_[i].estimate();
+    const Eigen::Vector4d d = e.x().head<4>() - x;
+    P += part_probability_(static_cast<int>(i)) * (e.P().topLeftCorner<4, 4>() + d * d.transpose());
+  }
+  state_ = estimation::StateEstimate(Eigen::VectorXd(x), Eigen::MatrixXd(P), t);
+}
+
+PlanarTargetFilter::Update PlanarTargetFilter::updateMixture(core::Timestamp t, const Eigen::Vector2d& z,
+                                                             const Eigen::Matrix2d& R) {
+  core::requireFinite(z, "PlanarTargetFilter: z");
+  Update out;
+  if (!initialized_) {
+    for (PlanarTargetFilter& f : parts_) f.update(t, z, R);
+    gate_.drop();
+    gate_.decide(t, 0.0);  // Start
+    initialized_ = true;
+    setMixtureState(t);
+    out.accepted = out.reinitialized = true;
+    out.decision = GateDecision::Start;
+    count(out);
+    return out;
+  }
+  // Markov prediction of the model probabilities over dt: each switches to the other at
+  // mixture_switch_rate (the chain's transition probability 1 − exp(−r dt)).
+  const double dt = std::max(0.0, t - state_.t());
+  const double e = 0.5 * (1.0 - std::exp(-2.0 * config_.mixture_switch_rate * dt));
+  Eigen::Vector2d prior(part_probability_(0) * (1.0 - e) + part_probability_(1) * e,
+                        part_probability_(1) * (1.0 - e) + part_probability_(0) * e);
+  // The predictive likelihood of each part, N(z; p̂ᵢ(t), Pᵢ + R).
+  Eigen::Vector2d log_like;
+  std::vector<Kinematics> ks;
+  for (const PlanarTargetFilter& f : parts_) ks.push_back(f.at(t));
+  for (int i = 0; i < 2; ++i) {
+    const Eigen::Matrix2d S = ks[static_cast<std::size_t>(i)].P_pos + R;
+    const Eigen::Vector2d d = z - ks[static_cast<std::size_t>(i)].p;
+    log_like(i) = -0.5 * d.dot(S.ldlt().solve(d)) - 0.5 * std::log(S.determinant());
+  }
+  // ONE gate for the mixture: the NIS of the measurement against the mixture's prediction at(t) (the
+  // prediction a consumer, e.g. the telemetry's innovation record, sees before the update), and every
+  // part takes that decision. Gating each part on its own prediction would let the wider part (ct)
+  // fuse an outlier the leading part rejects, and the mixture's estimate would move by that part's
+  // share although the mixture reports the measurement as rejected (a 1 m outlier moved it 0.28 m).
+  const Kinematics mix = mixtureAt(t);
+  const Eigen::Vector2d innovation = z - mix.p;
+  const double nis = innovation.dot((mix.P_pos + R).ldlt().solve(innovation));
+  const GateDecision decision = gate_.decide(t, nis);
+  // A rejected measurement still goes to each part, without being fused: the cv part keeps it in its
+  // corner history, as a cv filter does with its gated-out measurements (after a sharp corner the first
+  // measurements of the new leg are the ones the gate rejects, and they are the evidence of the corner);
+  // a detected corner then re-processes them under the cv part's own gate. A restart re-initialises
+  // every part at the measurement.
+  std::vector<Update> ups;
+  for (PlanarTargetFilter& f : parts_) ups.push_back(f.updateUnder(t, z, R, decision));
+  // Only a fused measurement is evidence about the motion: a rejected one (an outlier) or a restart
+  // leaves the probabilities at the chain's prediction (otherwise the wider part would win it).
+  Eigen::Vector2d post = prior;
+  if (decision == GateDecision::Accept)
+    post = Eigen::Vector2d(prior.array() * (log_like.array() - log_like.maxCoeff()).exp());
+  // Floor: neither model is ever ruled out beyond recovery by one measurement (a corner's first ones).
+  post = (post / post.sum()).cwiseMax(1e-6);
+  part_probability_ = post / post.sum();
+  setMixtureState(t);
+  out.decision = decision;
+  out.accepted = uses(decision);
+  out.reinitialized = decision == GateDecision::Restart;
+  out.jump = ups.front().jump;  // the corner report is the cv part's
+  out.nis = nis;
+  count(out);
+  return out;
 }
 
 }  // namespace viewline::tracking

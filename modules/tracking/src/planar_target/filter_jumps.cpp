@@ -54,6 +54,7 @@ bool PlanarTargetFilter::detectJump() {
 }
 
 int PlanarTargetFilter::minSamples() const {
+  if (!parts_.empty()) return parts_.front().minSamples();
   // The speed the "auto" setting scales by: ŝ, or before the first leg has ended |v̂| once it exceeds its std.
   double speed = speed_.estimate();
   if (!speed_.known() && initialized_) {
@@ -64,7 +65,9 @@ int PlanarTargetFilter::minSamples() const {
   return corners_.minSamples(speed);
 }
 
-double PlanarTargetFilter::cornerSigma() const { return corners_.cornerSigma(); }
+double PlanarTargetFilter::cornerSigma() const {
+  return parts_.empty() ? corners_.cornerSigma() : parts_.front().cornerSigma();
+}
 
 LegFactory PlanarTargetFilter::legFactory() const {
   return [this](core::Timestamp t_c, const Eigen::Vector2d& c, const Eigen::Matrix2d& P_c, double from_direction) {

@@ -19,10 +19,33 @@
 
 #include "viewline/control/pan_tilt_servo.h"
 #include "viewline/core/statistics.h"
+#include "viewline/estimation/consistency.h"
 #include "viewline/scenarios/pan_tilt/config.h"
 #include "viewline/tracking/track_gate.h"
 
 namespace viewline::scenarios {
+
+/// Consistency of ours' filter over the metric window (the simulator knows the truth): NIS of every
+/// detected frame of a live track (innovation against the prediction the filter reported, 2 dof) and NEES
+/// of x(k|k) = (p, v) against the true position and velocity (4 dof), with two-sided 99 % chi-square
+/// bands for their means (core::averagedChiSquareInterval). Innovations of a consistent filter are white,
+/// so the NIS band counts every sample; successive NEES values are correlated (the error drifts over
+/// about a second), so its band counts one sample per second of NEES values (N = samples / fps).
+struct FilterConsistency {
+  estimation::ConsistencyStats nis;   ///< NIS values (2 dof)
+  estimation::ConsistencyStats nees;  ///< NEES values of (p, v) (4 dof)
+  double fps = 30.0;                  ///< frame rate, Hz: the NEES band's samples per independent one
+  /// Adds one frame's NIS (skipped when not finite).
+  void addNis(double value);
+  /// Adds one frame's NEES of the estimate (p, v) and covariance P (4 x 4) against the truth.
+  void addNees(const Eigen::Vector4d& estimate, const Eigen::Matrix4d& P, const Eigen::Vector4d& truth);
+  /// NIS band [lo, hi] of the mean at 99 % (NaN when empty).
+  core::Interval nisBand() const;
+  /// NEES band [lo, hi] of the mean at 99 %, one sample per second (NaN when empty).
+  core::Interval neesBand() const;
+  /// Means, counts, bands and "inside" flags as JSON.
+  nlohmann::json toJson() const;
+};
 
 /// One controller's run: image error, target-position errors, limits, occlusion and filter
 /// figures. Errors are taken from metrics_start on, leaving out the occlusion and the 2 s after it.
@@ -64,6 +87,7 @@ struct PanTiltRunMetrics {
   /// Ours: the gate's decisions on the detected frames (start, accept, reject, restart), as the
   /// telemetry's innovation records report them. (Not in the JSON summary.)
   tracking::GateCounts gate;
+  FilterConsistency consistency;  ///< ours: NIS and NEES with their bands (empty for the baseline)
   bool stopped = false;  ///< the run ended early (a display's quit key)
   /// The frames came with truth (the simulator, or a recording of it): false for footage, where
   /// every figure that needs the true target is NaN ("not scored" in the summary).
@@ -131,6 +155,10 @@ public:
   /// ours' estimate at the frame (NaN when none).
   void frame(double tc, double error_px, bool detected, const Eigen::Vector2d& measured, const Eigen::Vector2d& truth,
              bool used, const Eigen::Vector2d& filtered);
+  /// Ours' filter at a detected frame: the NIS it reported (decision Accept or Reject) and, when the
+  /// measurement was fused, its x(k|k) = (p, v) with covariance against the true (p, v).
+  void consistency(double tc, double nis, bool fused, const Eigen::Vector4d& estimate, const Eigen::Matrix4d& P,
+                   const Eigen::Vector4d& truth);
   /// One command issued at the joints q (`safe`: within the limits from the predicted state).
   void command(const robots::PanTiltLimits& limits, const Eigen::Vector2d& q, const Eigen::Vector2d& qdot, bool safe,
                bool searching);

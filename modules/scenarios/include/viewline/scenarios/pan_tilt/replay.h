@@ -8,6 +8,7 @@
 
 #include "viewline/io/log.h"
 #include "viewline/scenarios/pan_tilt/config.h"
+#include "viewline/scenarios/pan_tilt/metrics.h"
 
 namespace viewline::scenarios {
 
@@ -33,6 +34,7 @@ struct PanTiltReplayMetrics {
   bool region_dropped = false;            ///< the filter dropped filter.region (the target left it)
   int min_samples = 0;                    ///< the filter's corner settings at the end (see PanTiltRunMetrics)
   double corner_sigma = 0.0;              ///< the corner test's threshold at the end, σ
+  FilterConsistency consistency;          ///< Filter: NIS and NEES in the metric window (metrics.h)
   /// The figures above as JSON (the replay's summary).
   nlohmann::json toJson() const;
 };
@@ -48,6 +50,12 @@ enum class PanTiltReplayEstimator {
   /// (waypoints uniform in filter.region, one constant speed), the causal reference; `jumps` is 0.
   WaypointParticles,
 };
+/// Writes a frames CSV that replayPanTiltFilter reads (t, truth_x, truth_y, detected, meas_x, meas_y) without a
+/// camera: the path of `seed` at every frame (fps, duration of the config), measured with [T]'s noise
+/// (σ per axis as the scenario's, its own seeded stream, not the closed loop's draws) and not detected
+/// during the occlusion. For filter studies over many seeds at a fraction of a closed loop's cost.
+void writeSyntheticPanTiltFrames(const PanTiltScenarioConfig& config, std::uint64_t seed, const std::string& frames_csv);
+
 /// With a log, writes the stream replay_frames (t, truth, detected, measurement, the estimator's output,
 /// accepted, jumps so far) for per-frame comparisons. `particles`: the particle count of
 /// WaypointParticles.

@@ -13,9 +13,9 @@
 namespace viewline::tracking {
 
 /// Motion model of the planar target filter (plane coordinates).
-enum class TargetModel { ConstantVelocity, ConstantAcceleration, Singer, CoordinatedTurn, Imm, WaypointParticles };
+enum class TargetModel { ConstantVelocity, ConstantAcceleration, Singer, CoordinatedTurn, Imm, WaypointParticles, Mixture };
 /// "constant_velocity" | "cv", "constant_acceleration" | "ca", "singer", "coordinated_turn" | "ct", "imm",
-/// "waypoint_particles"
+/// "waypoint_particles", "mixture" (legs_or_turn: the cv filter with its corner keys beside the ct filter)
 TargetModel targetModelFromString(const std::string& name);
 /// The config spelling of a model ("constant_velocity", "constant_acceleration", "singer", ...).
 const char* toString(TargetModel model);
@@ -34,6 +34,9 @@ struct TargetFilterConfig {
   double ct_q_omega = 1e-3;              ///< CT/IMM: turn-rate random-walk density (rad²/s³)
   double maneuver_q = 0.5;               ///< IMM manoeuvre mode: CV acceleration density (m²/s³)
   Eigen::Vector3d imm_sojourn{5.0, 5.0, 0.2};  ///< IMM mean sojourn times (s) of the cv, ct, manoeuvre modes
+  /// mixture: rate (1/s) at which the target may switch between the cv-legs and the ct motion (Markov chain
+  /// of the two models' probabilities; > 0 keeps either model recoverable)
+  double mixture_switch_rate = 0.05;
   double jump_window = 0.0;              ///< s searched back for a velocity jump (GLR; 0: no jump detection)
   double jump_threshold = 20.0;          ///< GLR statistic (χ², 2 dof) that declares a jump
   /// Measurements after a candidate jump time before it is tested; nullopt: "auto", scaled to the

@@ -28,6 +28,19 @@
 // the gate (every measurement is accepted; NIS against the predicted moments), and a reset() draws
 // a fresh cloud from the next stream. The Kalman keys (q, jumps, legs, turns) are not used. It is
 // the Bayes reference of the replays put in the loop, for targets whose generator is known.
+// Mixture (model mixture): the target either runs straight constant-speed legs between corners or
+// turns at a steady rate, and the user need not say which: two filters run side by side on every
+// measurement, the cv filter with all its corner keys (jumps, legs, turns, region) and the ct filter
+// (ct_q_accel, ct_q_omega, init_omega_sigma; no corner keys), and their probabilities are the posterior
+// of a two-state Markov chain (switch rate mixture_switch_rate) given each one's predictive likelihood
+// N(z; p̂ᵢ, Pᵢ + R) (Bar-Shalom, Li, Kirubarajan 2001, §11.6, the multiple-model estimator without
+// interaction: the cv filter's corner history cannot be mixed). The output (at(), estimate()) is the
+// Gaussian mixture's mean and covariance (spread of the means included); the NIS that update() reports
+// is the measurement's against that mixture's prediction, and the mixture's gate (gate_probability,
+// reinit_after) decides on it for every part: a measurement it rejects is fused by no part (the cv part
+// keeps it in its corner history, as a cv filter keeps its gated-out measurements) and leaves the
+// probabilities at the chain's prediction; a restart re-initialises every part and keeps the
+// probabilities. Corner diagnostics (jumps, speed, turns, region) are the cv part's.
 
 #include <Eigen/Core>
 #include <cstdint>
@@ -92,10 +105,10 @@ public:
   const TargetFilterConfig& config() const { return config_; }
   /// Dimension of the model's state (e.g. 4 for CV on the plane).
   int stateDim() const;
-  /// IMM mode probabilities (cv, ct, maneuver); empty for the other models.
+  /// IMM mode probabilities (cv, ct, maneuver); mixture: (cv legs, ct); empty for the other models.
   Eigen::VectorXd modeProbabilities() const;
   /// Velocity jumps detected since construction.
-  std::size_t jumps() const { return jumps_; }
+  std::size_t jumps() const { return parts_.empty() ? jumps_ : parts_.front().jumps(); }
   /// The gate's decisions reported by update() and reset() since construction (the measurements a
   /// detected jump processes again are not counted twice).
   const GateCounts& gateCounts() const { return counts_; }
@@ -112,23 +125,30 @@ public:
   /// σ_c in force now, m.
   double cornerSigma() const;
   /// The learnt speed ŝ (m/s) and its variance; 0 / 1e300 before the first segment has ended.
-  double speedEstimate() const { return speed_.estimate(); }
+  double speedEstimate() const { return parts_.empty() ? speed_.estimate() : parts_.front().speedEstimate(); }
   /// Variance of the learnt speed ŝ, m²/s² (1e300 before the first segment has ended).
-  double speedVariance() const { return speed_.variance(); }
+  double speedVariance() const { return parts_.empty() ? speed_.variance() : parts_.front().speedVariance(); }
   /// The configured waypoint region was dropped because the measurements left it (waypoint_region.h).
-  bool regionDropped() const { return region_.dropped(); }
+  bool regionDropped() const { return parts_.empty() ? region_.dropped() : parts_.front().regionDropped(); }
   /// The turn angles (rad, in [−π, π], oldest first) learnt at the last corners (turn_prior_weight > 0).
-  const std::vector<double>& learntTurns() const { return turns_.turns(); }
+  const std::vector<double>& learntTurns() const {
+    return parts_.empty() ? turns_.turns() : parts_.front().learntTurns();
+  }
 
 private:
   using Snapshot = PlanarSnapshot;
   /// The old state is dropped: x = (z, 0...), P = diag(R, the motion prior), the gate started at t.
   void start(core::Timestamp t, const Eigen::Vector2d& z, const Eigen::Matrix2d& R);
-  Update step(core::Timestamp t, const Eigen::Vector2d& z, const Eigen::Matrix2d& R);
-  /// The gate on out.nis: true to fuse. Otherwise the state becomes `coast` (if given) and a restart
-  /// re-initialises at the measurement.
+  /// update() under the gate's decision `decided` (a mixture part: the mixture's), or its own gate's (nullopt).
+  Update updateUnder(core::Timestamp t, const Eigen::Vector2d& z, const Eigen::Matrix2d& R,
+                     std::optional<GateDecision> decided);
+  /// One predict-gate-fuse step; `decided` as in updateUnder.
+  Update step(core::Timestamp t, const Eigen::Vector2d& z, const Eigen::Matrix2d& R,
+              std::optional<GateDecision> decided = std::nullopt);
+  /// The gate on out.nis (or the decision `decided`, if given): true to fuse. Otherwise the state becomes
+  /// `coast` (if given) and a restart re-initialises at the measurement.
   bool admit(Update& out, core::Timestamp t, const Eigen::Vector2d& z, const Eigen::Matrix2d& R,
-             const estimation::StateEstimate* coast = nullptr);
+             const estimation::StateEstimate* coast = nullptr, std::optional<GateDecision> decided = std::nullopt);
   void count(const Update& u);
   Snapshot snapshot(core::Timestamp t, const Eigen::Vector2d& z, const Eigen::Matrix2d& R) const;
   bool detectJump();
@@ -146,6 +166,10 @@ private:
   std::vector<double> regionJumpOdds() const;
   bool usesImm() const { return config_.model == TargetModel::CoordinatedTurn || config_.model == TargetModel::Imm; }
   void setParticleState();  ///< state_ from the particles' moments at their time
+  /// update() of model mixture: both parts updated, their probabilities from the predictive likelihoods.
+  Update updateMixture(core::Timestamp t, const Eigen::Vector2d& z, const Eigen::Matrix2d& R);
+  Kinematics mixtureAt(core::Timestamp t) const;  ///< the parts' at(t) as one Gaussian
+  void setMixtureState(core::Timestamp t);  ///< state_ = the parts' (p, v) estimates as one Gaussian
 
   TargetFilterConfig config_;
   TrackGate gate_;
@@ -161,6 +185,8 @@ private:
   std::optional<estimation::Imm> imm_;
   std::optional<WaypointParticleFilter> particles_;  ///< model waypoint_particles
   std::uint64_t particle_resets_ = 0;
+  std::vector<PlanarTargetFilter> parts_;  ///< model mixture: the cv-legs filter, then the ct filter
+  Eigen::Vector2d part_probability_ = Eigen::Vector2d::Constant(0.5);  ///< model mixture: P(cv legs), P(ct)
   estimation::ContinuousLinearModel model_;
   estimation::StateEstimate state_;
   bool initialized_ = false;
