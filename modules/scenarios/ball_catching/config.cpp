@@ -272,6 +272,7 @@ void BallCatchingConfig::validate() const {
 
 BallCatchingConfig loadBallCatchingConfig(const io::ConfigNode& root) {
   BallCatchingConfig c;
+  c.faults = runtime::readFaultPlanConfig(root);  // first: the config reference's probe reaches it
   c.name = root.getOr<std::string>("name", c.name);
   c.threads = root.getOr<int>("threads", c.threads);
   c.processing_latency = root.getOr<double>("processing_latency_s", c.processing_latency);

@@ -3,6 +3,7 @@
 // ScenarioConfigKeys fails when a key is read without an entry here or an entry is never read.
 #include "viewline/scenarios/config_keys.h"
 #include "viewline/scenarios/ball_catching/config.h"
+#include "viewline/runtime/faults.h"
 
 namespace viewline::scenarios {
 
@@ -17,7 +18,8 @@ io::ConfigReferenceSection ballCatchingConfigReference() {
   // No shipped file has inline cameras (both name a rig): a camera given by its geometry.
   s.probes = {
       "cameras:\n  - {name: a, position: [0.0, -3.0, 1.5], look_at: [2.0, 0.0, 1.3], cx: 320, cy: 240}\n"
-      "robot: {kind: stage}\n"};
+      "robot: {kind: stage}\n",
+      runtime::faultConfigProbe()};
   s.read = [](const io::ConfigNode& root) { loadBallCatchingConfig(root); };
   s.keys = {
       {"name", "", "scenario name in summaries"},
@@ -148,6 +150,7 @@ io::ConfigReferenceSection ballCatchingConfigReference() {
       {"room.walls", "", "render walls around the floor"},
       {"room.floor_size", "m", "side of the floor square"},
   };
+  for (io::ConfigKeyDoc& d : runtime::faultConfigKeys()) s.keys.push_back(std::move(d));
   return s;
 }
 

@@ -107,6 +107,7 @@ void positive(const io::ConfigNode& n, const std::string& key, double v) {
 
 MobileCaptureConfig loadMobileCaptureConfig(const io::ConfigNode& root) {
   MobileCaptureConfig c = MobileCaptureConfig::defaults();
+  c.faults = runtime::readFaultPlanConfig(root);  // first: the config reference's probe reaches it
   if (root.has("world")) {
     const auto w = root.child("world");
     readOpt(w, "robot_start", c.robot_start);

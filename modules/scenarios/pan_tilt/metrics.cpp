@@ -61,6 +61,7 @@ nlohmann::json PanTiltRunMetrics::toJson() const {
           {"filter_corner_settings", {{"min_samples", filter_min_samples}, {"corner_sigma_m", filter_corner_sigma}}},
           {"wall_ms_per_frame", wall_ms_per_frame}};
   if (!scored) j["truth"] = "not scored (the frame source has no truth)";  // only then: reference summaries unchanged
+  if (!faults.empty()) j["faults"] = runtime::toJson(faults);  // only with injected faults (the same reason)
   return j;
 }
 

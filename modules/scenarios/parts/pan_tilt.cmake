@@ -3,6 +3,7 @@
 list(APPEND scenarios_sources
   pan_tilt/command.cpp
   pan_tilt/config.cpp
+  pan_tilt/faults.cpp
   pan_tilt/footage.cpp
   pan_tilt/loop.cpp
   pan_tilt/metrics.cpp
@@ -15,3 +16,4 @@ list(APPEND scenarios_sources pan_tilt/config_keys.cpp)
 list(APPEND scenarios_tests test/pan_tilt_footage_test.cpp)
 # The loop on other frame sources: record and replay bit for bit, footage not scored.
 list(APPEND scenarios_tests test/pan_tilt_sources_test.cpp)
+list(APPEND scenarios_tests test/pan_tilt_faults_test.cpp)

@@ -135,7 +135,8 @@ TableBallResult runTableBall(const TableBallConfig& cfg, std::uint64_t seed, con
     recorded = std::make_unique<runtime::RecordingSource>(hooks.replay_dir);
   else if (cfg.source.kind == runtime::SourceKind::Recording)
     recorded = std::make_unique<runtime::RecordingSource>(cfg.source.recording);
-  runtime::FrameSource& camera = recorded ? static_cast<runtime::FrameSource&>(*recorded) : renderer;
+  runtime::FaultPlan faults(cfg.faults, core::deriveSeed(seed, 0xFA));
+  runtime::FrameSource& camera = faults.wrap(recorded ? static_cast<runtime::FrameSource&>(*recorded) : renderer);
   std::unique_ptr<runtime::RecordingWriter> writer;
   if (!hooks.record_dir.empty()) {
     writer = std::make_unique<runtime::RecordingWriter>(hooks.record_dir);
@@ -208,7 +209,11 @@ TableBallResult runTableBall(const TableBallConfig& cfg, std::uint64_t seed, con
       else
         writer->lost(ready, meta);
     }
-    const double t = cap.stamp;
+    if (frame && faults.missesDeadline(*frame)) {  // stale: dropped as a lost frame (faults.h)
+      faults.note("frames_late_dropped");
+      frame.reset();
+    }
+    const double t = frame ? frame->stamp : cap.stamp;  // the stamp as delivered (injected stamp faults)
     const sim::TiltTableState truth = world.stateAt(cap.capture_time);
     const Eigen::Vector2d ref = cfg.setpointAt(t);
     const Eigen::Isometry3d w_M_t_nominal = world.tablePose(controller.modelTilt());
@@ -220,7 +225,10 @@ TableBallResult runTableBall(const TableBallConfig& cfg, std::uint64_t seed, con
       const Eigen::Matrix3d c_R_w = world.groundRotationReading(obs_c_M_w);
       const Eigen::Isometry3d c_M_t_nominal = obs_c_M_w * w_M_t_nominal;
       const double c0 = threadCpuSeconds();
-      of = &observer.process(frame->image, t, c_R_w, c_M_t_nominal);
+      const auto processed = runtime::guardedDetect(faults, frame->camera, cap.capture_time, [&] {
+        return &observer.process(frame->image, t, c_R_w, c_M_t_nominal);
+      });
+      of = processed ? *processed : &observer.predictOnly(t);
       const double c1 = threadCpuSeconds();
       if (cfg.time_reference) {
         const double ref_wall = reference.run(frame->image, t, c_R_w, c_M_t_nominal, of->a_xy);
@@ -278,6 +286,7 @@ TableBallResult runTableBall(const TableBallConfig& cfg, std::uint64_t seed, con
   if (writer) writer->finish();
   TableBallResult res = metrics.result(seed);
   res.stopped_early = stopped;
+  if (!faults.empty()) res.faults = faults.report();
   if (sink != nullptr) sink->flush();
   res.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   return res;

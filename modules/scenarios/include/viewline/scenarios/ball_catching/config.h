@@ -17,6 +17,7 @@
 #include "viewline/io/config.h"
 #include "viewline/planning/catch_planner.h"
 #include "viewline/robots/cartesian_robot.h"
+#include "viewline/runtime/faults.h"
 #include "viewline/scenarios/ball_catching/flight_fit.h"
 #include "viewline/sim/physics.h"
 #include "viewline/sim/renderer.h"
@@ -142,6 +143,8 @@ struct BallCatchingConfig {
   sim::RenderSettings render;        ///< renderer quality (supersampling, shading)
   sim::RoomParams room;              ///< the simulated room around the scene (walls, floor, light)
   int threads = 2;                   ///< throws run in parallel (independent seeds: same results)
+  /// Injected faults (runtime/faults.h; windows in each throw's time, release at 0; empty: none).
+  runtime::FaultConfig faults;
 
   /// The cameras a throw uses: the first camera_count (all when 0).
   std::size_t activeCameras() const { return camera_count > 0 ? camera_count : cameras.size(); }

@@ -1,0 +1,48 @@
+// Injected faults in the table-ball loop: a frame the observer cannot use (lost, late, or its
+// detector threw) is predicted through, counted, and the wrist stays within its limits. Short run
+// (1.5 s of the shipped scenario).
+#include <gtest/gtest.h>
+
+#include <vector>
+
+#include "viewline/io/config_edit.h"
+#include "viewline/scenarios/table_ball.h"
+
+using namespace viewline;
+using runtime::FaultKind;
+
+namespace {
+
+scenarios::TableBallConfig shortRun(std::vector<runtime::FaultSpec> faults) {
+  auto cfg = scenarios::tableBallConfigFromYaml(io::loadConfigWithValues("config/table_ball.yaml", {}));
+  cfg.duration = 1.5;
+  cfg.faults.faults = std::move(faults);
+  return cfg;
+}
+
+}  // namespace
+
+TEST(TableBallFaults, UnusableFramesArePredictedThroughCountedAndTheWristStaysWithinItsLimits) {
+  // 50 Hz head camera: windows between frames, five frames each.
+  const auto cfg = shortRun({{FaultKind::Blackout, 0, 0.405, 0.505},
+                             {FaultKind::DetectorThrow, 0, 0.605, 0.705},
+                             {FaultKind::Late, 0, 0.805, 0.905, 0.01, 0.1},
+                             {FaultKind::Freeze, 0, 1.005, 1.105},
+                             {FaultKind::StampRepeat, 0, 1.205, 1.225}});
+  const auto clean = scenarios::runTableBall(shortRun({}), 5);
+  const auto r = scenarios::runTableBall(cfg, 5);
+  const runtime::FaultReport& f = r.faults;
+  EXPECT_EQ(f.of(FaultKind::Blackout), 5u);
+  EXPECT_EQ(f.of(FaultKind::DetectorThrow), 5u);
+  EXPECT_EQ(f.outcomeOf("detector_errors"), 5u);
+  EXPECT_EQ(f.of(FaultKind::Late), 5u);
+  EXPECT_EQ(f.outcomeOf("frames_late_dropped"), 5u);  // 0.1 s late, the deadline is 0.05 s
+  EXPECT_EQ(f.of(FaultKind::Freeze), 5u);
+  EXPECT_EQ(f.of(FaultKind::StampRepeat), 1u);
+  EXPECT_EQ(r.frames, clean.frames);
+  EXPECT_EQ(r.frames_dropped - clean.frames_dropped, 15);  // lost, thrown and late: predicted through
+  EXPECT_TRUE(r.limits_respected);
+  EXPECT_TRUE(clean.faults.empty());
+  EXPECT_FALSE(scenarios::toJson(clean).contains("faults"));
+  EXPECT_EQ(scenarios::toJson(r)["faults"]["injected"]["late"], 5);
+}
