@@ -161,6 +161,7 @@ TableBallResult runTableBall(const TableBallConfig& cfg, std::uint64_t seed, con
   current.t0 = -1.0;
   current.period = period;
   bool frame_pending = false;
+  double last_stamp = -std::numeric_limits<double>::infinity();  // of the last frame the loop used
 
   // --- physics: tick k at k · kTick (scheduled from k, not accumulated) -----------------------
   std::function<void(double)> tick = [&](double) {
@@ -214,6 +215,12 @@ TableBallResult runTableBall(const TableBallConfig& cfg, std::uint64_t seed, con
       frame.reset();
     }
     const double t = frame ? frame->stamp : cap.stamp;  // the stamp as delivered (injected stamp faults)
+    if (!(t > last_stamp)) {  // a repeated or backward stamp: the filters only step forward in time
+      faults.note("frames_stale_stamp_dropped");
+      scheduleFrame();
+      return;
+    }
+    last_stamp = t;
     const sim::TiltTableState truth = world.stateAt(cap.capture_time);
     const Eigen::Vector2d ref = cfg.setpointAt(t);
     const Eigen::Isometry3d w_M_t_nominal = world.tablePose(controller.modelTilt());

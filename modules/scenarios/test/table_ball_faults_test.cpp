@@ -23,7 +23,7 @@ scenarios::TableBallConfig shortRun(std::vector<runtime::FaultSpec> faults) {
 }  // namespace
 
 TEST(TableBallFaults, UnusableFramesArePredictedThroughCountedAndTheWristStaysWithinItsLimits) {
-  // 50 Hz head camera: windows between frames, five frames each.
+  // 50 Hz head camera (trigger jitter): four or five frames in each 0.1 s window.
   const auto cfg = shortRun({{FaultKind::Blackout, 0, 0.405, 0.505},
                              {FaultKind::DetectorThrow, 0, 0.605, 0.705},
                              {FaultKind::Late, 0, 0.805, 0.905, 0.01, 0.1},
@@ -32,17 +32,20 @@ TEST(TableBallFaults, UnusableFramesArePredictedThroughCountedAndTheWristStaysWi
   const auto clean = scenarios::runTableBall(shortRun({}), 5);
   const auto r = scenarios::runTableBall(cfg, 5);
   const runtime::FaultReport& f = r.faults;
-  EXPECT_EQ(f.of(FaultKind::Blackout), 5u);
-  EXPECT_EQ(f.of(FaultKind::DetectorThrow), 5u);
-  EXPECT_EQ(f.outcomeOf("detector_errors"), 5u);
-  EXPECT_EQ(f.of(FaultKind::Late), 5u);
-  EXPECT_EQ(f.outcomeOf("frames_late_dropped"), 5u);  // 0.1 s late, the deadline is 0.05 s
-  EXPECT_EQ(f.of(FaultKind::Freeze), 5u);
+  for (const FaultKind k : {FaultKind::Blackout, FaultKind::DetectorThrow, FaultKind::Late, FaultKind::Freeze}) {
+    EXPECT_GE(f.of(k), 4u) << runtime::toString(k);
+    EXPECT_LE(f.of(k), 5u) << runtime::toString(k);
+  }
+  EXPECT_EQ(f.outcomeOf("detector_errors"), f.of(FaultKind::DetectorThrow));
+  EXPECT_EQ(f.outcomeOf("frames_late_dropped"), f.of(FaultKind::Late));  // 0.1 s late, the deadline is 0.05 s
   EXPECT_EQ(f.of(FaultKind::StampRepeat), 1u);
-  EXPECT_EQ(r.frames, clean.frames);
-  EXPECT_EQ(r.frames_dropped - clean.frames_dropped, 15);  // lost, thrown and late: predicted through
+  EXPECT_EQ(f.outcomeOf("frames_stale_stamp_dropped"), 1u);  // the filters only step forward
+  EXPECT_EQ(r.frames, clean.frames - 1);  // the repeated stamp's frame is not scored
+  // Lost, thrown and late frames: the observer predicts through them.
+  EXPECT_EQ(static_cast<std::uint64_t>(r.frames_dropped - clean.frames_dropped),
+            f.of(FaultKind::Blackout) + f.of(FaultKind::DetectorThrow) + f.of(FaultKind::Late));
   EXPECT_TRUE(r.limits_respected);
   EXPECT_TRUE(clean.faults.empty());
   EXPECT_FALSE(scenarios::toJson(clean).contains("faults"));
-  EXPECT_EQ(scenarios::toJson(r)["faults"]["injected"]["late"], 5);
+  EXPECT_EQ(scenarios::toJson(r)["faults"]["injected"]["late"], f.of(FaultKind::Late));
 }
