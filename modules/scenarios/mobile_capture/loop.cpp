@@ -2,6 +2,7 @@
 
 #include <Eigen/Cholesky>
 #include <cmath>
+#include <limits>
 #include <optional>
 
 #include "viewline/core/interrupt.h"
@@ -286,16 +287,21 @@ MobileCaptureRun runMobileCapture(const MobileCaptureConfig& cfg, std::uint64_t 
     }
   };
   // Frames when the source has them (a renderer: every vision period, on the control ticks).
+  double last_stamp = -std::numeric_limits<double>::infinity();  // of the last frame processed
   std::function<void()> next_frame = [&] {
     const auto t = frames.nextReadyTime();
     if (!t) return;
     sched.at(*t, kVision, [&](double) {
-      auto frame = frames.grab();
-      if (frame && faults.missesDeadline(*frame)) {  // stale: dropped as a lost frame (faults.h)
-        faults.note("frames_late_dropped");
-        frame.reset();
+      if (auto frame = frames.grab()) {
+        if (faults.missesDeadline(*frame)) {  // stale: dropped as a lost frame (faults.h)
+          faults.note("frames_late_dropped");
+        } else if (!(frame->stamp > last_stamp)) {  // a repeated or backward stamp: the track only steps forward
+          faults.note("frames_stale_stamp_dropped");
+        } else {
+          last_stamp = frame->stamp;
+          process(*frame);
+        }
       }
-      if (frame) process(*frame);
       next_frame();
     });
   };

@@ -18,7 +18,8 @@ TEST(MobileCaptureFaults, FaultsAreCountedRefusedOrSurvivedAndTheTrackTakesTheOb
   cfg.rig.reset();  // one perfect camera (as the short capture test)
   cfg.hfov = core::deg2rad(50.0);
   cfg.vfov = core::deg2rad(40.0);
-  cfg.faults.faults = {{FaultKind::DetectInf, 0, 2.0, 2.5},
+  cfg.faults.faults = {{FaultKind::StampRepeat, 0, 1.0, 1.1},
+                       {FaultKind::DetectInf, 0, 2.0, 2.5},
                        {FaultKind::DetectOutside, 0, 2.5, 3.0},
                        {FaultKind::DetectorThrow, 0, 3.0, 3.5},
                        {FaultKind::Late, 0, 3.5, 4.0, 0.01, 0.3},
@@ -45,6 +46,8 @@ TEST(MobileCaptureFaults, FaultsAreCountedRefusedOrSurvivedAndTheTrackTakesTheOb
   EXPECT_GT(f.of(FaultKind::Late), 0u);
   EXPECT_EQ(f.outcomeOf("frames_late_dropped"), f.of(FaultKind::Late));  // 0.3 s late, deadline 0.05 s
   EXPECT_GT(f.of(FaultKind::Blackout), 0u);
+  EXPECT_GT(f.of(FaultKind::StampRepeat), 0u);
+  EXPECT_EQ(f.outcomeOf("frames_stale_stamp_dropped"), f.of(FaultKind::StampRepeat));  // the track only steps forward
   // Tracked before the faults, nothing detected during them, fused again within 5 frames after.
   int fused_before = 0, detected_during = 0, frames_after = 0, first_fused_after = -1;
   for (const Seen& s : seen) {
