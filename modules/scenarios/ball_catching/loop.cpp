@@ -16,6 +16,7 @@
 #include "viewline/estimation/consistency.h"
 #include "viewline/io/log.h"
 #include "viewline/runtime/delay_line.h"
+#include "viewline/runtime/stale_frames.h"
 #include "viewline/scenarios/ball_catching/planner_input.h"
 #include "viewline/scenarios/ball_catching/robot_guard.h"
 #include "viewline/scenarios/ball_catching/world.h"
@@ -83,6 +84,10 @@ public:
     ++res_.frames;
     if (faults_.missesDeadline(*frame)) {  // stale: the planner has moved on (faults.h)
       faults_.note("frames_late_dropped");
+      return true;
+    }
+    if (stale_.repeats(*frame)) {  // a frozen camera's old image with a new stamp (stale_frames.h)
+      faults_.note("frames_frozen_dropped");
       return true;
     }
     const std::size_t ci = frame->camera;
@@ -206,6 +211,7 @@ private:
   runtime::FrameSource& frames_;  // the frames, through the injected faults
   runtime::FaultPlan& faults_;
   RobotGuard guard_;
+  runtime::StaleFrameFilter stale_;
   std::vector<core::Camera> est_cams_;
   robots::SimulatedCartesianRobot& robot_;
   planning::CatchPlanner planner_;

@@ -6,6 +6,7 @@
 #include <optional>
 
 #include "viewline/core/interrupt.h"
+#include "viewline/runtime/stale_frames.h"
 #include "viewline/robots/mobile_ground_localization.h"
 #include "viewline/scenarios/mobile_capture/world.h"
 
@@ -288,6 +289,7 @@ MobileCaptureRun runMobileCapture(const MobileCaptureConfig& cfg, std::uint64_t 
   };
   // Frames when the source has them (a renderer: every vision period, on the control ticks).
   double last_stamp = -std::numeric_limits<double>::infinity();  // of the last frame processed
+  runtime::StaleFrameFilter stale;
   std::function<void()> next_frame = [&] {
     const auto t = frames.nextReadyTime();
     if (!t) return;
@@ -295,6 +297,8 @@ MobileCaptureRun runMobileCapture(const MobileCaptureConfig& cfg, std::uint64_t 
       if (auto frame = frames.grab()) {
         if (faults.missesDeadline(*frame)) {  // stale: dropped as a lost frame (faults.h)
           faults.note("frames_late_dropped");
+        } else if (stale.repeats(*frame)) {  // a frozen camera's old image, new stamp (stale_frames.h)
+          faults.note("frames_frozen_dropped");
         } else if (!(frame->stamp > last_stamp)) {  // a repeated or backward stamp: the track only steps forward
           faults.note("frames_stale_stamp_dropped");
         } else {

@@ -11,6 +11,7 @@
 #include "viewline/core/random.h"
 #include "viewline/runtime/delay_line.h"
 #include "viewline/runtime/recording.h"
+#include "viewline/runtime/stale_frames.h"
 #include "viewline/scenarios/pan_tilt/faults.h"
 #include "viewline/scenarios/pan_tilt/world.h"
 
@@ -144,6 +145,7 @@ PanTiltRunMetrics runPanTilt(const PanTiltScenarioConfig& cfg, std::uint64_t see
   }
   runtime::FaultPlan faults(cfg.faults, core::deriveSeed(seed, 0xFA));
   runtime::FrameSource& source = faults.wrap(*grabber);
+  runtime::StaleFrameFilter stale;
   CommandsInFlight recent(latency, period);
   runtime::DelayLine<Processed> to_controller;  // the processing delay
   runtime::TelemetrySink* tel = io.telemetry;
@@ -241,6 +243,10 @@ PanTiltRunMetrics runPanTilt(const PanTiltScenarioConfig& cfg, std::uint64_t see
     std::optional<runtime::Frame> frame = source.grab();
     if (frame && faults.missesDeadline(*frame)) {  // stale: dropped as a lost frame (faults.h)
       faults.note("frames_late_dropped");
+      frame.reset();
+    }
+    if (frame && stale.repeats(*frame)) {  // a frozen camera's old image with a new stamp (stale_frames.h)
+      faults.note("frames_frozen_dropped");
       frame.reset();
     }
     if (frame) {

@@ -12,6 +12,7 @@
 #include "viewline/core/error.h"
 #include "viewline/runtime/delay_line.h"
 #include "viewline/runtime/recording.h"
+#include "viewline/runtime/stale_frames.h"
 #include "viewline/scenarios/table_ball/world.h"
 #include "viewline/vision/table_detector.h"
 
@@ -136,6 +137,7 @@ TableBallResult runTableBall(const TableBallConfig& cfg, std::uint64_t seed, con
   else if (cfg.source.kind == runtime::SourceKind::Recording)
     recorded = std::make_unique<runtime::RecordingSource>(cfg.source.recording);
   runtime::FaultPlan faults(cfg.faults, core::deriveSeed(seed, 0xFA));
+  runtime::StaleFrameFilter stale;
   runtime::FrameSource& camera = faults.wrap(recorded ? static_cast<runtime::FrameSource&>(*recorded) : renderer);
   std::unique_ptr<runtime::RecordingWriter> writer;
   if (!hooks.record_dir.empty()) {
@@ -212,6 +214,10 @@ TableBallResult runTableBall(const TableBallConfig& cfg, std::uint64_t seed, con
     }
     if (frame && faults.missesDeadline(*frame)) {  // stale: dropped as a lost frame (faults.h)
       faults.note("frames_late_dropped");
+      frame.reset();
+    }
+    if (frame && stale.repeats(*frame)) {  // a frozen camera's old image with a new stamp (stale_frames.h)
+      faults.note("frames_frozen_dropped");
       frame.reset();
     }
     const double t = frame ? frame->stamp : cap.stamp;  // the stamp as delivered (injected stamp faults)

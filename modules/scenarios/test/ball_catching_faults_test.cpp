@@ -120,6 +120,7 @@ TEST(BallCatchingFaults, ALimitErrorHaltsOrHoldsAndFrozenOrRestampedImagesAreCou
   EXPECT_EQ(f.of(FaultKind::RobotLimitError), static_cast<std::uint64_t>(5 * kThrows));
   EXPECT_EQ(f.outcomeOf("robot_commands_failed"), f.of(FaultKind::RobotLimitError));
   EXPECT_GT(f.of(FaultKind::Freeze), 0u);
+  EXPECT_EQ(f.outcomeOf("frames_frozen_dropped"), f.of(FaultKind::Freeze));  // stale images, not fused
   EXPECT_GT(f.of(FaultKind::StampRepeat), 0u);
   // 50 Hz cameras: five images of camera 0 in the 0.1 s blackout of each throw, lost.
   EXPECT_GE(f.of(FaultKind::Blackout), static_cast<std::uint64_t>(4 * kThrows));

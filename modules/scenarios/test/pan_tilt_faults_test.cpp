@@ -75,8 +75,9 @@ TEST(PanTiltFaults, LostLateAndFrozenFramesAreCountedAndTheTrackGoesOn) {
   EXPECT_EQ(f.of(FaultKind::Late), 3u);
   EXPECT_EQ(f.outcomeOf("frames_late_dropped"), 3u);  // 0.2 s late, the deadline is 0.05 s
   EXPECT_EQ(f.of(FaultKind::Freeze), 3u);
+  EXPECT_EQ(f.outcomeOf("frames_frozen_dropped"), 3u);  // each repeats the previous image bit for bit
   EXPECT_GE(f.of(FaultKind::StampBackwards), 1u);
-  EXPECT_EQ(r.frames, clean.frames - 6);  // the lost and the late-dropped frames are not processed
+  EXPECT_EQ(r.frames, clean.frames - 9);  // the lost, late and frozen frames are not processed
   // After the last window the filter still accepts the detections (no stuck gate).
   EXPECT_GT(r.detections, clean.detections - 12);
   expectWithinLimits(r);

@@ -1,5 +1,5 @@
-// Injected faults in the table-ball loop: a frame the observer cannot use (lost, late, or its
-// detector threw) is predicted through, counted, and the wrist stays within its limits. Short run
+// Injected faults in the table-ball loop: a frame the observer cannot use (lost, late, frozen, or
+// its detector threw) is predicted through, counted, and the wrist stays within its limits. Short run
 // (1.5 s of the shipped scenario).
 #include <gtest/gtest.h>
 
@@ -42,8 +42,10 @@ TEST(TableBallFaults, UnusableFramesArePredictedThroughCountedAndTheWristStaysWi
   EXPECT_EQ(f.outcomeOf("frames_stale_stamp_dropped"), 1u);  // the filters only step forward
   EXPECT_EQ(r.frames, clean.frames - 1);  // the repeated stamp's frame is not scored
   // Lost, thrown and late frames: the observer predicts through them.
+  // A frozen image repeats its camera's previous one bit for bit: dropped as stale.
+  EXPECT_EQ(f.outcomeOf("frames_frozen_dropped"), f.of(FaultKind::Freeze));
   EXPECT_EQ(static_cast<std::uint64_t>(r.frames_dropped - clean.frames_dropped),
-            f.of(FaultKind::Blackout) + f.of(FaultKind::DetectorThrow) + f.of(FaultKind::Late));
+            f.of(FaultKind::Blackout) + f.of(FaultKind::DetectorThrow) + f.of(FaultKind::Late) + f.of(FaultKind::Freeze));
   EXPECT_TRUE(r.limits_respected);
   EXPECT_TRUE(clean.faults.empty());
   EXPECT_FALSE(scenarios::toJson(clean).contains("faults"));
