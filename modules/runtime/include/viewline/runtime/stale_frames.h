@@ -3,8 +3,8 @@
 // sensor never gives two bit-identical images (its read-out noise alone changes every frame),
 // so an image equal to the previous one of its camera is stale: its stamp says now, its content
 // is old, and a tracker fed with it is pulled back to where the target was (ball catching with
-// one of two cameras frozen for 0.2 s: the catch rate fell to about a tenth, docs/results.md).
-// The loops drop such a frame. The comparison is a 64-bit FNV-1a hash of the pixels per camera
+// one of two cameras frozen for 0.2 s of each flight then misses most throws, late). The loops
+// drop such a frame. The comparison is a 64-bit FNV-1a hash of the pixels per camera
 // (one pass over the image, no copy kept).
 
 #include <cstddef>
