@@ -7,6 +7,7 @@
 #include "viewline/core/error.h"
 #include "viewline/io/config.h"
 #include "viewline/runtime/faults.h"
+#include "viewline/runtime/stale_frames.h"
 
 namespace viewline::runtime {
 namespace {
@@ -283,6 +284,22 @@ TEST(FaultConfig, ReadsTheNewKindsTheDelayAndTheDeadline) {
                    "faults:\n  - {kind: late, from_s: 0, to_s: 1, delay_s: -1}\n", "d.yaml")),
                core::InvalidInput);
   EXPECT_EQ(std::string(toString(FaultKind::RobotLimitError)), "robot_limit_error");
+}
+
+TEST(StaleFrameFilter, ARepeatedImageIsStaleABlankOneIsNot) {
+  StaleFrameFilter stale;
+  Frame f;
+  f.image = cv::Mat(4, 4, CV_8UC3);
+  cv::randu(f.image, cv::Scalar::all(0), cv::Scalar::all(256));
+  EXPECT_FALSE(stale.repeats(f));  // the first image of camera 0
+  f.stamp = 0.02;
+  EXPECT_TRUE(stale.repeats(f));   // the same pixels again, a new stamp
+  f.camera = 1;
+  EXPECT_FALSE(stale.repeats(f));  // another camera's own history
+  Frame dark;
+  dark.image = cv::Mat(4, 4, CV_8UC3, cv::Scalar::all(0));
+  EXPECT_FALSE(stale.repeats(dark));
+  EXPECT_FALSE(stale.repeats(dark));  // a covered camera: blank, not stale
 }
 
 }  // namespace

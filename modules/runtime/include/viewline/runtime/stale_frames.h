@@ -4,12 +4,14 @@
 // so an image equal to the previous one of its camera is stale: its stamp says now, its content
 // is old, and a tracker fed with it is pulled back to where the target was (ball catching with
 // one of two cameras frozen for 0.2 s of each flight then misses most throws, late). The loops
-// drop such a frame. The comparison is a 64-bit FNV-1a hash of the pixels per camera
+// drop such a frame. A blank image (every value the same: a covered or dark camera, or a
+// simulated one without sensor noise) repeats without being stale and is left alone. The comparison is a 64-bit FNV-1a hash of the pixels per camera
 // (one pass over the image, no copy kept).
 
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
+#include <opencv2/core.hpp>
 #include <vector>
 
 #include "viewline/runtime/frame_source.h"
@@ -26,10 +28,15 @@ public:
     const std::uint64_t h = hashOf(frame.image);
     const bool same = last_[frame.camera] != 0 && h == last_[frame.camera];
     last_[frame.camera] = h;
-    return same;
+    return same && !blank(frame.image);  // the second pass only on a repeat
   }
 
 private:
+  static bool blank(const cv::Mat& image) {
+    double lo = 0.0, hi = 0.0;
+    cv::minMaxLoc(image.reshape(1), &lo, &hi);
+    return lo == hi;
+  }
   static std::uint64_t hashOf(const cv::Mat& image) {
     std::uint64_t h = 1469598103934665603ull;  // FNV-1a offset basis
     const std::size_t row_bytes = static_cast<std::size_t>(image.cols) * image.elemSize();
