@@ -7,6 +7,7 @@
 #include "viewline/core/error.h"
 #include "viewline/io/config.h"
 #include "viewline/runtime/faults.h"
+#include "viewline/runtime/stale_frames.h"
 
 namespace viewline::runtime {
 namespace {
@@ -161,6 +162,144 @@ TEST(FaultConfig, ReadsTheListAndNamesTheBadKey) {
   }
   EXPECT_THROW(readFaultConfig(io::ConfigNode::fromString("faults:\n  - {kind: melt, from_s: 0, to_s: 1}\n", "k.yaml")),
                core::InvalidInput);
+}
+
+
+TEST(FaultPlan, WithoutFaultsItHandsTheSourceBackAndNoInjectionPointFires) {
+  TwoCameras inner(5);
+  FaultPlan plan;
+  EXPECT_EQ(&plan.wrap(inner), &inner);
+  EXPECT_NO_THROW(plan.beforeDetect(0, 0.1));
+  EXPECT_NO_THROW(plan.beforeCommand(0.1));
+  EXPECT_EQ(plan.detected(0, 0.1, Eigen::Vector2d(3.0, 4.0), 640, 480), Eigen::Vector2d(3.0, 4.0));
+  EXPECT_TRUE(plan.report().empty());
+}
+
+TEST(FaultPlan, DetectionFaultsHitTheirCameraAndWindowAndTheGuardRefusesEveryOne) {
+  FaultConfig cfg;
+  cfg.faults = {{FaultKind::DetectNan, 0, 0.10, 0.20}, {FaultKind::DetectInf, 1, 0.10, 0.20},
+                {FaultKind::DetectOutside, std::nullopt, 0.30, 0.40}};
+  FaultPlan plan(cfg, 3);
+  const Eigen::Vector2d px(100.0, 200.0);
+  int refused = 0;
+  for (int i = 0; i < 50; ++i) {  // camera i % 2 at 0.01 i s
+    const std::size_t cam = static_cast<std::size_t>(i % 2);
+    const Eigen::Vector2d got = plan.detected(cam, 0.01 * i, px, 640, 480);
+    if (!usablePixel(got, 640, 480)) ++refused;
+    else EXPECT_EQ(got, px);
+  }
+  const FaultReport r = plan.report();
+  EXPECT_EQ(r.of(FaultKind::DetectNan), 5u);      // camera 0 at 0.10, 0.12, ..., 0.18
+  EXPECT_EQ(r.of(FaultKind::DetectInf), 5u);      // camera 1 at 0.11, ..., 0.19
+  EXPECT_EQ(r.of(FaultKind::DetectOutside), 10u); // both cameras in [0.30, 0.40)
+  EXPECT_EQ(refused, 20);
+  EXPECT_TRUE(usablePixel(Eigen::Vector2d(-0.5, 479.5), 640, 480));
+  EXPECT_FALSE(usablePixel(Eigen::Vector2d(-0.6, 10.0), 640, 480));
+}
+
+TEST(FaultPlan, AThrowingDetectorIsCaughtCountedAndTheNextFrameIsDetected) {
+  FaultConfig cfg;
+  cfg.faults = {{FaultKind::DetectorThrow, 1, 0.0, 0.05}};
+  FaultPlan plan(cfg, 1);
+  int calls = 0;
+  const auto detect = [&] { return ++calls; };
+  EXPECT_FALSE(guardedDetect(plan, 1, 0.02, detect).has_value());  // injected: detector never runs
+  EXPECT_EQ(guardedDetect(plan, 0, 0.02, detect), std::optional<int>(1));  // the other camera
+  EXPECT_EQ(guardedDetect(plan, 1, 0.06, detect), std::optional<int>(2));  // after the window
+  const auto own_throw = []() -> int { throw std::runtime_error("detector bug"); };
+  EXPECT_FALSE(guardedDetect(plan, 0, 0.5, own_throw).has_value());  // the detector's own exception
+  EXPECT_EQ(plan.report().of(FaultKind::DetectorThrow), 1u);
+  EXPECT_EQ(plan.report().outcomeOf("detector_errors"), 2u);
+  EXPECT_THROW(plan.beforeDetect(1, 0.01), InjectedFault);
+}
+
+TEST(FaultPlan, LateFramesMissTheDeadlineOnlyWhenTheDelayExceedsIt) {
+  FaultConfig cfg;
+  cfg.faults = {{FaultKind::Late, 0, 0.0, 0.1, 0.01, 0.08}, {FaultKind::Late, 1, 0.0, 0.1, 0.01, 0.02}};
+  cfg.frame_deadline_s = 0.05;
+  FaultPlan plan(cfg, 1);
+  TwoCameras inner(10);
+  FrameSource& s = plan.wrap(inner);
+  EXPECT_EQ(&s, &inner);  // no frame fault: the source itself
+  int missed = 0;
+  for (const Frame& f : drain(s)) missed += plan.missesDeadline(f);
+  EXPECT_EQ(missed, 5);  // camera 0 at 0.00, 0.02, ..., 0.08; camera 1's 20 ms delay is within it
+  EXPECT_EQ(plan.report().of(FaultKind::Late), 10u);
+}
+
+TEST(FaultPlan, RobotFaultsFailTheCommandsOfTheirWindowWhateverTheCamera) {
+  FaultConfig cfg;
+  cfg.faults = {{FaultKind::RobotSilent, 0, 0.5, 0.6}, {FaultKind::RobotLimitError, std::nullopt, 0.7, 0.72}};
+  FaultPlan plan(cfg, 1);
+  int silent = 0, limit = 0, sent = 0;
+  for (int i = 0; i < 100; ++i) {
+    try {
+      plan.beforeCommand(0.01 * i);
+      ++sent;
+    } catch (const InjectedFault& e) {
+      (e.kind() == FaultKind::RobotSilent ? silent : limit)++;
+    }
+  }
+  EXPECT_EQ(silent, 10);
+  EXPECT_EQ(limit, 2);
+  EXPECT_EQ(sent, 88);
+  EXPECT_EQ(plan.report().of(FaultKind::RobotSilent), 10u);
+  plan.note("robot_holds", 12);
+  const nlohmann::json j = toJson(plan.report());
+  EXPECT_EQ(j["injected"]["robot_limit_error"], 2);
+  EXPECT_EQ(j["outcome"]["robot_holds"], 12);
+  EXPECT_EQ(summaryLine(plan.report()),
+            "faults injected: robot_limit_error 2, robot_silent 10; outcome: robot_holds 12");
+}
+
+TEST(FaultPlan, FrameKindsGoThroughTheDecoratorAndAreReportedWithTheOthers) {
+  FaultConfig cfg;
+  cfg.faults = {{FaultKind::Blackout, 1, 0.0, 0.1}, {FaultKind::DetectNan, 0, 0.0, 0.1}};
+  FaultPlan plan(cfg, 1);
+  TwoCameras inner(10);
+  FrameSource& s = plan.wrap(inner);
+  EXPECT_NE(&s, &inner);
+  int lost = 0;
+  drain(s, &lost);
+  EXPECT_EQ(lost, 5);
+  EXPECT_EQ(plan.report().of(FaultKind::Blackout), 5u);
+  EXPECT_EQ(plan.report().of(FaultKind::DetectNan), 0u);  // configured, nothing detected yet
+  EXPECT_EQ(plan.report().injected.size(), 2u);
+}
+
+TEST(FaultConfig, ReadsTheNewKindsTheDelayAndTheDeadline) {
+  const io::ConfigNode root = io::ConfigNode::fromString(
+      "faults:\n"
+      "  - {kind: late, camera: 1, from_s: 0.5, to_s: 0.7, delay_s: 0.2}\n"
+      "  - {kind: robot_limit_error, from_s: 1.0, to_s: 1.1}\n"
+      "frame_deadline_s: 0.04\n",
+      "plan.yaml");
+  const FaultConfig c = readFaultPlanConfig(root);
+  ASSERT_EQ(c.faults.size(), 2u);
+  EXPECT_EQ(c.faults[0].kind, FaultKind::Late);
+  EXPECT_DOUBLE_EQ(c.faults[0].delay_s, 0.2);
+  EXPECT_EQ(c.faults[1].kind, FaultKind::RobotLimitError);
+  EXPECT_DOUBLE_EQ(c.frame_deadline_s, 0.04);
+  EXPECT_THROW(readFaultPlanConfig(io::ConfigNode::fromString(
+                   "faults:\n  - {kind: late, from_s: 0, to_s: 1, delay_s: -1}\n", "d.yaml")),
+               core::InvalidInput);
+  EXPECT_EQ(std::string(toString(FaultKind::RobotLimitError)), "robot_limit_error");
+}
+
+TEST(StaleFrameFilter, ARepeatedImageIsStaleABlankOneIsNot) {
+  StaleFrameFilter stale;
+  Frame f;
+  f.image = cv::Mat(4, 4, CV_8UC3);
+  cv::randu(f.image, cv::Scalar::all(0), cv::Scalar::all(256));
+  EXPECT_FALSE(stale.repeats(f));  // the first image of camera 0
+  f.stamp = 0.02;
+  EXPECT_TRUE(stale.repeats(f));   // the same pixels again, a new stamp
+  f.camera = 1;
+  EXPECT_FALSE(stale.repeats(f));  // another camera's own history
+  Frame dark;
+  dark.image = cv::Mat(4, 4, CV_8UC3, cv::Scalar::all(0));
+  EXPECT_FALSE(stale.repeats(dark));
+  EXPECT_FALSE(stale.repeats(dark));  // a covered camera: blank, not stale
 }
 
 }  // namespace

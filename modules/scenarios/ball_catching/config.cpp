@@ -273,6 +273,7 @@ void BallCatchingConfig::validate() const {
 
 BallCatchingConfig loadBallCatchingConfig(const io::ConfigNode& root) {
   BallCatchingConfig c;
+  c.faults = runtime::readFaultPlanConfig(root);  // first: the config reference's probe reaches it
   c.name = root.getOr<std::string>("name", c.name);
   c.source = readCatchSource(root);  // sim or a recording (ball_catching/recording.h)
   c.threads = root.getOr<int>("threads", c.threads);

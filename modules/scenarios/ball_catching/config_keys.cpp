@@ -3,6 +3,7 @@
 // ScenarioConfigKeys fails when a key is read without an entry here or an entry is never read.
 #include "viewline/scenarios/config_keys.h"
 #include "viewline/scenarios/ball_catching/config.h"
+#include "viewline/runtime/faults.h"
 
 namespace viewline::scenarios {
 
@@ -18,7 +19,7 @@ io::ConfigReferenceSection ballCatchingConfigReference() {
   s.probes = {
       "cameras:\n  - {name: a, position: [0.0, -3.0, 1.5], look_at: [2.0, 0.0, 1.3], cx: 320, cy: 240}\n"
       "robot: {kind: stage}\n",
-      "source: {kind: recording, path: rec}\n"};
+      "source: {kind: recording, path: rec}\n", runtime::faultConfigProbe()};
   s.read = [](const io::ConfigNode& root) { loadBallCatchingConfig(root); };
   s.keys = {
       {"name", "", "scenario name in summaries"},
@@ -152,6 +153,7 @@ io::ConfigReferenceSection ballCatchingConfigReference() {
       {"source.kind", "", "sim (the rendered cameras) or recording (a folder written by --record); other kinds are refused"},
       {"source.path", "", "recording: the folder written by --record (as --replay)"},
   };
+  for (io::ConfigKeyDoc& d : runtime::faultConfigKeys()) s.keys.push_back(std::move(d));
   return s;
 }
 

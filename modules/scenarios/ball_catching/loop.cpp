@@ -16,8 +16,10 @@
 #include "viewline/estimation/consistency.h"
 #include "viewline/io/log.h"
 #include "viewline/runtime/delay_line.h"
+#include "viewline/runtime/stale_frames.h"
 #include "viewline/scenarios/ball_catching/planner_input.h"
 #include "viewline/scenarios/ball_catching/recording.h"
+#include "viewline/scenarios/ball_catching/robot_guard.h"
 #include "viewline/scenarios/ball_catching/world.h"
 #include "viewline/tracking/tracker.h"
 #include "viewline/vision/ball_detector.h"
@@ -41,12 +43,14 @@ class ThrowLoop {
 public:
   ThrowLoop(const BallCatchingConfig& cfg, const sim::DragFlight& flight, ThrowFrames& source,
             std::vector<core::Camera> est_cams, robots::SimulatedCartesianRobot& robot, ThrowResult& res,
-            const CatchHooks* hooks, runtime::TelemetrySink* tel, std::uint64_t seed)
-      : cfg_(cfg), flight_(flight), source_(source), est_cams_(std::move(est_cams)), robot_(robot),
+            const CatchHooks* hooks, runtime::TelemetrySink* tel, std::uint64_t seed, runtime::FaultPlan& faults)
+      : cfg_(cfg), flight_(flight), source_(source), frames_(faults.wrap(source)), faults_(faults),
+        guard_(robot, faults), est_cams_(std::move(est_cams)), robot_(robot),
         planner_(cfg.plannerConfig(), robot), tracker_(est_cams_, cfg.tracker), res_(res), hooks_(hooks), tel_(tel),
         noise_rng_(core::makeRng(core::deriveSeed(seed, 0xD37))),  // pixel_noise_px only
         planner_input_(cfg, est_cams_) {
     planner_.reset(0.0, cfg.robot.home);
+    guard_.reset(robot.read(0.0));
     for (const auto& c : est_cams_) detectors_.emplace_back(cfg.detector, c);
   }
 
@@ -65,7 +69,7 @@ public:
       }
     });
     const robots::CartesianState sp = planner_.setpoint(t);
-    robot_.command(sp);
+    guard_.send(sp);  // holds or halts when the robot fails (robot_guard.h)
     if (tel_) {
       Eigen::VectorXd u(6);
       u << sp.p, sp.v;
@@ -76,9 +80,17 @@ public:
   // A frame is ready: grab, detect, track; the estimate leaves for the planner. Returns false
   // when the live view asks to stop.
   bool capture() {
-    const std::optional<runtime::Frame> frame = source_.grab();
+    const std::optional<runtime::Frame> frame = frames_.grab();
     if (!frame) return true;  // dropped
     ++res_.frames;
+    if (faults_.missesDeadline(*frame)) {  // stale: the planner has moved on (faults.h)
+      faults_.note("frames_late_dropped");
+      return true;
+    }
+    if (stale_.repeats(*frame)) {  // a frozen camera's old image with a new stamp (stale_frames.h)
+      faults_.note("frames_frozen_dropped");
+      return true;
+    }
     const std::size_t ci = frame->camera;
     const CatchFrameTruth* truth = source_.lastTruth();
     if (truth && truth->in_front && truth->in_image && res_.t_first_visible < 0.0)
@@ -112,16 +124,24 @@ private:
       const double tp = std::max(frame.stamp, tracker_.state().t());
       if (auto uv = est_cams_[ci].project(tracker_.predictAt(tp).x().head<3>())) predicted = *uv;
     }
-    const auto det = detectors_[ci].detect(frame.image, frame.stamp, predicted);
-    if (!det.ok()) return std::nullopt;
+    const auto det = runtime::guardedDetect(faults_, ci, frame.capture_time, [&] {
+      return detectors_[ci].detect(frame.image, frame.stamp, predicted);
+    });
+    if (!det || !det->ok()) return std::nullopt;
+    const Eigen::Vector2d det_px =
+        faults_.detected(ci, frame.capture_time, det->value().pixel, frame.image.cols, frame.image.rows);
+    if (!runtime::usablePixel(det_px, frame.image.cols, frame.image.rows)) {
+      faults_.note("detections_rejected");
+      return std::nullopt;
+    }
     ++res_.detections;
     if (res_.t_first_detection < 0.0) res_.t_first_detection = frame.capture_time;
     // The detector's std: as measured against the truth (detector.sigma_px), else the blob's own.
     const double sigma_det = cfg_.sigma_px > 0.0
                                  ? cfg_.sigma_px
-                                 : std::max(cfg_.sigma_px_floor, std::sqrt(0.5 * det.value().pixel_covariance.trace()));
+                                 : std::max(cfg_.sigma_px_floor, std::sqrt(0.5 * det->value().pixel_covariance.trace()));
     const double sigma = std::hypot(sigma_det, cfg_.pixel_noise_px);  // the tracker is told the added noise
-    Eigen::Vector2d px = det.value().pixel;
+    Eigen::Vector2d px = det_px;
     // The detector's own error as the tracker sees it: against the estimator camera's image of the
     // true ball at the stamp (calibration, registration, blur and stamp errors included).
     if (cfg_.object == "ball" && frame.stamp >= flight_.startTime() && frame.stamp <= flight_.endTime())
@@ -135,7 +155,10 @@ private:
     const tracking::ImageMeasurement m{next_id_++, ci, frame.stamp, px, sigma};
     if (tel_) tel_->measurement({"camera" + std::to_string(ci), m.t, m.id, m.uv, Eigen::Vector2d::Constant(sigma)});
     const int restarts_before = tracker_.trackState().restarts;
-    if (tracker_.submit(m) != tracking::Refusal::None) return px;
+    if (const tracking::Refusal r = tracker_.submit(m); r != tracking::Refusal::None) {
+      faults_.note(std::string("tracker_refused_") + tracking::toString(r));
+      return px;
+    }
     const auto o = tracker_.outcome(m.id);
     const bool fused = o && o->fate == tracking::Fate::Fused;
     if (fused) ++res_.fused;
@@ -185,7 +208,11 @@ private:
 
   const BallCatchingConfig& cfg_;
   const sim::DragFlight& flight_;
-  ThrowFrames& source_;
+  ThrowFrames& source_;            // the truth of the last frame
+  runtime::FrameSource& frames_;  // the frames, through the injected faults
+  runtime::FaultPlan& faults_;
+  RobotGuard guard_;
+  runtime::StaleFrameFilter stale_;
   std::vector<core::Camera> est_cams_;
   robots::SimulatedCartesianRobot& robot_;
   planning::CatchPlanner planner_;
@@ -242,7 +269,8 @@ ThrowResult runThrow(const BallCatchingConfig& cfg, const sim::Scene& room, int 
           : std::make_unique<ThrowFrames>(catchThrowDir(replay_root, index), est_cams.size());
   if (hooks && !hooks->record_dir.empty()) frames->record(catchThrowDir(hooks->record_dir, index), est_cams, d);
   ThrowFrames& source = *frames;
-  ThrowLoop loop(cfg, flight, source, std::move(est_cams), robot, res, hooks, tel, seed);
+  runtime::FaultPlan faults(cfg.faults, core::deriveSeed(seed, 0xFA));
+  ThrowLoop loop(cfg, flight, source, std::move(est_cams), robot, res, hooks, tel, seed, faults);
 
   // 3. One clock: the control tick every period, the next frame when it is ready.
   runtime::Scheduler sched;
@@ -271,6 +299,7 @@ ThrowResult runThrow(const BallCatchingConfig& cfg, const sim::Scene& room, int 
 
   // 4. Outcome.
   scoreThrow(res, cfg, robot, loop.planner(), loop.leadPrediction());
+  if (!faults.empty()) res.faults = faults.report();
   res.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   if (tel) tel->flush();
   return res;

@@ -87,6 +87,7 @@ CatchSummary summarise(std::vector<ThrowResult> results, std::uint64_t seed,
     if (r.gave_up && r.reachable) ++s.gave_up_reachable;
     if (r.reachable) miss_reach.push_back(1e3 * r.miss_distance);
     s.limit_violations += r.limit_violations;
+    s.faults.add(r.faults);
     s.refused_setpoints += r.refused_setpoints;
     s.max_speed = std::max(s.max_speed, r.max_speed);
     s.max_acceleration = std::max(s.max_acceleration, r.max_acceleration);
@@ -219,6 +220,7 @@ nlohmann::json summaryJson(const CatchSummary& s, const BallCatchingConfig& cfg)
   j["reachability_start"] = "first capture with the ball inside a camera image (truth), robot at home at rest";
   j["wall_time_s"] = s.wall_s;
   j["ms_per_frame_per_thread"] = s.ms_per_frame;
+  if (!cfg.faults.faults.empty()) j["faults"] = runtime::toJson(s.faults);
   return j;
 }
 
@@ -274,6 +276,7 @@ std::string summaryText(const CatchSummary& s, const BallCatchingConfig& cfg) {
                 "robot limit violations %zu\n",
                 s.frames, s.detection_rate, s.ms_per_frame, s.limit_violations);
   out += line;
+  if (!cfg.faults.faults.empty()) out += "  " + runtime::summaryLine(s.faults) + "\n";
   return out;
 }
 

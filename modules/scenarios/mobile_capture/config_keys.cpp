@@ -2,6 +2,7 @@
 // docs/config_reference.md is generated from this table and the recorded reads; the unit test
 // ScenarioConfigKeys fails when a key is read without an entry here or an entry is never read.
 #include "viewline/scenarios/config_keys.h"
+#include "viewline/runtime/faults.h"
 #include "viewline/scenarios/mobile_capture/config.h"
 
 namespace viewline::scenarios {
@@ -16,7 +17,8 @@ io::ConfigReferenceSection mobileCaptureConfigReference() {
       "`MobileCaptureConfig::defaults()`).";
   s.shipped = {"mobile_capture.yaml"};
   // The shipped file names a rig: the inline camera's field of view too.
-  s.probes = {"camera: {width: 640, height: 480, hfov_deg: 50, vfov_deg: 40}\n", "source: {kind: recording, path: rec}\n"};
+  s.probes = {"camera: {width: 640, height: 480, hfov_deg: 50, vfov_deg: 40}\n", "source: {kind: recording, path: rec}\n",
+              runtime::faultConfigProbe()};
   s.read = [](const io::ConfigNode& root) { loadMobileCaptureConfig(root); };
   s.keys = {
       {"world", "", "the floor, the robot and the object"},
@@ -116,6 +118,7 @@ io::ConfigReferenceSection mobileCaptureConfigReference() {
       {"source.kind", "", "sim (the rendered head camera) or recording (a folder written by --record); other kinds are refused"},
       {"source.path", "", "recording: the folder written by --record (as --replay)"},
   };
+  for (io::ConfigKeyDoc& d : runtime::faultConfigKeys()) s.keys.push_back(std::move(d));
   return s;
 }
 

@@ -2,10 +2,12 @@
 
 #include <Eigen/Cholesky>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <optional>
 
 #include "viewline/core/interrupt.h"
+#include "viewline/runtime/stale_frames.h"
 #include "viewline/robots/mobile_ground_localization.h"
 #include "viewline/scenarios/mobile_capture/recording.h"
 #include "viewline/scenarios/mobile_capture/world.h"
@@ -112,11 +114,13 @@ MobileCaptureRun runMobileCapture(const MobileCaptureConfig& cfg, std::uint64_t 
     const robots::BasePose& p = robot.base.pose();
     return trueCamera_c_M_w(robot.head, robot.q, p.x, p.y, p.theta);
   };
-  std::unique_ptr<MobileCaptureFrames> frames =
+  std::unique_ptr<MobileCaptureFrames> head_frames =
       replay_dir.empty() ? std::make_unique<MobileCaptureFrames>(cfg, target, rng, camera_pose)
                          : std::make_unique<MobileCaptureFrames>(replay_dir, target);
-  if (hooks && !hooks->record_dir.empty()) frames->record(hooks->record_dir, estimatorCamera(cfg));
-  MobileCaptureFrames& source = *frames;
+  if (hooks && !hooks->record_dir.empty()) head_frames->record(hooks->record_dir, estimatorCamera(cfg));
+  MobileCaptureFrames& source = *head_frames;
+  runtime::FaultPlan faults(cfg.faults, core::deriveSeed(seed, 0xFA));
+  runtime::FrameSource& frames = faults.wrap(source);
   vision::BallDetector detector(cfg.detector);
   core::Camera camera = estimatorCamera(cfg);  // detection ROI, ground localisation
   const robots::AnglePerPixel printed{cfg.hfov, cfg.vfov, robots::AngleRange::PrintedSlant};
@@ -170,13 +174,22 @@ MobileCaptureRun runMobileCapture(const MobileCaptureConfig& cfg, std::uint64_t 
       const Vector2d p = track.positionAt(t);
       predicted_px = camera.project(Vector3d(p.x(), p.y(), plane_z));
     }
-    const auto det = detector.detect(frame.image, t, predicted_px);
+    const auto det = runtime::guardedDetect(faults, frame.camera, frame.capture_time,
+                                            [&] { return detector.detect(frame.image, t, predicted_px); });
+    std::optional<Vector2d> det_px;
+    if (det && det->ok())
+      det_px = faults.detected(frame.camera, frame.capture_time, det->value().blob_center, frame.image.cols,
+                               frame.image.rows);
+    if (det_px && !runtime::usablePixel(*det_px, frame.image.cols, frame.image.rows)) {
+      faults.note("detections_rejected");
+      det_px.reset();
+    }
     bool detected = false, fused = false;
     std::optional<FloorMeasurement> measurement;
     double nis = std::numeric_limits<double>::quiet_NaN();
     Vector2d pixel = Vector2d::Zero();
-    if (det.ok()) {
-      pixel = det.value().blob_center;
+    if (det_px) {
+      pixel = *det_px;
       if (sink) sink->measurement({channel::kPixel, t, frame.sequence, pixel, vec({cfg.pixel_sigma, cfg.pixel_sigma})});
       // The floor point and its noise: white pixel noise through the range-dependent
       // ground-projection Jacobian goes into R; the calibration and centroid bias does not (the
@@ -284,11 +297,24 @@ MobileCaptureRun runMobileCapture(const MobileCaptureConfig& cfg, std::uint64_t 
     }
   };
   // Frames when the source has them (a renderer: every vision period, on the control ticks).
+  double last_stamp = -std::numeric_limits<double>::infinity();  // of the last frame processed
+  runtime::StaleFrameFilter stale;
   std::function<void()> next_frame = [&] {
-    const auto t = source.nextReadyTime();
+    const auto t = frames.nextReadyTime();
     if (!t) return;
     sched.at(*t, kVision, [&](double) {
-      if (auto frame = source.grab()) process(*frame);
+      if (auto frame = frames.grab()) {
+        if (faults.missesDeadline(*frame)) {  // stale: dropped as a lost frame (faults.h)
+          faults.note("frames_late_dropped");
+        } else if (stale.repeats(*frame)) {  // a frozen camera's old image, new stamp (stale_frames.h)
+          faults.note("frames_frozen_dropped");
+        } else if (!(frame->stamp > last_stamp)) {  // a repeated or backward stamp: the track only steps forward
+          faults.note("frames_stale_stamp_dropped");
+        } else {
+          last_stamp = frame->stamp;
+          process(*frame);
+        }
+      }
       next_frame();
     });
   };
@@ -330,6 +356,7 @@ MobileCaptureRun runMobileCapture(const MobileCaptureConfig& cfg, std::uint64_t 
   sched.runUntil(clock.time(clock.last));
   if (!run.captured) run.capture_time = cfg.max_time;
   run.gate = track.gate().counts();
+  if (!faults.empty()) run.faults = faults.report();
   if (sink) sink->flush();
   // requestStop() also ends a run at its capture; a signal or the view's quit ends it early.
   if (core::interruptRequested()) run.interrupted = true;

@@ -317,6 +317,11 @@ std::string summaryJson(const MobileCaptureSummary& s, const MobileCaptureConfig
   j["consistency"] = consistencyJson(s);
   j["rig"] = cfg.rig ? nlohmann::json(cfg.rig->folder) : nlohmann::json(nullptr);
   j["wall_time_s"] = s.wall_time;
+  if (!cfg.faults.faults.empty()) {  // only with injected faults: reference summaries unchanged
+    runtime::FaultReport total;
+    for (const MobileCaptureRun& r : s.runs) total.add(r.faults);
+    j["faults"] = runtime::toJson(total);
+  }
   return j.dump(indent);
 }
 
@@ -381,6 +386,11 @@ std::string summaryText(const MobileCaptureSummary& s, const MobileCaptureConfig
                 "horizontal range %.3f m\n",
                 rms(l.sse_exact, l.count), rms(l.sse_printed, l.count), rms(l.sse_horizontal, l.count));
   out += line;
+  if (!cfg.faults.faults.empty()) {
+    runtime::FaultReport total;
+    for (const MobileCaptureRun& r : s.runs) total.add(r.faults);
+    out += "  " + runtime::summaryLine(total) + "\n";
+  }
   if (s.interrupted) {
     out += "  FOV sweep and filter test: not run (interrupted)\n";
     return out;

@@ -113,6 +113,7 @@ void printSummary(const PanTiltScenarioConfig& cfg, const PanTiltComparison& res
   std::fprintf(out, "\n");
   if (o.filter_region_dropped) printRegionWarning(out);
   std::fprintf(out, "  %.1f ms per frame (render + detect + control)\n", o.wall_ms_per_frame);
+  if (!o.faults.empty()) std::fprintf(out, "  %s (ours)\n", runtime::summaryLine(o.faults).c_str());
 }
 
 }  // namespace

@@ -61,6 +61,7 @@ PanTiltScenarioConfig loadPanTiltScenarioConfig(const io::ConfigNode& root) {
   // its first missing required key).
   PanTiltScenarioConfig c;
   c.source = runtime::readSourceConfig(root);
+  c.faults = runtime::readFaultPlanConfig(root);
   {
     const auto p = root.child("path");
     const std::string shape = p.getChoice("shape", {"rectangle", "circle", "random"});

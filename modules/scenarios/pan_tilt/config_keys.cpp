@@ -2,6 +2,7 @@
 // docs/config_reference.md is generated from this table and the recorded reads; the unit test
 // ScenarioConfigKeys fails when a key is read without an entry here or an entry is never read.
 #include "viewline/scenarios/config_keys.h"
+#include "viewline/runtime/faults.h"
 #include "viewline/scenarios/pan_tilt/config.h"
 
 namespace viewline::scenarios {
@@ -127,6 +128,8 @@ io::ConfigReferenceSection panTiltConfigReference() {
       {"run.baseline", "", "also run ViSP's law on the same seed"},
   };
   for (const io::ConfigKeyDoc& k : runtime::sourceConfigKeys()) s.keys.push_back(k);
+  for (const io::ConfigKeyDoc& k : runtime::faultConfigKeys()) s.keys.push_back(k);
+  s.probes.push_back(runtime::faultConfigProbe());
   return s;
 }
 

@@ -11,6 +11,8 @@
 #include "viewline/core/random.h"
 #include "viewline/runtime/delay_line.h"
 #include "viewline/runtime/recording.h"
+#include "viewline/runtime/stale_frames.h"
+#include "viewline/scenarios/pan_tilt/faults.h"
 #include "viewline/scenarios/pan_tilt/world.h"
 
 namespace viewline::scenarios {
@@ -141,7 +143,9 @@ PanTiltRunMetrics runPanTilt(const PanTiltScenarioConfig& cfg, std::uint64_t see
     recorder = std::make_unique<runtime::RecordingFrameSource>(*grabber, *writer);
     grabber = recorder.get();
   }
-  runtime::FrameSource& source = *grabber;
+  runtime::FaultPlan faults(cfg.faults, core::deriveSeed(seed, 0xFA));
+  runtime::FrameSource& source = faults.wrap(*grabber);
+  runtime::StaleFrameFilter stale;
   CommandsInFlight recent(latency, period);
   runtime::DelayLine<Processed> to_controller;  // the processing delay
   runtime::TelemetrySink* tel = io.telemetry;
@@ -208,8 +212,7 @@ PanTiltRunMetrics runPanTilt(const PanTiltScenarioConfig& cfg, std::uint64_t see
     const robots::JointState e = robots::predictJointState(limits, in.joints, recent.all(), latency, t_cmd + latency);
     const bool safe = robots::isSafeCommand(limits, e.q, e.qdot, out.qdot, period, 1e-9);
     score.command(limits, in.joints.q, out.qdot, safe, out.mode == control::TrackingMode::Searching);
-    unit.commandVelocity(t_cmd, out.qdot);
-    recent.issued(t_cmd, out.qdot);
+    if (const auto sent = pan_tilt::commandThroughFaults(unit, faults, t_cmd, out.qdot)) recent.issued(t_cmd, *sent);
     if (tel != nullptr) tel->command({name, t_cmd, vec(out.qdot)});
 
     if (io.frames != nullptr) {
@@ -246,6 +249,14 @@ PanTiltRunMetrics runPanTilt(const PanTiltScenarioConfig& cfg, std::uint64_t see
   std::function<void(double)> capture = [&](double) {
     const std::size_t k = grabbed++;
     std::optional<runtime::Frame> frame = source.grab();
+    if (frame && faults.missesDeadline(*frame)) {  // stale: dropped as a lost frame (faults.h)
+      faults.note("frames_late_dropped");
+      frame.reset();
+    }
+    if (frame && stale.repeats(*frame)) {  // a frozen camera's old image with a new stamp (stale_frames.h)
+      faults.note("frames_frozen_dropped");
+      frame.reset();
+    }
     if (frame) {
       Processed p;
       p.index = k;
@@ -268,13 +279,21 @@ PanTiltRunMetrics runPanTilt(const PanTiltScenarioConfig& cfg, std::uint64_t see
       const Vector2d n = world.drawNoise();
       control::TargetObservation& obs = p.obs;
       obs.stamp = frame->stamp;
-      const auto det = detector.detect(frame->image, frame->stamp);
+      const auto det = runtime::guardedDetect(faults, frame->camera, tc,
+                                              [&] { return detector.detect(frame->image, frame->stamp); });
+      std::optional<Vector2d> det_px;
+      if (det && det->ok())
+        det_px = faults.detected(frame->camera, tc, det->value().pixel, frame->image.cols, frame->image.rows);
+      if (det_px && !runtime::usablePixel(*det_px, frame->image.cols, frame->image.rows)) {
+        faults.note("detections_rejected");
+        det_px.reset();
+      }
       // The camera as the controllers know it at the capture stamp: calibrated intrinsics,
       // calibrated mount, encoder reading at the stamp.
       model_cam.c_M_w = kin_model.c_M_f(unit.read(frame->stamp).q);
-      if (det.ok()) {
+      if (det_px) {
         // Back-project onto the screen plane (z_screen = 0) through that camera.
-        const Vector3d ray_f = model_cam.rayThroughPixel_w(det.value().pixel);
+        const Vector3d ray_f = model_cam.rayThroughPixel_w(*det_px);
         const Vector3d c_f = model_cam.center_w();
         const Eigen::Isometry3d screen_M_f = world.f_M_screen().inverse();
         const Vector3d o_s = screen_M_f * c_f;
@@ -289,7 +308,7 @@ PanTiltRunMetrics runPanTilt(const PanTiltScenarioConfig& cfg, std::uint64_t see
           obs.plane_cov = world.R();
           obs.feature = Vector2d(meas_c.x() / meas_c.z(), meas_c.y() / meas_c.z());
           p.meas_px = model_cam.normalizedToPixel(obs.feature);
-          score.detectorError(tc, det.value().pixel, p.truth.px);
+          score.detectorError(tc, *det_px, p.truth.px);
         }
       }
       if (tel != nullptr) {
@@ -324,6 +343,7 @@ PanTiltRunMetrics runPanTilt(const PanTiltScenarioConfig& cfg, std::uint64_t see
   PanTiltRunMetrics m = score.finish(ours, world.unit(), wall);
   m.stopped = sched.stopRequested();
   m.scored = has_truth;
+  if (!faults.empty()) m.faults = faults.report();
   return m;
 }
 

@@ -62,6 +62,7 @@ nlohmann::json PanTiltRunMetrics::toJson() const {
           {"wall_ms_per_frame", wall_ms_per_frame}};
   if (!scored) j["truth"] = "not scored (the frame source has no truth)";  // only then: reference summaries unchanged
   if (consistency.nis.count() > 0) j["consistency"] = consistency.toJson();
+  if (!faults.empty()) j["faults"] = runtime::toJson(faults);  // only with injected faults (the same reason)
   return j;
 }
 

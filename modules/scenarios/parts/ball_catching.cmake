@@ -9,7 +9,9 @@ list(APPEND scenarios_sources
   ball_catching/planner_input.cpp
   ball_catching/recording.cpp
   ball_catching/registration.cpp
+  ball_catching/robot_guard.cpp
   ball_catching/world.cpp)
 list(APPEND scenarios_tests test/summary_text_test.cpp test/flight_fit_test.cpp test/ball_catching_sources_test.cpp)
 # Unit and meaning of every key its config reader reads (docs/config_reference.md is generated from it).
 list(APPEND scenarios_sources ball_catching/config_keys.cpp)
+list(APPEND scenarios_tests test/ball_catching_faults_test.cpp)

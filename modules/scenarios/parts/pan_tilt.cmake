@@ -3,6 +3,7 @@
 list(APPEND scenarios_sources
   pan_tilt/command.cpp
   pan_tilt/config.cpp
+  pan_tilt/faults.cpp
   pan_tilt/footage.cpp
   pan_tilt/loop.cpp
   pan_tilt/metrics.cpp
@@ -19,3 +20,4 @@ list(APPEND scenarios_tests test/pan_tilt_sources_test.cpp)
 list(APPEND scenarios_tests test/calibrated_rig_test.cpp)
 # Guard of the headline figures: the shipped filter replayed on each path's synthetic measurements.
 list(APPEND scenarios_tests test/pan_tilt_headline_test.cpp)
+list(APPEND scenarios_tests test/pan_tilt_faults_test.cpp)

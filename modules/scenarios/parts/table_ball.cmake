@@ -7,3 +7,4 @@ list(APPEND scenarios_tests test/table_ball_observer_test.cpp)
 list(APPEND scenarios_sources table_ball/config_keys.cpp)
 # The loop on a recording of its head camera (--record / --replay).
 list(APPEND scenarios_tests test/table_ball_sources_test.cpp)
+list(APPEND scenarios_tests test/table_ball_faults_test.cpp)

@@ -2,6 +2,7 @@
 // docs/config_reference.md is generated from this table and the recorded reads; the unit test
 // ScenarioConfigKeys fails when a key is read without an entry here or an entry is never read.
 #include "viewline/scenarios/config_keys.h"
+#include "viewline/runtime/faults.h"
 #include "viewline/scenarios/table_ball/config.h"
 
 namespace viewline::scenarios {
@@ -16,7 +17,7 @@ io::ConfigReferenceSection tableBallConfigReference() {
   s.shipped = {"table_ball.yaml", "table_ball_apriltag.yaml"};
   // No shipped file has the inline camera (both name a rig): the camera given by its geometry.
   s.probes = {"table: {}\nwrist: {}\ncamera: {cx: 320, cy: 240, position: [0.5, 0.0, 1.5], look_at: [0.0, 0.0, 0.9]}\n",
-              "source: {kind: recording, path: rec}\n"};
+              "source: {kind: recording, path: rec}\n", runtime::faultConfigProbe()};
   s.read = [](const io::ConfigNode& root) { tableBallConfigFromYaml(root); };
   s.keys = {
       {"duration", "s", "simulated time (--duration overrides it)"},
@@ -101,6 +102,7 @@ io::ConfigReferenceSection tableBallConfigReference() {
       {"source.kind", "", "sim (the rendered head camera) or recording (a folder written by --record); other kinds are refused"},
       {"source.path", "", "recording: the folder written by --record"},
   };
+  for (io::ConfigKeyDoc& d : runtime::faultConfigKeys()) s.keys.push_back(std::move(d));
   return s;
 }
 

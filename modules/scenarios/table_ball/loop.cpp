@@ -12,6 +12,7 @@
 #include "viewline/core/error.h"
 #include "viewline/runtime/delay_line.h"
 #include "viewline/runtime/recording.h"
+#include "viewline/runtime/stale_frames.h"
 #include "viewline/scenarios/table_ball/world.h"
 #include "viewline/vision/table_detector.h"
 
@@ -135,7 +136,9 @@ TableBallResult runTableBall(const TableBallConfig& cfg, std::uint64_t seed, con
     recorded = std::make_unique<runtime::RecordingSource>(hooks.replay_dir);
   else if (cfg.source.kind == runtime::SourceKind::Recording)
     recorded = std::make_unique<runtime::RecordingSource>(cfg.source.recording);
-  runtime::FrameSource& camera = recorded ? static_cast<runtime::FrameSource&>(*recorded) : renderer;
+  runtime::FaultPlan faults(cfg.faults, core::deriveSeed(seed, 0xFA));
+  runtime::StaleFrameFilter stale;
+  runtime::FrameSource& camera = faults.wrap(recorded ? static_cast<runtime::FrameSource&>(*recorded) : renderer);
   std::unique_ptr<runtime::RecordingWriter> writer;
   if (!hooks.record_dir.empty()) {
     writer = std::make_unique<runtime::RecordingWriter>(hooks.record_dir);
@@ -160,6 +163,7 @@ TableBallResult runTableBall(const TableBallConfig& cfg, std::uint64_t seed, con
   current.t0 = -1.0;
   current.period = period;
   bool frame_pending = false;
+  double last_stamp = -std::numeric_limits<double>::infinity();  // of the last frame the loop used
 
   // --- physics: tick k at k · kTick (scheduled from k, not accumulated) -----------------------
   std::function<void(double)> tick = [&](double) {
@@ -208,7 +212,21 @@ TableBallResult runTableBall(const TableBallConfig& cfg, std::uint64_t seed, con
       else
         writer->lost(ready, meta);
     }
-    const double t = cap.stamp;
+    if (frame && faults.missesDeadline(*frame)) {  // stale: dropped as a lost frame (faults.h)
+      faults.note("frames_late_dropped");
+      frame.reset();
+    }
+    if (frame && stale.repeats(*frame)) {  // a frozen camera's old image with a new stamp (stale_frames.h)
+      faults.note("frames_frozen_dropped");
+      frame.reset();
+    }
+    const double t = frame ? frame->stamp : cap.stamp;  // the stamp as delivered (injected stamp faults)
+    if (!(t > last_stamp)) {  // a repeated or backward stamp: the filters only step forward in time
+      faults.note("frames_stale_stamp_dropped");
+      scheduleFrame();
+      return;
+    }
+    last_stamp = t;
     const sim::TiltTableState truth = world.stateAt(cap.capture_time);
     const Eigen::Vector2d ref = cfg.setpointAt(t);
     const Eigen::Isometry3d w_M_t_nominal = world.tablePose(controller.modelTilt());
@@ -220,7 +238,10 @@ TableBallResult runTableBall(const TableBallConfig& cfg, std::uint64_t seed, con
       const Eigen::Matrix3d c_R_w = world.groundRotationReading(obs_c_M_w);
       const Eigen::Isometry3d c_M_t_nominal = obs_c_M_w * w_M_t_nominal;
       const double c0 = threadCpuSeconds();
-      of = &observer.process(frame->image, t, c_R_w, c_M_t_nominal);
+      const auto processed = runtime::guardedDetect(faults, frame->camera, cap.capture_time, [&] {
+        return &observer.process(frame->image, t, c_R_w, c_M_t_nominal);
+      });
+      of = processed ? *processed : &observer.predictOnly(t);
       const double c1 = threadCpuSeconds();
       if (cfg.time_reference) {
         const double ref_wall = reference.run(frame->image, t, c_R_w, c_M_t_nominal, of->a_xy);
@@ -278,6 +299,7 @@ TableBallResult runTableBall(const TableBallConfig& cfg, std::uint64_t seed, con
   if (writer) writer->finish();
   TableBallResult res = metrics.result(seed);
   res.stopped_early = stopped;
+  if (!faults.empty()) res.faults = faults.report();
   if (sink != nullptr) sink->flush();
   res.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   return res;

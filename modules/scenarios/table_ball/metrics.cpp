@@ -274,6 +274,7 @@ nlohmann::json toJson(const TableBallResult& r) {
   }
   j["pushes"] = pushes;
   j["wall_seconds"] = r.wall_seconds;
+  if (!r.faults.empty()) j["faults"] = runtime::toJson(r.faults);  // only with injected faults
   return j;
 }
 
@@ -360,6 +361,7 @@ void printTableBallSummary(std::FILE* out, const TableBallResult& r, const Table
   std::fprintf(out, "  commands: max |tilt| %.2f deg, max rate %.1f deg/s, limits %s; wall %.1f s\n",
                r.max_commanded_angle_deg, r.max_commanded_rate_deg_s, r.limits_respected ? "respected" : "VIOLATED",
                r.wall_seconds);
+  if (!r.faults.empty()) std::fprintf(out, "  %s\n", runtime::summaryLine(r.faults).c_str());
 }
 
 }  // namespace viewline::scenarios

@@ -17,6 +17,7 @@
 #include "viewline/io/config.h"
 #include "viewline/planning/catch_planner.h"
 #include "viewline/robots/cartesian_robot.h"
+#include "viewline/runtime/faults.h"
 #include "viewline/runtime/source_config.h"
 #include "viewline/scenarios/ball_catching/flight_fit.h"
 #include "viewline/sim/physics.h"
@@ -144,6 +145,8 @@ struct BallCatchingConfig {
   sim::RoomParams room;              ///< the simulated room around the scene (walls, floor, light)
   int threads = 2;                   ///< throws run in parallel (independent seeds: same results)
   runtime::SourceConfig source;      ///< `source:` sim (render) or recording (a folder of --record, recording.h)
+  /// Injected faults (runtime/faults.h; windows in each throw's time, release at 0; empty: none).
+  runtime::FaultConfig faults;
 
   /// The cameras a throw uses: the first camera_count (all when 0).
   std::size_t activeCameras() const { return camera_count > 0 ? camera_count : cameras.size(); }

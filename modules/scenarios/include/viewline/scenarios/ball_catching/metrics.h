@@ -33,6 +33,7 @@
 #include "viewline/planning/catch_planner.h"
 #include "viewline/robots/cartesian_robot.h"
 #include "viewline/scenarios/ball_catching/config.h"
+#include "viewline/runtime/faults.h"
 #include "viewline/scenarios/ball_catching/registration.h"
 
 namespace viewline::scenarios {
@@ -95,6 +96,7 @@ struct ThrowResult {
   double max_speed = 0.0,  ///< largest set-point speed, m/s (measured as robot.limit_norm says)
          max_acceleration = 0.0;  ///< largest set-point acceleration |Δv| / Δt, m/s² (same measure)
   double wall_s = 0.0;  ///< wall-clock time the throw took to simulate, s
+  runtime::FaultReport faults;  ///< injected faults and what the loop did (empty without faults)
 };
 
 /// The figures of runBallCatching() (the summary JSON): catch rates, prediction errors, decisions, limits.
@@ -150,6 +152,7 @@ struct CatchSummary {
   double wall_s = 0.0,        ///< wall-clock time of all throws, s (set by the caller)
          ms_per_frame = 0.0;  ///< wall-clock per image, ms
   std::vector<ThrowResult> results;  ///< every throw, in throw order
+  runtime::FaultReport faults;  ///< injected faults and outcomes summed over the throws
 };
 
 /// The end of a throw: caught or not (and why), the oracle, the planner's decisions, the robot's

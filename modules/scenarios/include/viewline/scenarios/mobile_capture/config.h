@@ -14,6 +14,7 @@
 #include "viewline/planning/capture_planner.h"
 #include "viewline/robots/differential_drive.h"
 #include "viewline/robots/mobile_pan_tilt.h"
+#include "viewline/runtime/faults.h"
 #include "viewline/runtime/source_config.h"
 #include "viewline/tracking/unicycle_tracker.h"
 #include "viewline/vision/ball_detector.h"
@@ -69,6 +70,8 @@ struct MobileCaptureConfig {
     Eigen::Isometry3d cal_M_c = Eigen::Isometry3d::Identity();  ///< c'_M_c, calibrated vs DH camera
   };
   std::optional<RigCameras> rig;  ///< empty: an ideal camera from width, height, hfov, vfov
+  /// Injected camera and detector faults (runtime/faults.h; windows in run time; empty: none).
+  runtime::FaultConfig faults;
 
   // Robot.
   robots::MobilePanTiltParams head;       ///< pan-tilt head on the base: DH geometry, joint limits

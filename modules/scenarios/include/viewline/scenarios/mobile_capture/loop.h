@@ -99,6 +99,7 @@ struct MobileCaptureRun {
   double nees_sum = 0.0;  ///< Σ of the position NEES samples
   long nees_count = 0;    ///< NEES samples in nees_sum
   bool interrupted = false;            ///< a stop request (signal, closed view) ended the run early: not scored
+  runtime::FaultReport faults;         ///< injected faults and what the loop did (empty without faults)
 };
 
 /// s a track must have been valid before its NIS and NEES samples count (the two-point start's

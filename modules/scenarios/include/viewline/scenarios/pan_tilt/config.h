@@ -19,6 +19,7 @@
 #include "viewline/io/config.h"
 #include "viewline/robots/flir_ptu.h"
 #include "viewline/robots/simulated_pan_tilt.h"
+#include "viewline/runtime/faults.h"
 #include "viewline/runtime/source_config.h"
 #include "viewline/sim/physics.h"
 #include "viewline/vision/screen_target_detector.h"
@@ -76,6 +77,8 @@ struct PanTiltScenarioConfig {
   /// Where the frames come from (`source:`; default: the renderer over the simulated world). A
   /// recording with truth is scored; other sources are not (the unit stays simulated).
   runtime::SourceConfig source;
+  /// Injected faults (runtime/faults.h; windows in run time, robot faults on the unit's commands; empty: none).
+  runtime::FaultConfig faults;
 
   void validate() const;  ///< throws core::InvalidInput naming the field
 };

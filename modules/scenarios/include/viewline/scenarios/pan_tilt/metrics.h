@@ -92,6 +92,7 @@ struct PanTiltRunMetrics {
   /// The frames came with truth (the simulator, or a recording of it): false for footage, where
   /// every figure that needs the true target is NaN ("not scored" in the summary).
   bool scored = true;
+  runtime::FaultReport faults;  ///< injected faults and what the loop did (empty without faults)
 
   /// Every figure above but the gate counts, as JSON (NaN as null; "truth": "not scored" when not scored).
   nlohmann::json toJson() const;

@@ -12,6 +12,7 @@
 #include "viewline/core/camera.h"
 #include "viewline/io/config.h"
 #include "viewline/robots/table_tilt.h"
+#include "viewline/runtime/faults.h"
 #include "viewline/runtime/source_config.h"
 #include "viewline/scenarios/table_ball/observer.h"
 
@@ -90,6 +91,8 @@ struct TableBallConfig {
   /// Where the frames come from (`source:`): sim (the rendered head camera, the default) or a
   /// recording of a simulated run (its truth is the simulated world's, which a replay reproduces).
   runtime::SourceConfig source;
+  /// Injected camera and detector faults (runtime/faults.h; windows in run time; empty: none).
+  runtime::FaultConfig faults;
   bool time_reference = true;                                  ///< time the plain OpenCV reference
 
   /// Throws core::InvalidInput naming the field. tableBallConfigFromYaml calls it; code that

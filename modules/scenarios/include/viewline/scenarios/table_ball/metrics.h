@@ -77,6 +77,7 @@ struct TableBallResult {
   bool limits_respected = true;  ///< every command within the wrist's angle and rate limits
   bool stopped_early = false;  ///< the run was stopped before its duration (a display's quit key)
   double wall_seconds = 0.0;   ///< wall-clock time of the run, s
+  runtime::FaultReport faults;  ///< injected faults and what the loop did (empty without faults)
 };
 
 /// The result as the summary JSON (NaN and ±inf as null; steps and pushes as arrays).
