@@ -234,8 +234,36 @@ void RecordingWriter::truth(std::size_t camera, std::uint64_t sequence, const st
   truth_text_ += "\n";
 }
 
+void RecordingWriter::setTable(const std::string& name, std::vector<std::string> columns) {
+  if (name.empty() || name == "recording" || name == "truth" || name.find_first_of("/\\.") != std::string::npos)
+    throw core::InvalidInput("recording " + dir_ + ": table name '" + name +
+                             "' (expected a plain file stem other than recording and truth)");
+  if (columns.empty()) throw core::InvalidInput("recording " + dir_ + ": table " + name + " has no columns");
+  if (tables_.count(name) != 0) throw core::InvalidInput("recording " + dir_ + ": table " + name + " declared twice");
+  tables_[name] = {std::move(columns), std::string()};
+}
+
+void RecordingWriter::tableRow(const std::string& name, std::size_t camera, std::uint64_t sequence,
+                               const std::vector<double>& values) {
+  if (finished_) throw core::InvalidInput("recording " + dir_ + ": a table row after finish()");
+  const auto it = tables_.find(name);
+  if (it == tables_.end()) throw core::InvalidInput("recording " + dir_ + ": table " + name + " was not declared");
+  if (values.size() != it->second.first.size())
+    throw core::InvalidInput("recording " + dir_ + ": " + std::to_string(values.size()) + " values for the " +
+                             std::to_string(it->second.first.size()) + " columns of table " + name);
+  std::string& text = it->second.second;
+  text += std::to_string(camera) + "," + std::to_string(sequence);
+  for (double v : values) text += "," + exact(v);
+  text += "\n";
+}
+
 void RecordingWriter::finish() {
   if (finished_) return;
+  for (const auto& [name, table] : tables_) {
+    std::string text = "camera,sequence";
+    for (const auto& c : table.first) text += "," + c;
+    io::writeTextFileAtomic((fs::path(dir_) / (name + ".csv")).string(), text + "\n" + table.second);
+  }
   if (!truth_columns_.empty()) {
     std::string text = "camera,sequence";
     for (const auto& c : truth_columns_) text += "," + c;
@@ -319,6 +347,12 @@ std::optional<std::vector<double>> RecordingSource::truth(std::size_t camera, st
   const auto it = truth_.rows.find({camera, sequence});
   if (it == truth_.rows.end()) return std::nullopt;
   return it->second;
+}
+
+std::optional<RecordingTruth> RecordingSource::table(const std::string& name) const {
+  const fs::path file = fs::path(dir_) / (name + ".csv");
+  if (!fs::exists(file)) return std::nullopt;
+  return parseRecordingTruth(csv::readWholeFile(file.string(), "recording table " + name), file.string());
 }
 
 std::optional<core::Camera> RecordingSource::camera(std::size_t k) const {

@@ -258,6 +258,35 @@ TEST(Recording, WritesAndReadsBackBitForBit) {
   EXPECT_EQ(r.configText(), "a: 1\n");
 }
 
+TEST(Recording, PerFrameTablesReadBackBitForBit) {
+  const fs::path d = scratch("rec_table");
+  {
+    RecordingWriter w((d / "r").string());
+    w.setTable("ptu", {"joint_t", "pan"});
+    EXPECT_NE(errorOf([&] { w.setTable("ptu", {"x"}); }).find("declared twice"), std::string::npos);
+    EXPECT_NE(errorOf([&] { w.setTable("truth", {"x"}); }).find("table name"), std::string::npos);
+    EXPECT_NE(errorOf([&] { w.setTable("../up", {"x"}); }).find("table name"), std::string::npos);
+    EXPECT_NE(errorOf([&] { w.tableRow("other", 0, 0, {1.0}); }).find("not declared"), std::string::npos);
+    EXPECT_NE(errorOf([&] { w.tableRow("ptu", 0, 0, {1.0}); }).find("1 values for the 2 columns"), std::string::npos);
+    Frame f;
+    f.sequence = 4;
+    f.capture_time = f.stamp = 0.1 / 3.0;
+    f.image = cv::Mat(4, 4, CV_8UC1, cv::Scalar(7));
+    w.frame(0.05, f);
+    w.tableRow("ptu", 0, 4, {0.1 / 3.0, -1.0 / 7.0});
+    w.finish();
+    EXPECT_NE(errorOf([&] { w.tableRow("ptu", 0, 5, {0.0, 0.0}); }).find("after finish()"), std::string::npos);
+  }
+  const RecordingSource r((d / "r").string());
+  EXPECT_FALSE(r.hasTruth());
+  EXPECT_FALSE(r.table("other"));
+  const auto t = r.table("ptu");
+  ASSERT_TRUE(t);
+  EXPECT_EQ(t->columns, (std::vector<std::string>{"joint_t", "pan"}));
+  ASSERT_EQ(t->rows.size(), 1u);
+  EXPECT_EQ(t->rows.at({0, 4}), (std::vector<double>{0.1 / 3.0, -1.0 / 7.0}));
+}
+
 TEST(Recording, IndexErrorsNameFileAndLine) {
   const std::string h = "ready_time,camera,sequence,capture_time,stamp,file\n";
   EXPECT_NE(errorOf([] { parseRecordingIndex("time,file\n", "r.csv"); }).find("r.csv:1: expected the header"), std::string::npos);

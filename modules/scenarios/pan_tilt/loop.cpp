@@ -22,6 +22,10 @@ using Eigen::Vector3d;
 
 std::string truthChannel(const std::string& controller) { return controller + "_truth"; }
 std::string imageErrorChannel(const std::string& controller) { return controller + "_image_error_px"; }
+const std::vector<std::string>& ptuTableColumns() {
+  static const std::vector<std::string> c = {"joint_t", "pan", "tilt", "noise_x", "noise_y", "R_xx", "R_xy", "R_yy"};
+  return c;
+}
 
 namespace {
 
@@ -140,6 +144,7 @@ PanTiltRunMetrics runPanTilt(const PanTiltScenarioConfig& cfg, std::uint64_t see
     writer->setCamera(0, panTiltModelCamera(cfg));  // the calibration the controllers use
     if (!io.config_text.empty()) writer->setConfig(io.config_text);
     if (has_truth) writer->setTruthColumns(kTruthColumns);
+    writer->setTable(kPtuTable, ptuTableColumns());  // a replay without the unit needs its readings
     recorder = std::make_unique<runtime::RecordingFrameSource>(*grabber, *writer);
     grabber = recorder.get();
   }
@@ -290,7 +295,11 @@ PanTiltRunMetrics runPanTilt(const PanTiltScenarioConfig& cfg, std::uint64_t see
       }
       // The camera as the controllers know it at the capture stamp: calibrated intrinsics,
       // calibrated mount, encoder reading at the stamp.
-      model_cam.c_M_w = kin_model.c_M_f(unit.read(frame->stamp).q);
+      const robots::JointState joints = unit.read(frame->stamp);
+      model_cam.c_M_w = kin_model.c_M_f(joints.q);
+      if (writer)
+        writer->tableRow(kPtuTable, frame->camera, frame->sequence,
+                         {joints.t, joints.q.x(), joints.q.y(), n.x(), n.y(), world.R()(0, 0), world.R()(0, 1), world.R()(1, 1)});
       if (det_px) {
         // Back-project onto the screen plane (z_screen = 0) through that camera.
         const Vector3d ray_f = model_cam.rayThroughPixel_w(*det_px);

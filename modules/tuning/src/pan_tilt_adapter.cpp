@@ -101,7 +101,7 @@ detail::OptionTable<PanTiltOptions> panTiltOptions() {
       .integer("burn_in", &PanTiltOptions::burn_in, "5", 1, 1e6, "accepted measurements of a track before its innovations count")
       .number("nees_spacing_s", &PanTiltOptions::nees_spacing, "2", 1e-9, detail::kUnbounded, "s between NEES samples (nearly independent)")
       .integer("log_seed", &PanTiltOptions::log_seed, "1", 0, 1e15,
-               "seed of the run a --log folder or a --recording comes from (its path amplitude gives R)");
+               "seed of the run a --log folder comes from (its path amplitude gives R; a --recording carries its R)");
   return options;
 }
 
@@ -257,21 +257,28 @@ public:
     return d;
   }
 
-  /// A recording's frames through the scenario's detector and loop (pan_tilt_recording.h), seed
-  /// log_seed; NIS only (a recording of a real rig has no truth).
+  /// A recording's frames through the scenario's detector and back-projection at the recorded joint
+  /// readings (pan_tilt_recording.h): no unit, no simulator, no seed; NIS only (a recording of a real
+  /// rig has no truth).
   std::unique_ptr<ReplayData> loadRecording(const std::string& dir) const override {
-    const detail::PanTiltRecordingRun run = detail::panTiltRecordingRun(cfg_, dir);
-    PanTiltOptions o = opt_;
-    o.duration = 0.0;  // the recording's length, set in run.config
-    const PanTiltInstance on(run.config, o, r_scale_);
-    runtime::MemorySink sink;
-    Recorded rec = on.recordOne(opt_.log_seed, {}, nullptr, sink);
+    const detail::PanTiltRecordedMeasurements m = detail::panTiltRecordedMeasurements(cfg_, dir);
+    Recorded rec;
+    rec.R = m.R;
     rec.has_truth = false;
+    const double nan = std::nan("");
+    for (const detail::PanTiltRecordedFrame& f : m.frames) {
+      Frame fr;
+      fr.t = f.t;
+      fr.detected = f.detected;
+      fr.z = f.z;
+      fr.truth = Eigen::Vector2d::Constant(nan);
+      fr.error_px = nan;
+      rec.frames.push_back(fr);
+    }
     auto d = newReplayData();
     d->items.push_back(std::move(rec));
-    d->source = "recording " + run.dir + " (" + std::to_string(run.grabs) +
-                " grabs through the scenario's detector and loop, seed option log_seed " + std::to_string(opt_.log_seed) +
-                "; " + run.note + ")";
+    d->source = "recording " + m.dir + " (" + std::to_string(m.grabs) +
+                " grabs through the scenario's detector, back-projected at the unit readings of its ptu.csv)";
     return d;
   }
 

@@ -1,12 +1,13 @@
 #include "pan_tilt_recording.h"
 
-#include <yaml-cpp/yaml.h>
-
 #include <filesystem>
+#include <optional>
 
 #include "viewline/core/error.h"
 #include "viewline/runtime/recording.h"
-#include "viewline/tracking/planar_target/config.h"
+#include "viewline/scenarios/pan_tilt/loop.h"
+#include "viewline/scenarios/pan_tilt/world.h"
+#include "viewline/vision/screen_target_detector.h"
 
 namespace viewline::tuning::detail {
 
@@ -25,48 +26,80 @@ std::string recordingFolder(const std::string& dir) {
 
 }  // namespace
 
-PanTiltRecordingRun panTiltRecordingRun(scenarios::PanTiltScenarioConfig base, const std::string& dir) {
-  PanTiltRecordingRun run;
-  run.dir = recordingFolder(dir);
-  const runtime::RecordingSource source(run.dir);
-  run.grabs = source.entries().size();
-  scenarios::PanTiltScenarioConfig& c = base;
-  c.source = runtime::SourceConfig{};
-  c.source.kind = runtime::SourceKind::Recording;
-  c.source.recording = run.dir;
-  c.run_baseline = false;
-  // Every grab (the loop stops at floor(duration x fps) grabs or at the recording's end).
-  c.duration = (static_cast<double>(run.grabs) + 0.5) / c.fps;
-  if (!(c.metrics_start < c.duration))
-    throw core::InvalidInput(run.dir + ": " + std::to_string(run.grabs) + " grabs at " + std::to_string(c.fps) +
-                             " fps end before run.metrics_start (" + std::to_string(c.metrics_start) + " s)");
-  run.note = "no config.yaml: the given config's filter replays the loop";
-  const std::string text = source.configText();
-  if (!text.empty()) {
-    const std::string file = run.dir + "/config.yaml";
-    YAML::Node recorded;
-    try {
-      recorded = YAML::Load(text);
-    } catch (const YAML::Exception& e) {
-      throw core::InvalidInput(file + ": " + e.what());
+PanTiltRecordedMeasurements panTiltRecordedMeasurements(const scenarios::PanTiltScenarioConfig& cfg,
+                                                         const std::string& dir) {
+  using Eigen::Vector2d;
+  using Eigen::Vector3d;
+  PanTiltRecordedMeasurements out;
+  out.dir = recordingFolder(dir);
+  runtime::RecordingSource source(out.dir);
+  out.grabs = source.entries().size();
+  const std::string ptu_file = out.dir + "/" + scenarios::kPtuTable + ".csv";
+  const std::optional<runtime::RecordingTruth> ptu = source.table(scenarios::kPtuTable);
+  if (!ptu)
+    throw core::InvalidInput(out.dir + ": no " + std::string(scenarios::kPtuTable) +
+                             ".csv (the unit's joint readings per frame, which pan_tilt_tracking --record writes): "
+                             "without them a detection cannot be placed on the screen");
+  if (ptu->columns != scenarios::ptuTableColumns())
+    throw core::InvalidInput(ptu_file + ": unexpected columns (expected camera,sequence then those of "
+                             "scenarios::ptuTableColumns())");
+
+  // The loop's geometry, all from the config (calibrated camera and mount, screen pose): none of it
+  // depends on a seed.
+  core::Camera cam = scenarios::panTiltModelCamera(cfg);
+  const robots::PanTiltKinematics kin =
+      cfg.calibrated_e_M_c ? robots::PanTiltKinematics(*cfg.calibrated_e_M_c) : robots::PanTiltKinematics();
+  const Eigen::Isometry3d f_M_screen = scenarios::pan_tilt::screenPose(cfg);
+  const Eigen::Isometry3d screen_M_f = f_M_screen.inverse();
+  vision::ScreenTargetDetector detector(cfg.detector);
+
+  bool have_R = false;
+  while (source.nextReadyTime()) {
+    const std::optional<runtime::Frame> frame = source.grab();
+    if (!frame) continue;  // a lost grab: no measurement, as in the loop
+    const auto row = ptu->rows.find({frame->camera, frame->sequence});
+    if (row == ptu->rows.end())
+      throw core::InvalidInput(ptu_file + ": no row for camera " + std::to_string(frame->camera) + " sequence " +
+                               std::to_string(frame->sequence) + " of recording.csv");
+    const std::vector<double>& v = row->second;  // joint_t, pan, tilt, noise_x, noise_y, R_xx, R_xy, R_yy
+    Eigen::Matrix2d R;
+    R << v[5], v[6], v[6], v[7];
+    if (!have_R) {
+      out.R = R;
+      have_R = true;
+    } else if (R != out.R) {
+      throw core::InvalidInput(ptu_file + ": R changes at camera " + std::to_string(frame->camera) + " sequence " +
+                               std::to_string(frame->sequence) + " (the replayed filter takes one R per recording)");
     }
-    const YAML::Node f = recorded["filter"];
-    if (f && f.IsMap() && f["model"]) {
-      const auto model = tracking::targetModelFromString(f["model"].as<std::string>());
-      if (model != c.control.filter.model)
-        throw core::InvalidInput(file + ": recorded with filter.model " + tracking::toString(model) + ", the config has " +
-                                 tracking::toString(c.control.filter.model) +
-                                 ": the loop replays the recorded run only with the filter it ran");
+    PanTiltRecordedFrame f;
+    f.t = frame->stamp;
+    const Vector2d n(v[3], v[4]);
+    // The capture step of the pan-tilt loop (modules/scenarios/pan_tilt/loop.cpp): the camera at
+    // the recorded joint reading, the detection's ray cut with the screen plane z_screen = 0, [T]'s
+    // noise added, and the measurement kept only in front of the camera.
+    cam.c_M_w = kin.c_M_f(Vector2d(v[1], v[2]));
+    const auto det = detector.detect(frame->image, frame->stamp);
+    if (det.ok()) {
+      const Vector3d ray_f = cam.rayThroughPixel_w(det.value().pixel);
+      const Vector3d c_f = cam.center_w();
+      const Vector3d o_s = screen_M_f * c_f;
+      const Vector3d d_s = screen_M_f.linear() * ray_f;
+      if (d_s.z() > 1e-9) {
+        const double lambda = -o_s.z() / d_s.z();
+        const Vector3d hit = o_s + lambda * d_s;
+        const Vector2d measured = hit.head<2>() + n;
+        const Vector3d meas_c = cam.toCamera(f_M_screen * Vector3d(measured.x(), measured.y(), 0.0));
+        f.detected = meas_c.z() > 0.0;
+        f.z = measured;
+      }
     }
-    if (f && f.IsMap() && f["q"]) {
-      c.control.filter.q = f["q"].as<double>();
-      run.note = "the loop replayed with the recorded filter.q " + f["q"].as<std::string>() + " (" + file + ")";
-    } else {
-      run.note = "the loop replayed with the config's filter (" + file + " sets no filter.q)";
-    }
+    out.frames.push_back(f);
   }
-  run.config = std::move(c);
-  return run;
+  if (!have_R) throw core::InvalidInput(out.dir + ": no frame to replay");
+  if (!(out.frames.back().t - out.frames.front().t > cfg.metrics_start))
+    throw core::InvalidInput(out.dir + ": " + std::to_string(out.frames.size()) + " frames end before run.metrics_start (" +
+                             std::to_string(cfg.metrics_start) + " s)");
+  return out;
 }
 
 }  // namespace viewline::tuning::detail

@@ -13,6 +13,10 @@
 //   camera<k>.xml        camera k's calibration, ViSP XML (vpXmlParserCamera), camera name "camera<k>"
 //   config.yaml          the scenario config as run (after --set edits)
 //   truth.csv            optional: camera,sequence,<the scenario's truth columns>
+//   <table>.csv          optional per-frame tables a scenario adds beside its frames (same layout
+//                        as truth.csv), e.g. pan-tilt's ptu.csv: the unit's joint readings that
+//                        back-projected each frame's detection, which a replay without the
+//                        unit needs
 // Text files are written atomically (io::writeTextFileAtomic), images through a temporary file
 // renamed into place; the index is written by finish(), so an interrupted recording that never
 // reached finish() has no recording.csv and is not mistaken for a complete one.
@@ -77,7 +81,11 @@ public:
   void lost(double ready_time, const Frame& frame);
   /// The truth of (camera, sequence): one value per truth column.
   void truth(std::size_t camera, std::uint64_t sequence, const std::vector<double>& values);
-  /// Writes recording.csv and truth.csv (atomically). Further frames are refused.
+  /// Declares a per-frame table `<name>.csv` with `columns` (after camera,sequence); written by finish().
+  void setTable(const std::string& name, std::vector<std::string> columns);
+  /// A row of table `name` for (camera, sequence): one value per column of the table.
+  void tableRow(const std::string& name, std::size_t camera, std::uint64_t sequence, const std::vector<double>& values);
+  /// Writes recording.csv, truth.csv and the tables (atomically). Further frames are refused.
   void finish();
   /// The folder.
   const std::string& dir() const { return dir_; }
@@ -90,6 +98,8 @@ private:
   std::vector<std::size_t> known_lost_;  ///< entries_ indices of lost frames with known fields
   std::vector<std::string> truth_columns_;
   std::string truth_text_;
+  /// Per-frame tables by name: their columns and the rows written so far (CSV text).
+  std::map<std::string, std::pair<std::vector<std::string>, std::string>> tables_;
   bool finished_ = false;
 };
 
@@ -127,6 +137,9 @@ public:
   const std::vector<std::string>& truthColumns() const { return truth_.columns; }
   /// The truth of (camera, sequence), nullopt when the recording has none for it.
   std::optional<std::vector<double>> truth(std::size_t camera, std::uint64_t sequence) const;
+  /// The per-frame table `<name>.csv` of the folder (parsed as truth.csv is), nullopt when absent;
+  /// throws core::InvalidInput naming the file when it is malformed.
+  std::optional<RecordingTruth> table(const std::string& name) const;
   /// The calibration of camera k from camera<k>.xml (ViSP XML), nullopt when the file is absent.
   std::optional<core::Camera> camera(std::size_t k) const;
   /// The config as run (config.yaml), "" when absent.

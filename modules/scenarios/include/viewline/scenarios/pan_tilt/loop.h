@@ -33,6 +33,7 @@
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "viewline/runtime/scheduler.h"
 #include "viewline/runtime/telemetry.h"
@@ -54,8 +55,8 @@ struct PanTiltRunIo {
   pan_tilt::FrameSink* frames = nullptr;        ///< per-frame records; null: none
   runtime::Pacing pacing;                       ///< as fast as possible by default
   std::function<void(double)> progress;         ///< fraction of the run done
-  /// Record each run's frames, truth and camera to record_dir/CONTROLLER, CONTROLLER the law's name
-  /// (runtime::RecordingWriter; "" : none).
+  /// Record each run's frames, truth, camera and unit readings (ptu.csv, ptuTableColumns()) to
+  /// record_dir/CONTROLLER, CONTROLLER the law's name (runtime::RecordingWriter; "" : none).
   std::string record_dir;
   /// Run on the frames recorded in replay_dir/CONTROLLER instead of the config's source: with the
   /// same config and seed the run, and its summary, are those of the recorded run ("" : none).
@@ -69,6 +70,13 @@ struct PanTiltRunIo {
 std::string truthChannel(const std::string& controller);
 /// The scalar channel of the image error (px) of `controller`'s run.
 std::string imageErrorChannel(const std::string& controller);
+
+/// Name of a pan-tilt recording's per-frame table of what the measurement used besides the frame.
+inline const char* const kPtuTable = "ptu";
+/// Its columns (after camera,sequence): the unit's joint reading that back-projected the frame's
+/// detection (its time s, pan and tilt rad), [T]'s noise draw added to the measurement (m), and the
+/// measurement covariance R given to the filter (m², xx, xy, yy).
+const std::vector<std::string>& ptuTableColumns();
 
 /// Runs one controller on the scenario; deterministic for (config, seed) whatever the pacing and
 /// the sinks: both controllers see the same path, sensor noise stream and [T] noise draws for the
