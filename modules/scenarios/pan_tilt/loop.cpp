@@ -86,6 +86,22 @@ pan_tilt::FrameTruth noTruth() {
 
 }  // namespace
 
+std::optional<ScreenMeasurement> measureOnScreen(const core::Camera& cam, const Vector2d& px,
+                                                 const Eigen::Isometry3d& f_M_screen, const Vector2d& noise) {
+  const Vector3d ray_f = cam.rayThroughPixel_w(px);
+  const Vector3d c_f = cam.center_w();
+  const Eigen::Isometry3d screen_M_f = f_M_screen.inverse();
+  const Vector3d o_s = screen_M_f * c_f;
+  const Vector3d d_s = screen_M_f.linear() * ray_f;
+  if (!(d_s.z() > 1e-9)) return std::nullopt;
+  const double lambda = -o_s.z() / d_s.z();
+  const Vector3d hit = o_s + lambda * d_s;
+  ScreenMeasurement m;
+  m.plane = hit.head<2>() + noise;
+  m.in_camera = cam.toCamera(f_M_screen * Vector3d(m.plane.x(), m.plane.y(), 0.0));
+  return m;
+}
+
 PanTiltRunMetrics runPanTilt(const PanTiltScenarioConfig& cfg, std::uint64_t seed, PanTiltControllerKind kind,
                              const PanTiltRunIo& io) {
   cfg.validate();
@@ -302,18 +318,10 @@ PanTiltRunMetrics runPanTilt(const PanTiltScenarioConfig& cfg, std::uint64_t see
                          {joints.t, joints.q.x(), joints.q.y(), n.x(), n.y(), world.R()(0, 0), world.R()(0, 1), world.R()(1, 1)});
       if (det_px) {
         // Back-project onto the screen plane (z_screen = 0) through that camera.
-        const Vector3d ray_f = model_cam.rayThroughPixel_w(*det_px);
-        const Vector3d c_f = model_cam.center_w();
-        const Eigen::Isometry3d screen_M_f = world.f_M_screen().inverse();
-        const Vector3d o_s = screen_M_f * c_f;
-        const Vector3d d_s = screen_M_f.linear() * ray_f;
-        if (d_s.z() > 1e-9) {
-          const double lambda = -o_s.z() / d_s.z();
-          const Vector3d hit = o_s + lambda * d_s;
-          const Vector2d measured = hit.head<2>() + n;
-          const Vector3d meas_c = model_cam.toCamera(world.f_M_screen() * Vector3d(measured.x(), measured.y(), 0.0));
+        if (const auto m = measureOnScreen(model_cam, *det_px, world.f_M_screen(), n)) {
+          const Vector3d& meas_c = m->in_camera;
           obs.detected = meas_c.z() > 0.0;
-          obs.plane = measured;
+          obs.plane = m->plane;
           obs.plane_cov = world.R();
           obs.feature = Vector2d(meas_c.x() / meas_c.z(), meas_c.y() / meas_c.z());
           p.meas_px = model_cam.normalizedToPixel(obs.feature);

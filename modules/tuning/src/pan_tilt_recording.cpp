@@ -29,7 +29,6 @@ std::string recordingFolder(const std::string& dir) {
 PanTiltRecordedMeasurements panTiltRecordedMeasurements(const scenarios::PanTiltScenarioConfig& cfg,
                                                          const std::string& dir) {
   using Eigen::Vector2d;
-  using Eigen::Vector3d;
   PanTiltRecordedMeasurements out;
   out.dir = recordingFolder(dir);
   runtime::RecordingSource source(out.dir);
@@ -50,7 +49,6 @@ PanTiltRecordedMeasurements panTiltRecordedMeasurements(const scenarios::PanTilt
   const robots::PanTiltKinematics kin =
       cfg.calibrated_e_M_c ? robots::PanTiltKinematics(*cfg.calibrated_e_M_c) : robots::PanTiltKinematics();
   const Eigen::Isometry3d f_M_screen = scenarios::pan_tilt::screenPose(cfg);
-  const Eigen::Isometry3d screen_M_f = f_M_screen.inverse();
   vision::ScreenTargetDetector detector(cfg.detector);
 
   bool have_R = false;
@@ -74,23 +72,15 @@ PanTiltRecordedMeasurements panTiltRecordedMeasurements(const scenarios::PanTilt
     PanTiltRecordedFrame f;
     f.t = frame->stamp;
     const Vector2d n(v[3], v[4]);
-    // The capture step of the pan-tilt loop (modules/scenarios/pan_tilt/loop.cpp): the camera at
-    // the recorded joint reading, the detection's ray cut with the screen plane z_screen = 0, [T]'s
-    // noise added, and the measurement kept only in front of the camera.
+    // The capture step of the pan-tilt loop (scenarios::measureOnScreen): the camera at the recorded
+    // joint reading, the detection's ray cut with the screen plane, [T]'s noise added, and the
+    // measurement kept only in front of the camera.
     cam.c_M_w = kin.c_M_f(Vector2d(v[1], v[2]));
     const auto det = detector.detect(frame->image, frame->stamp);
     if (det.ok()) {
-      const Vector3d ray_f = cam.rayThroughPixel_w(det.value().pixel);
-      const Vector3d c_f = cam.center_w();
-      const Vector3d o_s = screen_M_f * c_f;
-      const Vector3d d_s = screen_M_f.linear() * ray_f;
-      if (d_s.z() > 1e-9) {
-        const double lambda = -o_s.z() / d_s.z();
-        const Vector3d hit = o_s + lambda * d_s;
-        const Vector2d measured = hit.head<2>() + n;
-        const Vector3d meas_c = cam.toCamera(f_M_screen * Vector3d(measured.x(), measured.y(), 0.0));
-        f.detected = meas_c.z() > 0.0;
-        f.z = measured;
+      if (const auto m = scenarios::measureOnScreen(cam, det.value().pixel, f_M_screen, n)) {
+        f.detected = m->in_camera.z() > 0.0;
+        f.z = m->plane;
       }
     }
     out.frames.push_back(f);

@@ -32,9 +32,13 @@
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include <Eigen/Geometry>
+
+#include "viewline/core/camera.h"
 #include "viewline/runtime/scheduler.h"
 #include "viewline/runtime/telemetry.h"
 #include "viewline/scenarios/pan_tilt/config.h"
@@ -77,6 +81,17 @@ inline const char* const kPtuTable = "ptu";
 /// detection (its time s, pan and tilt rad), [T]'s noise draw added to the measurement (m), and the
 /// measurement covariance R given to the filter (m², xx, xy, yy).
 const std::vector<std::string>& ptuTableColumns();
+
+/// A detection measured on the screen plane, [T]'s capture step.
+struct ScreenMeasurement {
+  Eigen::Vector2d plane = Eigen::Vector2d::Zero();     ///< on the screen plane with [T]'s noise added (m)
+  Eigen::Vector3d in_camera = Eigen::Vector3d::Zero();  ///< that point in the camera frame (m)
+};
+/// The ray through pixel `px` of `cam` (its c_M_w the camera at the joint reading, frame f) cut with
+/// the screen plane z_screen = 0 (`f_M_screen`), plus `noise` (m, screen plane). Empty when the ray
+/// does not meet the plane in front of it. The loop and the tuning replay of a recording share it.
+std::optional<ScreenMeasurement> measureOnScreen(const core::Camera& cam, const Eigen::Vector2d& px,
+                                                 const Eigen::Isometry3d& f_M_screen, const Eigen::Vector2d& noise);
 
 /// Runs one controller on the scenario; deterministic for (config, seed) whatever the pacing and
 /// the sinks: both controllers see the same path, sensor noise stream and [T] noise draws for the
