@@ -34,7 +34,7 @@ void DifferentialDriveParams::validate() const {
   core::requirePositive(control_period, "DifferentialDriveParams.control_period");
   if (substeps < 1) throw core::InvalidInput("DifferentialDriveParams.substeps: expected >= 1");
   for (const auto& [value, name] : {std::pair{kp, "kp"}, std::pair{ki, "ki"}, std::pair{kd, "kd"},
-                                    std::pair{encoder_noise, "encoder_noise"}}) {
+                                    std::pair{encoder_noise, "encoder_noise"}, std::pair{command_timeout, "command_timeout"}}) {
     core::requireFinite(value, std::string("DifferentialDriveParams.") + name);
     if (value < 0.0) throw core::InvalidInput(std::string("DifferentialDriveParams.") + name + ": expected >= 0");
   }
@@ -58,10 +58,12 @@ void DifferentialDrive::setCommand(double v, double omega) {
   const double v_room = std::max(0.0, params_.wheel_speed_max - std::abs(omega) * half);
   v = std::clamp(v, -std::min(params_.max_speed, v_room), std::min(params_.max_speed, v_room));
   ref_ = Eigen::Vector2d(v - omega * half, v + omega * half);
+  last_command_t_ = t_;
 }
 
 void DifferentialDrive::step(core::Rng& rng) {
   const double dt = params_.control_period;
+  if (watchdogStopped()) ref_.setZero();  // no command for command_timeout: brake to rest
   Eigen::Vector2d u;
   for (int i = 0; i < 2; ++i) {
     const double meas = wheel_[i] + (params_.encoder_noise > 0.0 ? core::gaussian(rng, params_.encoder_noise) : 0.0);

@@ -73,12 +73,39 @@ TEST(DifferentialDrive, SpeedLimitAndTurningPriority) {
   EXPECT_NEAR(base.speed(), 0.15, 1e-2);
 }
 
+TEST(DifferentialDrive, TheCommandWatchdogBrakesToRestWhenCommandsStop) {
+  DifferentialDriveParams p;
+  p.command_timeout = 0.5;
+  DifferentialDrive base(p, {});
+  core::Rng rng = core::makeRng(3);
+  base.setCommand(0.3, 0.0);
+  for (int i = 0; i < 49; ++i) base.step(rng);  // 0.49 s: still the command
+  EXPECT_FALSE(base.watchdogStopped());
+  EXPECT_NEAR(base.speed(), 0.3, 0.01);
+  for (int i = 0; i < 51; ++i) base.step(rng);  // past 0.5 s without a command
+  EXPECT_TRUE(base.watchdogStopped());
+  EXPECT_NEAR(base.wheelReferences().norm(), 0.0, 0.0);
+  for (int i = 0; i < 100; ++i) base.step(rng);
+  EXPECT_LT(std::abs(base.speed()), 1e-3);
+  base.setCommand(0.2, 0.0);  // a command re-arms it
+  EXPECT_FALSE(base.watchdogStopped());
+  // Without a watchdog (the default) the last command holds.
+  DifferentialDrive hold(DifferentialDriveParams{}, {});
+  hold.setCommand(0.3, 0.0);
+  for (int i = 0; i < 300; ++i) hold.step(rng);
+  EXPECT_FALSE(hold.watchdogStopped());
+  EXPECT_NEAR(hold.speed(), 0.3, 1e-3);
+}
+
 TEST(DifferentialDrive, RejectsBadParameters) {
   DifferentialDriveParams p;
   p.track = 0.0;
   EXPECT_THROW(DifferentialDrive(p, {}), core::InvalidInput);
   p = {};
   p.wheel_speed_max = 0.1;
+  EXPECT_THROW(DifferentialDrive(p, {}), core::InvalidInput);
+  p = {};
+  p.command_timeout = -0.1;
   EXPECT_THROW(DifferentialDrive(p, {}), core::InvalidInput);
   DifferentialDrive ok({}, {});
   EXPECT_THROW(ok.setCommand(NAN, 0.0), core::InvalidInput);

@@ -31,6 +31,7 @@ MobileCaptureConfig MobileCaptureConfig::defaults() {
   c.detector.roi_half_size_px = 40.0;
   c.planner.reach = 0.2;
   c.planner.turn_rate = 1.5;
+  c.base.command_timeout = 0.5;  // s: ROS diff_drive_controller's cmd_vel_timeout default
   return c;
 }
 
@@ -175,6 +176,8 @@ MobileCaptureConfig loadMobileCaptureConfig(const io::ConfigNode& root) {
     readOpt(b, "ki", c.base.ki);
     readOpt(b, "kd", c.base.kd);
     readOpt(b, "encoder_noise", c.base.encoder_noise);
+    readOpt(b, "command_timeout", c.base.command_timeout);
+    if (!(c.base.command_timeout >= 0.0)) b.fail("command_timeout", "a time >= 0 s (0: no watchdog)");
   }
   if (root.has("gripper")) {
     const auto g = root.child("gripper");

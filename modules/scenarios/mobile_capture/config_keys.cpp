@@ -63,6 +63,7 @@ io::ConfigReferenceSection mobileCaptureConfigReference() {
       {"base.ki", "", "wheel PID integral gain"},
       {"base.kd", "", "wheel PID derivative gain"},
       {"base.encoder_noise", "", "wheel encoder noise (std)"},
+      {"base.command_timeout", "s", "the base's command watchdog: no command for this long and it brakes to rest (0: none; robot faults)"},
       {"gripper", "", "the gripper zones, robot frame"},
       {"gripper.jaws", "m", "[x_min, x_max, half_width]: the grasp succeeds when the true object is here"},
       {"gripper.trigger", "m", "[x_min, x_max, half_width]: the gripper closes when the estimated object is here"},

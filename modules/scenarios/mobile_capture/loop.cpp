@@ -10,6 +10,7 @@
 #include "viewline/runtime/stale_frames.h"
 #include "viewline/robots/mobile_ground_localization.h"
 #include "viewline/scenarios/mobile_capture/recording.h"
+#include "viewline/scenarios/mobile_capture/robot_link.h"
 #include "viewline/scenarios/mobile_capture/world.h"
 
 namespace viewline::scenarios {
@@ -121,6 +122,7 @@ MobileCaptureRun runMobileCapture(const MobileCaptureConfig& cfg, std::uint64_t 
   MobileCaptureFrames& source = *head_frames;
   runtime::FaultPlan faults(cfg.faults, core::deriveSeed(seed, 0xFA));
   runtime::FrameSource& frames = faults.wrap(source);
+  RobotLink link(robot, faults);  // commands through the robot faults (robot_link.h)
   vision::BallDetector detector(cfg.detector);
   core::Camera camera = estimatorCamera(cfg);  // detection ROI, ground localisation
   const robots::AnglePerPixel printed{cfg.hfov, cfg.vfov, robots::AngleRange::PrintedSlant};
@@ -341,8 +343,7 @@ MobileCaptureRun runMobileCapture(const MobileCaptureConfig& cfg, std::uint64_t 
         centre_bearing = std::remainder(centre_bearing - robot.base.turnRate() * cfg.controlPeriod(), 2.0 * M_PI);
       }
     }
-    robot.stepHead(head_target);
-    robot.base.setCommand(cmd.v, cmd.omega);
+    link.send(t, cmd, head_target);
     robot.base.step(rng.drive);
     if (sink) {
       sink->command({channel::kBase, t, vec({cmd.v, cmd.omega})});

@@ -8,3 +8,5 @@ list(APPEND scenarios_tests test/mobile_capture_sources_test.cpp)
 # Unit and meaning of every key its config reader reads (docs/config_reference.md is generated from it).
 list(APPEND scenarios_sources mobile_capture/config_keys.cpp)
 list(APPEND scenarios_tests test/mobile_capture_faults_test.cpp)
+# The robot's side of the faults: commands through the fault plan, the base's command watchdog.
+list(APPEND scenarios_sources mobile_capture/robot_link.cpp)

@@ -3,6 +3,8 @@
 // after them. The first 7 s of a run (the view's quit ends it there, without the oracle).
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <optional>
 #include <vector>
 
 #include "viewline/core/frames.h"
@@ -62,4 +64,60 @@ TEST(MobileCaptureFaults, FaultsAreCountedRefusedOrSurvivedAndTheTrackTakesTheOb
   EXPECT_EQ(detected_during, 0);
   EXPECT_GE(first_fused_after, 0);
   EXPECT_LT(first_fused_after, 5);
+}
+
+// Robot faults: a base that stops answering for 1 s keeps its last command until its watchdog
+// (base.command_timeout, 0.5 s) brakes it to rest; a limit error stops it at once; both are
+// counted per command, the loop resumes when the robot answers, and the track goes on.
+TEST(MobileCaptureFaults, ASilentBaseBrakesOnItsWatchdogALimitErrorStopsItAndTheLoopResumes) {
+  scenarios::MobileCaptureConfig cfg =
+      scenarios::loadMobileCaptureConfig(io::ConfigNode::loadFile("config/mobile_capture.yaml"));
+  cfg.rig.reset();
+  cfg.hfov = core::deg2rad(50.0);
+  cfg.vfov = core::deg2rad(40.0);
+  ASSERT_DOUBLE_EQ(cfg.base.command_timeout, 0.5);
+  const auto run = [&](const std::vector<runtime::FaultSpec>& faults, std::vector<scenarios::MobileCaptureFrame>& frames) {
+    scenarios::MobileCaptureConfig c = cfg;
+    c.faults.faults = faults;
+    double last_t = 0.0;
+    scenarios::MobileCaptureHooks hooks;
+    hooks.on_frame = [&](const scenarios::MobileCaptureFrame& f) {
+      scenarios::MobileCaptureFrame copy = f;
+      copy.image = nullptr;  // not kept past the callback
+      frames.push_back(copy);
+      last_t = f.t;
+    };
+    hooks.quit_requested = [&] { return last_t > 7.0; };
+    return scenarios::runMobileCapture(c, 7, &hooks);
+  };
+  std::vector<scenarios::MobileCaptureFrame> clean, faulty;
+  run({}, clean);
+  const scenarios::MobileCaptureRun r =
+      run({{FaultKind::RobotSilent, std::nullopt, 2.0, 3.0}, {FaultKind::RobotLimitError, std::nullopt, 4.0, 4.1}}, faulty);
+  const runtime::FaultReport& f = r.faults;
+  EXPECT_EQ(f.of(FaultKind::RobotSilent), 100u);  // one command per 10 ms control period
+  EXPECT_EQ(f.of(FaultKind::RobotLimitError), 10u);
+  EXPECT_EQ(f.outcomeOf("robot_commands_failed"), 110u);
+  EXPECT_EQ(f.outcomeOf("robot_halts"), 10u);
+  EXPECT_EQ(f.outcomeOf("base_watchdog_stops"), 1u);
+  EXPECT_EQ(f.outcomeOf("robot_resumed"), 2u);
+  // Distance the base covered between the frames nearest t0 and t1.
+  const auto moved = [](const std::vector<scenarios::MobileCaptureFrame>& fs, double t0, double t1) {
+    const scenarios::MobileCaptureFrame *a = nullptr, *b = nullptr;
+    for (const auto& fr : fs) {
+      if (!a && fr.t >= t0 - 1e-9) a = &fr;
+      if (!b && fr.t >= t1 - 1e-9) b = &fr;
+    }
+    if (!a || !b) return -1.0;
+    return std::hypot(b->robot.x - a->robot.x, b->robot.y - a->robot.y);
+  };
+  // Until the watchdog the base rolls on (as in the clean run), then it is at rest.
+  EXPECT_GT(moved(clean, 2.7, 3.0), 0.03);
+  EXPECT_GT(moved(faulty, 2.0, 2.4), 0.5 * moved(clean, 2.0, 2.4));
+  EXPECT_LT(moved(faulty, 2.8, 3.0), 0.003);
+  // After the robot answers again the loop drives and tracks on.
+  EXPECT_GT(moved(faulty, 5.0, 6.0), 0.1);
+  int fused_after = 0;
+  for (const auto& fr : faulty) fused_after += fr.t > 5.0 && fr.fused;
+  EXPECT_GT(fused_after, 5);
 }

@@ -49,6 +49,10 @@ struct DifferentialDriveParams {
          ki = 4.0,                 ///< integral gain, 1/s
          kd = 0.0;                 ///< derivative gain, s
   double encoder_noise = 0.0;      ///< std of the measured wheel speed, m/s
+  /// The base's command watchdog: when no setCommand() came for this long, the wheel references
+  /// drop to zero and the base brakes by itself, as ROS's diff_drive_controller does after its
+  /// cmd_vel_timeout (0.5 s by default there), s; 0: no watchdog (the last command holds).
+  double command_timeout = 0.0;
 
   /// Throws core::InvalidInput naming the field.
   void validate() const;
@@ -60,8 +64,10 @@ public:
   /// Base at `start` at rest, time 0 (validates params; throws core::InvalidInput).
   DifferentialDrive(const DifferentialDriveParams& params, const BasePose& start);
 
-  /// Desired body velocities; see the header comment for limits.
+  /// Desired body velocities; see the header comment for limits. Feeds the command watchdog.
   void setCommand(double v, double omega);
+  /// True when the command watchdog has stopped the base (no command for command_timeout).
+  bool watchdogStopped() const { return params_.command_timeout > 0.0 && t_ - last_command_t_ >= params_.command_timeout; }
   /// One control period: PID on both wheels, motors and pose integrated over control_period.
   /// `rng` is used only when encoder_noise > 0.
   void step(core::Rng& rng);
@@ -89,6 +95,7 @@ private:
   Eigen::Vector2d ref_ = Eigen::Vector2d::Zero();
   Eigen::Vector2d integral_ = Eigen::Vector2d::Zero();
   Eigen::Vector2d last_error_ = Eigen::Vector2d::Zero();
+  double last_command_t_ = 0.0;  ///< time of the last setCommand(), s (the watchdog's)
 };
 
 /// Rate-limited position servo of the pan/tilt joints (the head's own drive): each control
