@@ -50,13 +50,16 @@ if [ "$link" = fault ]; then
 fi
 # 15 frames/s: rendering a 640x480 frame takes 20-50 ms on a loaded 2-core machine, and a run paced
 # to the wall clock must keep up with it.
+# --record: the session a user records on the unit to tune on (viewline_tune --recording): every
+# frame, and ptu.csv with the unit's joint readings per frame.
 "$bin/pan_tilt_tracking" --config config/pan_tilt_circle.yaml --seed 1 --headless --quiet --no-baseline --duration 3 \
-  --set run.metrics_start=1 --set camera.fps=15 "${robot[@]}" --summary "$work/summary.json" >"$work/app.out" 2>&1 ||
+  --set run.metrics_start=1 --set camera.fps=15 "${robot[@]}" --summary "$work/summary.json" --record "$work/rec" \
+  >"$work/app.out" 2>&1 ||
   { echo "FAIL: pan_tilt_tracking failed"; cat "$work/app.out"; exit 1; }
 kill -TERM "$emu_pid"; wait "$emu_pid" || true; emu_pid=
 cat "$work/app.out" "$work/emulator.out"
-python3 - "$work/summary.json" "$work/emulator.out" <<'PY'
-import json, re, sys
+python3 - "$work/summary.json" "$work/emulator.out" "$work/rec" <<'PY'
+import csv, glob, json, math, re, sys
 s = json.load(open(sys.argv[1]))
 ours = s["ours"]
 served = re.search(r"served (\d+) commands \((\d+) halts\)", open(sys.argv[2]).read())
@@ -80,6 +83,22 @@ else:
     # Start-up (15), the move to the start (5), a command and reads per frame, the final halt.
     if int(served.group(1)) < 100: problems.append(f"the emulator served only {served.group(1)} commands")
     if int(served.group(2)) < 1: problems.append("no halt reached the emulator")
+# The recording holds the unit's own readings: one ptu.csv row per frame, joints that moved, within
+# the unit's range (the emulator's read-back, not the simulator's state).
+tables = glob.glob(sys.argv[3] + "/*/ptu.csv")
+if len(tables) != 1: problems.append(f"expected one ptu.csv in the recording, found {tables}")
+else:
+    rows = list(csv.DictReader(open(tables[0])))
+    frames = glob.glob(sys.argv[3] + "/*/cam0/*.png")
+    if len(rows) != ours["frames"] or len(frames) != ours["frames"]:
+        problems.append(f"ptu.csv rows {len(rows)}, frames {len(frames)}, run frames {ours['frames']}")
+    if rows:
+        pan = [float(r["pan"]) for r in rows]
+        tilt = [float(r["tilt"]) for r in rows]
+        if not all(math.isfinite(x) and abs(x) < math.radians(160) for x in pan + tilt):
+            problems.append("ptu.csv joints not finite or outside the unit's range")
+        if max(pan) - min(pan) < math.radians(0.5): problems.append("ptu.csv: the pan reading never moved")
+        print(f"recording: {len(rows)} ptu.csv rows, pan {math.degrees(min(pan)):.2f}..{math.degrees(max(pan)):.2f} deg")
 print("image error rms %.2f px, %d detections; %s" % (ours["image_error_rms_px"], ours["detections"], served.group(0) if served else "-"))
 if problems:
     print("FAIL: " + "; ".join(problems)); sys.exit(1)
