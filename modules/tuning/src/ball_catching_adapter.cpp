@@ -18,10 +18,19 @@
 // point and launch velocity (the scenario's own flight, deterministic RK4). Only for
 // object: ball (a dart's tracked point is its flights, not the centre of mass).
 //
-// Noise auto-tuning is not offered: the detector's search window follows the tracker's predicted
-// pixel, so which blobs are detected depends on the filter being tuned, and the measurement σ is
-// per detection (blob covariance, floored by detector.sigma_px_floor) rather than one config
-// value. Sweeps of tracker.accel_psd, tracker gates and detector.sigma_px_floor work.
+// Noise auto-tuning (tracker.accel_psd and detector.sigma_px, the detection's std the tracker is
+// told): record() runs throws and keeps, per throw, every image measurement the loop gave its
+// tracker (camera, stamp, pixel, in submission order, from the telemetry's camera<k> channels),
+// the tracker's cameras (registered to the robot) and the true flight; replay() feeds them to a
+// fresh ViewlineTracker per throw with the candidate noise (σ told = hypot(sigma_px,
+// pixel_noise_px), as the loop tells it) and takes NIS exactly as the loop does (accepted images
+// after kConsistencyBurnIn fused images of their track, the tracker's own gate statistic) and the
+// innovation cost of autotune.h from the tracker's own update. What a replay cannot follow: the
+// detector searched a window around the shipped filter's prediction, so a filter that would have
+// predicted elsewhere might have detected other blobs; the tuned config is therefore checked
+// live on a fresh seed (autotune's verify runs), where its windows are its own. Only with
+// detector.sigma_px > 0 (one told std); with 0 the std is per detection (blob covariance) and
+// auto-tuning is refused.
 // The scenario's live view (viz::BallCatchingDisplay) is not wired here: this module does not
 // link viz.
 
@@ -32,6 +41,7 @@
 
 #include "adapter_util.h"
 #include "viewline/core/error.h"
+#include "viewline/core/random.h"
 #include "viewline/estimation/consistency.h"
 #include "viewline/runtime/telemetry.h"
 #include "viewline/scenarios/ball_catching.h"
@@ -63,6 +73,18 @@ detail::OptionTable<CatchOptions> catchOptions() {
 const detail::SeriesLabels kLabels{"time since release [s]", "tracker position error |p_hat - p| [m]",
                                    "innovation number (in the run)", 2.0, "world x (towards the box) [m]", "world y [m]"};
 
+/// One recorded throw: what the loop gave its tracker, the tracker's cameras and the true flight.
+struct CatchThrow {
+  std::vector<tracking::ImageMeasurement> images;  ///< in submission order (σ as the loop told it)
+  std::vector<core::Camera> cameras;               ///< the tracker's cameras (registered)
+  Eigen::Vector3d release = Eigen::Vector3d::Zero(), launch = Eigen::Vector3d::Zero();  ///< the flight, world
+  double t_end = 0.0;                              ///< end of the true flight, s (throw clock)
+};
+
+using CatchReplayData = detail::Recording<CatchThrow>;
+
+std::size_t imagesOf(const CatchThrow& t) { return t.images.size(); }
+
 class CatchInstance final : public detail::ConfiguredInstance<scenarios::BallCatchingConfig, CatchOptions> {
 public:
   /// `cfg` as its reader validated it, on one thread (the sweep runs settings in parallel instead).
@@ -71,10 +93,73 @@ public:
   }
 
   std::string autotuneUnsupported() const override {
-    return "the ball-catching detector searches a window around the tracker's predicted pixel, so the "
-           "measurements depend on the filter being tuned and cannot be replayed honestly, and the measurement "
-           "sigma is per detection (blob covariance, floor detector.sigma_px_floor), not one config value; "
-           "sweep tracker.accel_psd / the gates instead";
+    if (cfg_.sigma_px > 0.0) return {};
+    return "detector.sigma_px is 0: the std the tracker is told is per detection (blob covariance, floor "
+           "detector.sigma_px_floor), not one config value to tune; set detector.sigma_px (the detection's measured "
+           "std) or sweep detector.sigma_px_floor instead";
+  }
+
+  std::vector<NoiseParameter> noiseParameters() const override {
+    return {{"process", "q", "m^2/s^3", "tracker.accel_psd", "white-acceleration density of the tracker's ballistic model",
+             cfg_.tracker.model.accel_psd},
+            {"measurement", "sigma_px", "px", "detector.sigma_px",
+             "the detection's std the tracker is told (per axis; the added pixel_noise_px on top)", cfg_.sigma_px}};
+  }
+
+  std::unique_ptr<ReplayData> record(std::uint64_t seed, int runs) const override {
+    auto d = std::make_unique<CatchReplayData>("ball-catching throws", "images", &imagesOf);
+    for (int run = 0; run < runs; ++run) {
+      const std::uint64_t s = core::deriveSeed(seed, static_cast<std::uint64_t>(run));
+      std::vector<std::shared_ptr<runtime::MemorySink>> sinks;
+      std::vector<std::vector<core::Camera>> cams(static_cast<std::size_t>(opt_.throws));
+      for (int i = 0; i < opt_.throws; ++i) sinks.push_back(std::make_shared<runtime::MemorySink>());
+      scenarios::CatchHooks hooks;
+      hooks.telemetry = [&sinks](int i) { return sinks[static_cast<std::size_t>(i)]; };
+      hooks.on_frame = [&cams](const scenarios::CatchFrame& f) {  // the tracker's cameras, as registered
+        auto& c = cams[static_cast<std::size_t>(f.throw_index)];
+        if (c.size() <= f.camera) c.resize(f.camera + 1);
+        if (f.camera_model != nullptr) c[f.camera] = *f.camera_model;
+        return true;
+      };
+      const scenarios::CatchSummary sum = scenarios::runBallCatching(cfg_, opt_.throws, s, hooks);
+      for (const scenarios::ThrowResult& tr : sum.results) {
+        CatchThrow t;
+        t.cameras = cams[static_cast<std::size_t>(tr.index)];
+        t.release = tr.release;
+        t.launch = tr.launch_velocity;
+        t.t_end = tr.t_cross + cfg_.post_crossing_s + 0.3;
+        for (const runtime::MeasurementRecord& m : sinks[static_cast<std::size_t>(tr.index)]->measurements) {
+          if (m.channel.rfind("camera", 0) != 0 || m.z.size() != 2 || m.sigma.size() < 1) continue;
+          const std::size_t k = static_cast<std::size_t>(std::stoul(m.channel.substr(6)));
+          if (k >= t.cameras.size()) throw core::Error("ball_catching record: an image of a camera the loop did not show");
+          t.images.push_back({m.id, k, m.t, Eigen::Vector2d(m.z(0), m.z(1)), m.sigma(0)});
+        }
+        d->items.push_back(std::move(t));
+      }
+    }
+    d->source = detail::liveSource(runs, seed);
+    return d;
+  }
+
+  ReplayResult replay(const ReplayData& data, const std::vector<double>& noise, double outlier_prior,
+                      bool want_series) const override {
+    return detail::replayRecording<CatchThrow, detail::InnovationTally>(
+        data, noise, 2, "ball_catching", want_series, kLabels,
+        [&](const CatchReplayData& d, detail::InnovationTally& a, RunSeries* series) {
+          tracking::TrackerConfig tc = cfg_.tracker;
+          tc.model.accel_psd = noise[0];
+          const double sigma = std::hypot(noise[1], cfg_.pixel_noise_px);  // as the loop tells its tracker
+          std::size_t sample = 0;
+          for (const CatchThrow& t : d.items) replayThrow(t, tc, sigma, outlier_prior, a, series, sample);
+        });
+  }
+
+  std::unique_ptr<ScenarioInstance> withNoise(const std::vector<double>& noise) const override {
+    if (noise.size() != 2) throw core::InvalidInput("ball_catching: expected (q, sigma_px)");
+    scenarios::BallCatchingConfig c = cfg_;
+    c.tracker.model.accel_psd = noise[0];
+    c.sigma_px = noise[1];
+    return std::make_unique<CatchInstance>(c, opt_);
   }
 
   RunResult run(std::uint64_t seed, const RunOptions& ro) const override {
@@ -114,6 +199,45 @@ public:
   }
 
 private:
+  /// One recorded throw through a fresh tracker: NIS as the loop counts it (ThrowLoop::consistency),
+  /// the innovation cost from the tracker's own update, NEES at the kNeesFusedImage-th fused image.
+  void replayThrow(const CatchThrow& t, const tracking::TrackerConfig& tc, double sigma, double eps,
+                   detail::InnovationTally& a, RunSeries* series, std::size_t& sample) const {
+    if (t.images.empty()) return;
+    tracking::ViewlineTracker tracker(t.cameras, tc);
+    const sim::DragFlight flight({t.release, t.launch}, 0.0, t.t_end, cfg_.throws.body);
+    int in_track = 0, fused_total = 0;
+    for (tracking::ImageMeasurement m : t.images) {
+      m.sigma_px = sigma;
+      const int restarts_before = tracker.trackState().restarts;
+      const bool in_order = !tracker.initialised() || m.t >= tracker.state().t();
+      if (tracker.submit(m) != tracking::Refusal::None) continue;
+      const auto o = tracker.outcome(m.id);
+      if (!o) continue;
+      const bool fused = o->fate == tracking::Fate::Fused;
+      const bool starts = fused && (o->seed || tracker.trackState().restarts > restarts_before);
+      const std::optional<tracking::ImageUpdate>& up = tracker.lastUpdate();
+      if (up && in_order) {
+        const detail::ViewlineInnovation inn = detail::viewlineInnovation(*up, t.cameras[m.camera], scenarios::kConsistencyBurnIn);
+        if (inn.valid) a.addCost(inn.nis, std::log(inn.S.determinant()), 2, eps, inn.log_u);
+      }
+      if (fused && !starts && in_track >= scenarios::kConsistencyBurnIn && std::isfinite(o->gate.mahalanobis))
+        detail::addNis(a.nis, o->gate.mahalanobis, 2.0, static_cast<double>(sample++), series);
+      if (starts) in_track = 0;
+      in_track += fused;
+      fused_total += fused;
+      if (fused && fused_total == scenarios::kNeesFusedImage && cfg_.object == "ball" && tracker.initialised()) {
+        const estimation::StateEstimate& s = tracker.state();
+        if (s.t() >= flight.startTime() && s.t() <= flight.endTime()) {
+          const sim::FlightState f = flight.state(s.t());
+          Eigen::VectorXd x(6);
+          x << f.p, f.v;
+          a.nees.add(estimation::nees(s, x), 6.0);
+        }
+      }
+    }
+  }
+
   void readThrow(const scenarios::ThrowResult& tr, const runtime::MemorySink& sink, RunResult& r, RunSeries* series,
                  io::CsvWriter* inn_csv, std::size_t& mismatch, std::size_t& sample, const RunOptions& ro) const {
     using tracking::GateDecision;

@@ -14,6 +14,8 @@
 #include <sstream>
 
 #include "viewline/core/error.h"
+#include "viewline/core/random.h"
+#include "viewline/io/config.h"
 #include "viewline/tuning/scenario.h"
 #include "viewline/tuning/session.h"
 #include "viewline/tuning/yaml_edit.h"
@@ -119,16 +121,31 @@ TEST(ScenarioAdapters, MobileCaptureTinySweep) {
   for (const auto& s : j.at("all_settings")) EXPECT_GT(s.at("nis").at("samples").get<double>(), 20.0) << s.dump();
 }
 
+/// A copy of the shipped config `name` in `dir` with `values` set (its relative paths re-expressed).
+std::string editedConfig(const fs::path& dir, const std::string& name, std::vector<std::pair<std::string, YAML::Node>> values) {
+  const std::string shipped = configPath(name);
+  std::ostringstream read;
+  read << std::ifstream(shipped).rdbuf();
+  const std::string text = read.str();
+  auto all = relocatedPaths(YAML::Load(text), fs::path(shipped).parent_path().string(), dir.string());
+  for (auto& v : values) all.push_back(std::move(v));
+  const std::string path = (dir / name).string();
+  std::ofstream(path) << io::rewriteYamlText(text, all, "test: " + name + " edited");
+  return path;
+}
+
 TEST(ScenarioAdapters, AutotuneSaysWhenAnAdapterDoesNotSupportIt) {
   const AdapterRegistry reg = makeBuiltinAdapters();
   for (const std::string sc : {"ball_catching"}) {
     const fs::path dir = scratch("unsupported_" + sc);
     AutotuneSessionOptions a;
     a.scenario = sc;
-    a.config = configPath(sc + ".yaml");
+    // The detection's std per detection (blob covariance): no one told std to tune.
+    a.config = editedConfig(dir, sc + ".yaml", {{"detector.sigma_px", YAML::Node(0.0)}});
     a.out_dir = (dir / "out").string();
     a.quiet = true;
     EXPECT_TRUE(hasInvalidInput([&] { runAutotuneSession(reg, a); }, "noise auto-tuning is not supported")) << sc;
+    EXPECT_TRUE(hasInvalidInput([&] { runAutotuneSession(reg, a); }, "detector.sigma_px is 0")) << sc;
     // A sweep file asking for it is refused before any run, naming the file.
     const std::string sweep = writeSweep(dir, "scenario: " + sc + "\nconfig: " + a.config +
                                                   "\nseeds: 1\nparameters:\n  - key: threads\n    values: [1]\n"
@@ -138,6 +155,33 @@ TEST(ScenarioAdapters, AutotuneSaysWhenAnAdapterDoesNotSupportIt) {
     o.quiet = true;
     EXPECT_TRUE(hasInvalidInput([&] { runSweepSession(reg, sweep, o); }, "sweep.yaml: section 'autotune'")) << sc;
   }
+}
+
+TEST(ScenarioAdapters, BallCatchingReplayIsWhatTheLoopGaveItsTracker) {
+  // The auto-tuner's replay of recorded throws at the shipped noise gives the live run's NIS sample
+  // for sample (same images, same tracker, counted as the loop counts them); a std told 4x too
+  // large shrinks it about 16-fold, so the replay does follow the noise.
+  const AdapterRegistry reg = makeBuiltinAdapters();
+  const ScenarioAdapter& ad = reg.get("ball_catching");
+  const io::ConfigNode o = io::ConfigNode::fromString("throws: 2", "adapter options");
+  const AdapterOptions opts = readAdapterOptions(ad, &o);
+  const auto inst = ad.loadConfig(io::ConfigNode::loadFile(configPath("ball_catching.yaml")), opts);
+  ASSERT_EQ(inst->autotuneUnsupported(), "");
+  const std::vector<NoiseParameter> noise = inst->noiseParameters();
+  ASSERT_EQ(noise.size(), 2u);
+  EXPECT_EQ(noise[0].config_key, "tracker.accel_psd");
+  EXPECT_EQ(noise[1].config_key, "detector.sigma_px");
+  const std::uint64_t seed = 21;
+  const RunResult live = inst->run(core::deriveSeed(seed, 0), {});
+  const auto data = inst->record(seed, 1);
+  ASSERT_GT(data->measurements(), 40u);
+  const ReplayResult same = inst->replay(*data, {noise[0].value, noise[1].value}, 0.0, false);
+  ASSERT_GT(live.nis.count, 20u);
+  EXPECT_EQ(same.nis.count, live.nis.count);
+  EXPECT_DOUBLE_EQ(same.nis.sum, live.nis.sum);
+  const ReplayResult wide = inst->replay(*data, {noise[0].value, 4.0 * noise[1].value}, 0.0, false);
+  EXPECT_LT(wide.nis.mean(), 0.25 * same.nis.mean());
+  EXPECT_GT(same.terms, 0u);
 }
 
 TEST(ScenarioAdapters, MobileCaptureAutotunesFromLiveRecordingsNotFromLogs) {
