@@ -7,8 +7,6 @@
 #include <functional>
 #include <limits>
 #include <optional>
-#include <cstdio>
-#include <cstdlib>
 
 #include "viewline/control/table_balancer.h"
 #include "viewline/core/error.h"
@@ -251,15 +249,6 @@ TableBallResult runTableBall(const TableBallConfig& cfg, std::uint64_t seed, con
       }
     } else {
       of = &observer.predictOnly(t);
-    }
-    if (std::getenv("TB_DIAG") != nullptr && frame && of->ball_circle) {
-      const Eigen::Isometry3d kin = world.observerHeadPose(cap.capture_time) * world.tablePose(truth.tilt);
-      const auto pk = ballOnTablePlane(obs_camera, *of->ball_circle, kin, cfg.ball_radius);
-      const Eigen::Vector2d mt = controller.modelTilt();
-      std::printf("DIAG %.4f %d %.6e %.6e %.6e %.6e %.6e %.6e %.6e %.6e %.6e %.6e %.6e %.6e %.6e %.6e %.6e %.6e %.6e %.6e\n", t, of->tracked ? 1 : 0,
-                  truth.p.x(), truth.p.y(), truth.v.x(), truth.v.y(), of->measured_own_pose.x(), of->measured_own_pose.y(), of->x[0], of->x[2],
-                  truth.tilt.x(), truth.tilt.y(), of->measured_tilt.x(), of->measured_tilt.y(), mt.x(), mt.y(),
-                  pk ? pk->x() : kNaN, pk ? pk->y() : kNaN, of->measured.x(), of->measured.y());
     }
     const std::optional<Eigen::Vector2d> y = of->ball_found ? std::optional<Eigen::Vector2d>(of->measured) : std::nullopt;
     for (auto& [name, trk] : side) {
