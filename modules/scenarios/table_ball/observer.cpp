@@ -60,14 +60,20 @@ TablePoseOffsetFilter::TablePoseOffsetFilter(double time_constant) : time_consta
   core::requirePositive(time_constant, "TablePoseOffsetFilter: time_constant");
 }
 
-void TablePoseOffsetFilter::update(double t, const Eigen::Isometry3d& c_M_t_measured,
+bool TablePoseOffsetFilter::update(double t, const Eigen::Isometry3d& c_M_t_measured,
                                    const Eigen::Isometry3d& c_M_t_kinematic) {
   // Residual Δ = c_M_t_meas c_M_t_kin⁻¹: rotation vector and translation, both small (a fraction
   // of a degree and a few mm), so their average is the average of the poses to first order.
   const Eigen::Isometry3d d = c_M_t_measured * c_M_t_kinematic.inverse();
   const Eigen::AngleAxisd aa(d.linear());
   const Eigen::Vector3d omega = aa.angle() * aa.axis();
-  if (!omega.allFinite() || !d.translation().allFinite()) return;
+  if (!omega.allFinite() || !d.translation().allFinite()) return false;
+  if (valid_ && ((omega - omega_).norm() > kGateRotation || (d.translation() - tau_).norm() > kGateTranslation)) {
+    ++gated_;
+    if (++gated_in_a_row_ < kRestartAfter) return false;
+    valid_ = false;  // restart from this residual
+  }
+  gated_in_a_row_ = 0;
   if (!valid_) {
     omega_ = omega;
     tau_ = d.translation();
@@ -80,6 +86,7 @@ void TablePoseOffsetFilter::update(double t, const Eigen::Isometry3d& c_M_t_meas
     tau_ += a * (d.translation() - tau_);
   }
   t_ = t;
+  return true;
 }
 
 Eigen::Isometry3d TablePoseOffsetFilter::apply(const Eigen::Isometry3d& c_M_t_kinematic) const {

@@ -223,3 +223,21 @@ TEST(TableBallObserver, TablePoseFilterGainFollowsTheElapsedTime) {
   EXPECT_NEAR(two.translation().x(), 0.001 * -std::expm1(-0.04 / 0.5), 1e-15);
   EXPECT_THROW(scenarios::TablePoseOffsetFilter(0.0), core::InvalidInput);
 }
+
+// A wrong PnP pose (here 5° off) is skipped instead of pulling the offset; a run of them means the
+// kinematics changed, and the offset restarts from the newest residual.
+TEST(TableBallObserver, TablePoseFilterSkipsAWrongPoseAndRestartsAfterARun) {
+  const Eigen::Isometry3d kin = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d wrong = Eigen::Isometry3d::Identity();
+  wrong.linear() = core::rotation(Eigen::Vector3d::UnitX(), core::deg2rad(5.0));
+  scenarios::TablePoseOffsetFilter filter(1.0);
+  ASSERT_TRUE(filter.update(0.0, kin, kin));
+  double t = 0.0;
+  for (int k = 1; k < scenarios::TablePoseOffsetFilter::kRestartAfter; ++k) {
+    EXPECT_FALSE(filter.update(t += 0.02, wrong, kin));
+    EXPECT_EQ(filter.rotation().norm(), 0.0);
+  }
+  EXPECT_TRUE(filter.update(t += 0.02, wrong, kin));  // the run: restart
+  EXPECT_NEAR(filter.rotation().x(), core::deg2rad(5.0), 1e-12);
+  EXPECT_EQ(filter.gated(), scenarios::TablePoseOffsetFilter::kRestartAfter);
+}

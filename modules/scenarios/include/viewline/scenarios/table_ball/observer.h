@@ -33,7 +33,8 @@
 //     Δ = c_M_t_meas c_M_t_kin⁻¹ (camera frame; rotation vector ω and translation τ) is
 //     estimated by an exponential average of the per-frame residuals, gain 1 − exp(−dt/τ) (the
 //     steady Kalman gain of a random-walk offset: complementary filtering of kinematics and
-//     vision), and the ball and the tilt use c_M_t = Δ̂ c_M_t_kin, also in frames where the
+//     vision; a residual far from the estimate is a wrong pose and skipped), and the ball and
+//     the tilt use c_M_t = Δ̂ c_M_t_kin, also in frames where the
 //     table was not found. `measured` is the ball on the filtered pose (the filter fuses it);
 //     `measured_own_pose` stays the ball on this frame's own PnP pose, the raw measurement
 //     (measurement_rmse_mm). τ = 0: the per-frame pose throughout ([M]);
@@ -79,11 +80,23 @@ std::optional<Eigen::Vector3d> ballOnTablePlane(const core::Camera& camera, cons
 /// the kinematic one, averaged over frames with time constant τ (s).
 class TablePoseOffsetFilter {
 public:
+  /// rad: a residual whose rotation is farther than this from the estimate is a wrong pose (a
+  /// quarter turn, a bad corner), not noise (the PnP's is ~0.25°).
+  static constexpr double kGateRotation = 0.035;
+  /// m: the same for the residual's translation (0.45 m x 2° is 16 mm).
+  static constexpr double kGateTranslation = 0.03;
+  /// Gated residuals in a row after which the offset restarts from the newest one (the
+  /// kinematics changed, e.g. the arm was re-mounted).
+  static constexpr int kRestartAfter = 10;
+
   /// `time_constant`: τ of the exponential average, s (> 0).
   explicit TablePoseOffsetFilter(double time_constant);
   /// Folds in the residual of a table pose measured at t (s): c_M_t_meas c_M_t_kin⁻¹ (the first
-  /// one is taken as it is).
-  void update(double t, const Eigen::Isometry3d& c_M_t_measured, const Eigen::Isometry3d& c_M_t_kinematic);
+  /// one is taken as it is; one outside the gate is skipped, kRestartAfter in a row restart).
+  /// Returns false when the residual was skipped.
+  bool update(double t, const Eigen::Isometry3d& c_M_t_measured, const Eigen::Isometry3d& c_M_t_kinematic);
+  /// Residuals skipped by the gate so far.
+  int gated() const { return gated_; }
   /// True once a measured pose has been folded in.
   bool valid() const { return valid_; }
   /// The filtered table pose Δ̂ c_M_t_kin for a kinematic pose (camera frame; identity offset before any update).
@@ -96,6 +109,7 @@ public:
 private:
   double time_constant_;
   bool valid_ = false;
+  int gated_ = 0, gated_in_a_row_ = 0;
   double t_ = 0.0;
   Eigen::Vector3d omega_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d tau_ = Eigen::Vector3d::Zero();
