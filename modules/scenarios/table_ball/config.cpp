@@ -52,6 +52,7 @@ void TableBallConfig::validate() const {
     throw core::InvalidInput("controller.latency: expected >= camera.exposure / 2 (a frame is processed after its exposure)");
   }
   if (latency >= 1.0 / rate_hz) throw core::InvalidInput("controller.latency: expected < one frame period");
+  core::requireNonNegative(observer.table_pose_time_constant, "observer.table_pose_time_constant");
   if (observer.table_pose == TablePoseSource::AprilTag && !table_tags) {
     throw core::InvalidInput("observer.table_pose: apriltag needs table.tags: true");
   }
@@ -169,6 +170,7 @@ void readObserver(const io::ConfigNode& n, TableBallConfig& c) {
   gate.restart_after = n.getOr<int>("restart_after", gate.restart_after);
   c.observer.detector.refine = n.getOr<bool>("refine", c.observer.detector.refine);
   c.observer.edge_tracking = n.getOr<bool>("edge_tracking", c.observer.edge_tracking);
+  c.observer.table_pose_time_constant = n.getOr<double>("table_pose_time_constant", c.observer.table_pose_time_constant);
   c.border_aware_pnp = n.getOr<bool>("border_aware_pnp", c.border_aware_pnp);
 }
 

@@ -72,6 +72,7 @@ io::ConfigReferenceSection tableBallConfigReference() {
       {"observer.refine", "", "detector refinements after [M]'s steps (false: [M] exactly)"},
       {"observer.edge_tracking", "", "track the sides and the ball locally between full [M] detections"},
       {"observer.border_aware_pnp", "", "re-solve the PnP for the strip of surface the borders hide (false: [M])"},
+      {"observer.table_pose_time_constant", "s", "time constant of the table pose filter (offset of the PnP pose from the kinematic one, averaged); 0: the per-frame PnP pose ([M])"},
       {"controller", "", "LQR on the estimated state with tilt-rate input (control::TableBalancer)"},
       {"controller.latency", "s", "capture to command (model delay = latency + wrist.delay)"},
       {"controller.q_position", "1/m²", "LQR weight on the position error²"},

@@ -56,6 +56,47 @@ std::optional<Eigen::Vector3d> ballOnTablePlane(const core::Camera& camera, cons
   return Eigen::Vector3d(t_prime + s * v1);
 }
 
+TablePoseOffsetFilter::TablePoseOffsetFilter(double time_constant) : time_constant_(time_constant) {
+  core::requirePositive(time_constant, "TablePoseOffsetFilter: time_constant");
+}
+
+bool TablePoseOffsetFilter::update(double t, const Eigen::Isometry3d& c_M_t_measured,
+                                   const Eigen::Isometry3d& c_M_t_kinematic) {
+  // Residual Δ = c_M_t_meas c_M_t_kin⁻¹: rotation vector and translation, both small (a fraction
+  // of a degree and a few mm), so their average is the average of the poses to first order.
+  const Eigen::Isometry3d d = c_M_t_measured * c_M_t_kinematic.inverse();
+  const Eigen::AngleAxisd aa(d.linear());
+  const Eigen::Vector3d omega = aa.angle() * aa.axis();
+  if (!omega.allFinite() || !d.translation().allFinite()) return false;
+  if (valid_ && ((omega - omega_).norm() > kGateRotation || (d.translation() - tau_).norm() > kGateTranslation)) {
+    ++gated_;
+    if (++gated_in_a_row_ < kRestartAfter) return false;
+    valid_ = false;  // restart from this residual
+  }
+  gated_in_a_row_ = 0;
+  if (!valid_) {
+    omega_ = omega;
+    tau_ = d.translation();
+    valid_ = true;
+  } else {
+    // Exponential average over time τ: the steady Kalman gain of an offset that drifts slowly
+    // (random walk) under white residual noise; dt-exact for dropped frames.
+    const double a = -std::expm1(-std::max(t - t_, 0.0) / time_constant_);
+    omega_ += a * (omega - omega_);
+    tau_ += a * (d.translation() - tau_);
+  }
+  t_ = t;
+  return true;
+}
+
+Eigen::Isometry3d TablePoseOffsetFilter::apply(const Eigen::Isometry3d& c_M_t_kinematic) const {
+  Eigen::Isometry3d d = Eigen::Isometry3d::Identity();
+  const double angle = omega_.norm();
+  if (angle > 0.0) d.linear() = Eigen::AngleAxisd(angle, omega_ / angle).toRotationMatrix();
+  d.translation() = tau_;
+  return d * c_M_t_kinematic;
+}
+
 // -------------------------------------------------------------------------------------------
 
 TableBallObserver::TableBallObserver(const core::Camera& camera, const TableBallObserverConfig& config)
@@ -66,6 +107,8 @@ TableBallObserver::TableBallObserver(const core::Camera& camera, const TableBall
     if (config_.tag_layout.empty()) throw core::InvalidInput("TableBallObserverConfig.tag_layout: empty for AprilTag table pose");
     tags_ = std::make_unique<vision::AprilTagTableDetector>(camera, config_.tag_layout, config_.tag_detector);
   }
+  core::requireNonNegative(config_.table_pose_time_constant, "TableBallObserverConfig.table_pose_time_constant");
+  if (config_.table_pose_time_constant > 0.0) pose_filter_.emplace(config_.table_pose_time_constant);
 }
 
 TableBallObserver::~TableBallObserver() = default;
@@ -135,34 +178,53 @@ const ObserverFrame& TableBallObserver::process(const cv::Mat& bgr, double t, co
     c_M_t_ = *pose;
     have_table_ = true;
   }
-  frame_.c_M_t = c_M_t_;
+  // The pose the ball and the tilt use: this frame's PnP pose, or the filtered one (step 2b).
+  if (pose_filter_ && pose) pose_filter_->update(t, *pose, c_M_t_nominal);
+  const bool filtered = pose_filter_ && pose_filter_->valid();
+  const Eigen::Isometry3d c_M_t_used = filtered ? pose_filter_->apply(c_M_t_nominal) : c_M_t_;
+  frame_.c_M_t = c_M_t_used;
   if (have_table_) {
-    const Eigen::Matrix3d t_R_w = estimation::tableRotationInWorld(c_M_t_.linear(), c_R_w);
+    const Eigen::Matrix3d t_R_w = estimation::tableRotationInWorld(c_M_t_used.linear(), c_R_w);
     frame_.a_xy = estimation::rollingBallAcceleration(t_R_w, config_.gravity_w);
     frame_.measured_tilt = tiltFromTableRotation(t_R_w.transpose());
   }
 
-  std::optional<Eigen::Vector2d> y;
+  std::optional<Eigen::Vector2d> y, y_raw;
   frame_.ball_circle = circle;
   if (have_table_ && circle) {
-    if (config_.ball_geometry == BallGeometry::KnownRadius) {
-      y = vision::ballOnTableKnownRadius(camera_, *circle, c_M_t_, model.ball_radius).p_t.head<2>();
-    } else if (config_.ball_geometry == BallGeometry::TablePlane) {
-      if (const auto p = ballOnTablePlane(camera_, *circle, c_M_t_, model.ball_radius)) y = p->head<2>();
-    } else if (const auto g = vision::ballOnTableUnknownRadius(camera_, *circle, c_M_t_)) {
-      y = g->p_t.head<2>();
-    }
-    // A ball "found" far outside the table is a detection error, not a measurement.
-    if (y && (!y->allFinite() || y->cwiseAbs().maxCoeff() > 0.5 * model.table_side + model.ball_radius)) y.reset();
+    y_raw = ballOnTable(*circle, c_M_t_);
+    y = filtered ? ballOnTable(*circle, c_M_t_used) : y_raw;
   } else if (!circle && frame_.failure.empty()) {
     frame_.failure = "ball: not found";
   }
   frame_.ball_found = y.has_value();
   frame_.ball_circle_prev = y ? circle : std::nullopt;
-  if (y) frame_.measured = *y;
+  frame_.measured_own_pose.setConstant(std::numeric_limits<double>::quiet_NaN());
+  if (y) {
+    frame_.measured = *y;
+    // The raw measurement is scored where the filter had one (a frame whose own-pose ball fell
+    // off the table keeps NaN: not measured).
+    if (y_raw) frame_.measured_own_pose = *y_raw;
+  }
   filterStep(t, y);
   frame_.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return frame_;
+}
+
+std::optional<Eigen::Vector2d> TableBallObserver::ballOnTable(const vision::Circle& circle,
+                                                              const Eigen::Isometry3d& c_M_t) const {
+  const auto& model = config_.tracker.model;
+  std::optional<Eigen::Vector2d> y;
+  if (config_.ball_geometry == BallGeometry::KnownRadius) {
+    y = vision::ballOnTableKnownRadius(camera_, circle, c_M_t, model.ball_radius).p_t.head<2>();
+  } else if (config_.ball_geometry == BallGeometry::TablePlane) {
+    if (const auto p = ballOnTablePlane(camera_, circle, c_M_t, model.ball_radius)) y = p->head<2>();
+  } else if (const auto g = vision::ballOnTableUnknownRadius(camera_, circle, c_M_t)) {
+    y = g->p_t.head<2>();
+  }
+  // A ball "found" far outside the table is a detection error, not a measurement.
+  if (y && (!y->allFinite() || y->cwiseAbs().maxCoeff() > 0.5 * model.table_side + model.ball_radius)) y.reset();
+  return y;
 }
 
 const ObserverFrame& TableBallObserver::predictOnly(double t) {
@@ -175,6 +237,7 @@ const ObserverFrame& TableBallObserver::predictOnly(double t) {
   frame_.ball_circle.reset();
   frame_.ball_circle_prev.reset();
   frame_.measured.setConstant(std::numeric_limits<double>::quiet_NaN());
+  frame_.measured_own_pose.setConstant(std::numeric_limits<double>::quiet_NaN());
   if (tracker_.initialized()) filterStep(t, std::nullopt);
   frame_.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return frame_;

@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "viewline/core/error.h"
 #include "viewline/core/frames.h"
 #include "viewline/core/random.h"
 #include "viewline/scenarios/table_ball.h"
@@ -160,4 +161,83 @@ TEST(TableBallObserver, AprilTagTablePoseMatchesTheRenderedTable) {
   // The ball measured on that table frame lies where it is.
   ASSERT_TRUE(of.ball_found) << of.failure;
   EXPECT_LT((of.measured - truth.p).norm(), 0.005);
+}
+
+// The table pose filter (observer.h, step 2b): a constant camera-frame offset between the PnP
+// pose and the kinematic one (calibration) under per-frame PnP noise is learnt, and the filtered
+// pose is much closer to the true pose than the noisy PnP poses are.
+TEST(TableBallObserver, TablePoseFilterLearnsTheOffsetAndAveragesThePnpNoise) {
+  const double tau = 1.0, dt = 0.02;
+  scenarios::TablePoseOffsetFilter filter(tau);
+  EXPECT_FALSE(filter.valid());
+  // The true offset: 0.06° about a skew axis and 1 mm (a calibration error of the head camera).
+  Eigen::Isometry3d offset = Eigen::Isometry3d::Identity();
+  offset.linear() = Eigen::AngleAxisd(core::deg2rad(0.06), Eigen::Vector3d(1.0, -2.0, 0.5).normalized()).toRotationMatrix();
+  offset.translation() = Eigen::Vector3d(0.001, -0.0005, 0.0008);
+  core::Rng rng = core::makeRng(11);
+  double raw_sq = 0.0, filtered_sq = 0.0;
+  int n = 0;
+  for (int k = 0; k < 500; ++k) {
+    const double t = k * dt;
+    // The kinematic pose moves (the table tilts, the head sways).
+    Eigen::Isometry3d kin = Eigen::Isometry3d::Identity();
+    kin.linear() = (core::rotation(Eigen::Vector3d::UnitX(), -2.2 + 0.1 * std::sin(t)) *
+                    core::rotation(Eigen::Vector3d::UnitY(), 0.05 * std::cos(1.3 * t)));
+    kin.translation() = Eigen::Vector3d(0.002 * std::sin(2.0 * t), 0.05, 0.45);
+    const Eigen::Isometry3d truth = offset * kin;
+    // A PnP pose: 0.25° of rotation noise about the table's centre and 0.5 mm of translation noise.
+    const Eigen::Vector3d w(core::gaussian(rng, 1.0), core::gaussian(rng, 1.0), core::gaussian(rng, 1.0));
+    Eigen::Isometry3d noise = Eigen::Isometry3d::Identity();
+    noise.linear() = Eigen::AngleAxisd(core::deg2rad(0.25) * w.norm() / std::sqrt(3.0), w.normalized()).toRotationMatrix();
+    noise.translation() = 0.0005 * Eigen::Vector3d(core::gaussian(rng, 1.0), core::gaussian(rng, 1.0), core::gaussian(rng, 1.0));
+    const Eigen::Isometry3d measured = truth * noise;  // noise in the table frame
+    filter.update(t, measured, kin);
+    ASSERT_TRUE(filter.valid());
+    if (k == 0) {  // the first residual is taken as it is
+      EXPECT_LT((filter.apply(kin).matrix() - measured.matrix()).norm(), 1e-12);
+    }
+    if (t < 3.0 * tau) continue;
+    // Error of the table centre's position and of the rotation against the truth.
+    const Eigen::Isometry3d f = filter.apply(kin);
+    raw_sq += (measured.translation() - truth.translation()).squaredNorm();
+    filtered_sq += (f.translation() - truth.translation()).squaredNorm();
+    EXPECT_LT(core::rotationAngle(f.linear(), truth.linear()), core::deg2rad(0.06));
+    ++n;
+  }
+  // Averaging over τ = 50 frames: about 1/sqrt(100) of the noise (0.1), at most 0.2 here.
+  EXPECT_LT(std::sqrt(filtered_sq / n), 0.2 * std::sqrt(raw_sq / n));
+  EXPECT_LT((filter.translation() - offset.translation()).norm(), 5e-4);  // of 1.4 mm
+}
+
+// A dropped frame does not stall the average: the gain follows the time since the last pose.
+TEST(TableBallObserver, TablePoseFilterGainFollowsTheElapsedTime) {
+  const Eigen::Isometry3d kin = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d a = Eigen::Isometry3d::Identity(), b = Eigen::Isometry3d::Identity();
+  b.translation() = Eigen::Vector3d(0.001, 0.0, 0.0);
+  scenarios::TablePoseOffsetFilter one(0.5), two(0.5);
+  one.update(0.0, a, kin);
+  two.update(0.0, a, kin);
+  one.update(0.02, b, kin);
+  two.update(0.04, b, kin);
+  EXPECT_NEAR(one.translation().x(), 0.001 * -std::expm1(-0.02 / 0.5), 1e-15);
+  EXPECT_NEAR(two.translation().x(), 0.001 * -std::expm1(-0.04 / 0.5), 1e-15);
+  EXPECT_THROW(scenarios::TablePoseOffsetFilter(0.0), core::InvalidInput);
+}
+
+// A wrong PnP pose (here 5° off) is skipped instead of pulling the offset; a run of them means the
+// kinematics changed, and the offset restarts from the newest residual.
+TEST(TableBallObserver, TablePoseFilterSkipsAWrongPoseAndRestartsAfterARun) {
+  const Eigen::Isometry3d kin = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d wrong = Eigen::Isometry3d::Identity();
+  wrong.linear() = core::rotation(Eigen::Vector3d::UnitX(), core::deg2rad(5.0));
+  scenarios::TablePoseOffsetFilter filter(1.0);
+  ASSERT_TRUE(filter.update(0.0, kin, kin));
+  double t = 0.0;
+  for (int k = 1; k < scenarios::TablePoseOffsetFilter::kRestartAfter; ++k) {
+    EXPECT_FALSE(filter.update(t += 0.02, wrong, kin));
+    EXPECT_EQ(filter.rotation().norm(), 0.0);
+  }
+  EXPECT_TRUE(filter.update(t += 0.02, wrong, kin));  // the run: restart
+  EXPECT_NEAR(filter.rotation().x(), core::deg2rad(5.0), 1e-12);
+  EXPECT_EQ(filter.gated(), scenarios::TablePoseOffsetFilter::kRestartAfter);
 }

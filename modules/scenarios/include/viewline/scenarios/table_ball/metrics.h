@@ -46,7 +46,9 @@ struct TableBallResult {
       ball_detections = 0;   ///< frames in which the ball was found
   int tracked_frames = 0;  ///< frames measured by the fast path (edge tracking), not [M]'s full pipeline
   double observer_rmse_mm = 0.0;     ///< RMS |p̂ − p| after warmup, mm
-  double measurement_rmse_mm = 0.0;  ///< RMS |y − p| of the ball measurements after warmup, mm
+  double measurement_rmse_mm = 0.0;  ///< RMS |y − p| of the raw ball measurements (own table pose) after warmup, mm
+  /// RMS |y − p| of the ball measurements the filter fused (filtered table pose) after warmup, mm.
+  double fused_measurement_rmse_mm = 0.0;
   double observer_rmse_mm_M_sw1_sv0005 = 0.0;   ///< [M]'s best tuning (side filter)
   double observer_rmse_mm_M_sw1_sv1 = 0.0;      ///< [M]'s lagging tuning (side filter)
   double observer_rmse_mm_stationary = 0.0;     ///< stationary (DARE) gain, configured σ
@@ -130,7 +132,7 @@ private:
   Eigen::Vector2d last_cmd_ = Eigen::Vector2d::Zero();
   std::vector<double> tick_t_;
   std::vector<Eigen::Vector2d> tick_p_;
-  Accumulator obs_, meas_, pred_, tilt_;
+  Accumulator obs_, meas_, fused_meas_, pred_, tilt_;
   std::vector<Accumulator> side_;
   std::vector<std::pair<double, Eigen::Vector2d>> pending_pred_;  // (time, predicted position N frames ahead)
   double next_nis_ = 0.0, next_nees_ = 0.0;

@@ -23,6 +23,21 @@
 //     α is 0.05 px of a 9 px radius off per 0.5 % (the edge of a shaded, blurred sphere sits a
 //     little inside its limb), and 0.5 % of d ≈ 0.45 m is the 1.5-2 mm depth bias the known-radius
 //     model had; the axis (the mid-point of the radial diameter) is unbiased by such an edge;
+//  2b. table pose filter (ours; option table_pose_time_constant τ > 0): the table's pose in the
+//     camera is also known from kinematics, c_M_t_kin = c_M_w(t) w_M_t(θ) (the head's measured
+//     sway on the calibrated rest pose, the arm's table pose at the tilt θ its wrist is driven
+//     to), up to a slowly varying error (camera calibration, arm kinematics) that the per-frame
+//     PnP pose sees as a constant offset under its own frame-to-frame noise (0.2-0.3° of
+//     rotation, correlated over ~2 frames, ~0.25 mm on the ball; the kinematic pose with the
+//     true tilt puts 0.06 mm of noise on the ball and a 1.3 mm calibration offset). The offset
+//     Δ = c_M_t_meas c_M_t_kin⁻¹ (camera frame; rotation vector ω and translation τ) is
+//     estimated by an exponential average of the per-frame residuals, gain 1 − exp(−dt/τ) (the
+//     steady Kalman gain of a random-walk offset: complementary filtering of kinematics and
+//     vision; a residual far from the estimate is a wrong pose and skipped), and the ball and
+//     the tilt use c_M_t = Δ̂ c_M_t_kin, also in frames where the
+//     table was not found. `measured` is the ball on the filtered pose (the filter fuses it);
+//     `measured_own_pose` stays the ball on this frame's own PnP pose, the raw measurement
+//     (measurement_rmse_mm). τ = 0: the per-frame pose throughout ([M]);
 //  3. measured tilt: table_R_world = c_R_tᵀ c_R_w, input a_xy = (5/7)[table_R_world g_w]_xy
 //     (estimation::rollingBallAcceleration). Without a table pose the last one is kept;
 //  4-5. tracking::RollingBallTracker: the rolling-ball filter (estimation::RollingBallModel)
@@ -61,6 +76,45 @@ Eigen::Isometry3d borderAwareTablePose(const core::Camera& camera, const std::ar
 std::optional<Eigen::Vector3d> ballOnTablePlane(const core::Camera& camera, const vision::Circle& circle,
                                                 const Eigen::Isometry3d& c_M_t, double ball_radius);
 
+/// The table pose filter of step 2b: a camera-frame offset Δ between the measured table pose and
+/// the kinematic one, averaged over frames with time constant τ (s).
+class TablePoseOffsetFilter {
+public:
+  /// rad: a residual whose rotation is farther than this from the estimate is a wrong pose (a
+  /// quarter turn, a bad corner), not noise (the PnP's is ~0.25°).
+  static constexpr double kGateRotation = 0.035;
+  /// m: the same for the residual's translation (0.45 m x 2° is 16 mm).
+  static constexpr double kGateTranslation = 0.03;
+  /// Gated residuals in a row after which the offset restarts from the newest one (the
+  /// kinematics changed, e.g. the arm was re-mounted).
+  static constexpr int kRestartAfter = 10;
+
+  /// `time_constant`: τ of the exponential average, s (> 0).
+  explicit TablePoseOffsetFilter(double time_constant);
+  /// Folds in the residual of a table pose measured at t (s): c_M_t_meas c_M_t_kin⁻¹ (the first
+  /// one is taken as it is; one outside the gate is skipped, kRestartAfter in a row restart).
+  /// Returns false when the residual was skipped.
+  bool update(double t, const Eigen::Isometry3d& c_M_t_measured, const Eigen::Isometry3d& c_M_t_kinematic);
+  /// Residuals skipped by the gate so far.
+  int gated() const { return gated_; }
+  /// True once a measured pose has been folded in.
+  bool valid() const { return valid_; }
+  /// The filtered table pose Δ̂ c_M_t_kin for a kinematic pose (camera frame; identity offset before any update).
+  Eigen::Isometry3d apply(const Eigen::Isometry3d& c_M_t_kinematic) const;
+  /// The estimated offset's rotation vector (rad, camera frame).
+  const Eigen::Vector3d& rotation() const { return omega_; }
+  /// The estimated offset's translation (m, camera frame).
+  const Eigen::Vector3d& translation() const { return tau_; }
+
+private:
+  double time_constant_;
+  bool valid_ = false;
+  int gated_ = 0, gated_in_a_row_ = 0;
+  double t_ = 0.0;
+  Eigen::Vector3d omega_ = Eigen::Vector3d::Zero();
+  Eigen::Vector3d tau_ = Eigen::Vector3d::Zero();
+};
+
 /// Tilt angles (θx, θy) of a table whose orientation in the world is w_R_t = Rx(θx) Ry(θy)
 /// (robots::TableTilt convention): θx = atan2(R21, R11), θy = atan2(R02, R00).
 Eigen::Vector2d tiltFromTableRotation(const Eigen::Matrix3d& w_R_t);
@@ -87,6 +141,8 @@ struct TableBallObserverConfig {
   vision::AprilTagDetectorConfig tag_detector;        ///< AprilTag alternative: detector settings
   tracking::RollingBallTrackerConfig tracker;  ///< the rolling-ball filter (steps 4-5)
   bool edge_tracking = true;                          ///< fast path between full detections (corners mode)
+  /// s, time constant τ of the table pose filter (step 2b); 0: the per-frame PnP pose ([M]).
+  double table_pose_time_constant = 0.0;
   vision::TableEdgeTrackerConfig edge_tracker;  ///< the fast path's settings
   Eigen::Vector3d gravity_w = Eigen::Vector3d(0.0, 0.0, -9.81);  ///< gravity in the world frame, m/s²
 };
@@ -99,12 +155,16 @@ struct ObserverFrame {
   bool tracked = false;                  ///< table and ball came from the fast path
   bool ball_found = false;               ///< a ball position on the table was measured
   std::string failure;                   ///< why the table or the ball was not measured
-  Eigen::Isometry3d c_M_t = Eigen::Isometry3d::Identity();  ///< last valid table pose
+  Eigen::Isometry3d c_M_t = Eigen::Isometry3d::Identity();  ///< table pose the ball and tilt used (filtered with step 2b)
   std::array<Eigen::Vector2d, 4> corners{};  ///< detected corners (corner pipeline)
   std::optional<vision::Circle> ball_circle;        ///< the ball's image circle (pixels), when detected
   std::optional<vision::Circle> ball_circle_prev;  ///< circle of a found ball (seeds the fast path)
-  /// Measured ball position on the table (m, table frame); NaN when not measured.
+  /// Measured ball position on the table (m, table frame), the one the filter fused: on the
+  /// filtered table pose with step 2b; NaN when not measured.
   Eigen::Vector2d measured = Eigen::Vector2d::Constant(std::numeric_limits<double>::quiet_NaN());
+  /// The raw measurement: the ball on this frame's own PnP table pose (m, table frame; equal to
+  /// `measured` without step 2b); NaN when not measured or off the table.
+  Eigen::Vector2d measured_own_pose = Eigen::Vector2d::Constant(std::numeric_limits<double>::quiet_NaN());
   Eigen::Vector2d measured_tilt = Eigen::Vector2d::Zero();  ///< (θx, θy) from the table pose
   Eigen::Vector2d a_xy = Eigen::Vector2d::Zero();  ///< in-plane acceleration fed to the filter, m/s² (table frame)
   bool estimate_valid = false;           ///< the filter has started (x and predictions are valid)
@@ -125,8 +185,8 @@ public:
   TableBallObserver& operator=(const TableBallObserver&) = delete;
 
   /// One frame: BGR image captured at t, camera-to-ground rotation c_R_w at that instant, and
-  /// the table pose expected from the arm's kinematics (resolves the square's quarter turns;
-  /// used when the table was lost or on the first frame).
+  /// the table pose expected from the arm's kinematics at t (resolves the square's quarter turns;
+  /// the kinematic pose of the table pose filter, step 2b).
   const ObserverFrame& process(const cv::Mat& bgr, double t, const Eigen::Matrix3d& c_R_w,
                                const Eigen::Isometry3d& c_M_t_nominal);
   /// A step without an image (dropped frame): prediction only.
@@ -141,6 +201,7 @@ public:
 
 private:
   void filterStep(double t, const std::optional<Eigen::Vector2d>& y);
+  std::optional<Eigen::Vector2d> ballOnTable(const vision::Circle& circle, const Eigen::Isometry3d& c_M_t) const;
   core::Camera camera_;
   TableBallObserverConfig config_;
   vision::TableDetector detector_;
@@ -150,7 +211,8 @@ private:
   ObserverFrame frame_;
   bool have_table_ = false;
   bool need_prior_ = true;
-  Eigen::Isometry3d c_M_t_ = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d c_M_t_ = Eigen::Isometry3d::Identity();  // the last PnP pose (the fast path starts from it)
+  std::optional<TablePoseOffsetFilter> pose_filter_;
 };
 
 }  // namespace viewline::scenarios
