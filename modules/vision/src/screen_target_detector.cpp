@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <opencv2/imgproc.hpp>
 
 #include "viewline/core/checks.h"
@@ -25,6 +26,122 @@ void ScreenTargetDetectorConfig::validate() const {
     throw core::InvalidInput("ScreenTargetDetectorConfig.min_fill must be in [0, 1]");
   core::requirePositive(edge_noise_px, "ScreenTargetDetectorConfig.edge_noise_px");
   core::requirePositive(min_sigma_px, "ScreenTargetDetectorConfig.min_sigma_px");
+}
+
+namespace {
+
+// Index of the first / last non-zero byte of p[0, n), or -1; eight bytes at a time (the binary image is
+// mostly background).
+int firstNonZero(const std::uint8_t* p, int n) {
+  int i = 0;
+  for (; i + 8 <= n; i += 8) {
+    std::uint64_t w;
+    std::memcpy(&w, p + i, 8);
+    if (w != 0) break;
+  }
+  for (; i < n; ++i)
+    if (p[i] != 0) return i;
+  return -1;
+}
+
+int lastNonZero(const std::uint8_t* p, int n) {
+  int i = n;
+  for (; i >= 8; i -= 8) {
+    std::uint64_t w;
+    std::memcpy(&w, p + i - 8, 8);
+    if (w != 0) break;
+  }
+  for (; i > 0; --i)
+    if (p[i - 1] != 0) return i - 1;
+  return -1;
+}
+
+}  // namespace
+
+BinaryBlobMoments medianBlobMoments(const cv::Mat& binary, int ksize, std::vector<std::int32_t>& scratch) {
+  if (binary.type() != CV_8UC1 || binary.empty())
+    throw core::InvalidInput("medianBlobMoments: expected a non-empty CV_8UC1 image");
+  if (ksize < 1 || ksize % 2 == 0) throw core::InvalidInput("medianBlobMoments: ksize must be odd and >= 1");
+  const int W = binary.cols, H = binary.rows, r = ksize / 2;
+  // The median of k² values in {0, 255} is 255 iff at least (k² + 1) / 2 of them are 255: the filter is
+  // a majority vote over the window (cv::medianBlur replicates the border, as the clamps below do). A
+  // pixel whose window holds no foreground stays 0, so only the input foreground's box grown by r is
+  // filtered.
+  const int need = (ksize * ksize + 1) / 2;
+  int fx0 = W, fx1 = -1, fy0 = H, fy1 = -1;
+  for (int y = 0; y < H; ++y) {
+    const std::uint8_t* row = binary.ptr<std::uint8_t>(y);
+    const int first = firstNonZero(row, W);
+    if (first < 0) continue;
+    fx0 = std::min(fx0, first);
+    fx1 = std::max(fx1, lastNonZero(row, W));
+    if (fy1 < 0) fy0 = y;
+    fy1 = y;
+  }
+  BinaryBlobMoments out;
+  if (fy1 < 0) return out;
+  const int ox0 = std::max(0, fx0 - r), ox1 = std::min(W - 1, fx1 + r);
+  const int oy0 = std::max(0, fy0 - r), oy1 = std::min(H - 1, fy1 + r);
+  // cv::moments sums 32x32 tiles in integers and the tiles in double (below): per tile the count, Σ x and
+  // Σ y of its foreground, in the tile's own coordinates.
+  constexpr int kTile = 32;
+  const int tiles_x = (W + kTile - 1) / kTile, tiles_y = (H + kTile - 1) / kTile;
+  const int cw = (ox1 - ox0 + 1) + 2 * r;  // column sums over x in [ox0 - r, ox1 + r] (clamped into the image)
+  scratch.assign(static_cast<std::size_t>(cw + 3 * tiles_x * tiles_y), 0);
+  std::int32_t* colsum = scratch.data();
+  std::int32_t* tile = colsum + cw;
+  const auto addRow = [&](int yy, int sign) {
+    const std::uint8_t* row = binary.ptr<std::uint8_t>(std::clamp(yy, 0, H - 1));
+    for (int c = 0; c < cw; ++c) colsum[c] += sign * (row[std::clamp(ox0 - r + c, 0, W - 1)] != 0 ? 1 : 0);
+  };
+  for (int dy = -r; dy <= r; ++dy) addRow(oy0 + dy, 1);
+  int bx0 = W, bx1 = -1, by0 = H, by1 = -1;
+  for (int y = oy0; y <= oy1; ++y) {
+    if (y > oy0) {  // the window moves down one row
+      addRow(y + r, 1);
+      addRow(y - r - 1, -1);
+    }
+    int sum = 0;
+    for (int c = 0; c < 2 * r; ++c) sum += colsum[c];
+    std::int32_t* tile_row = tile + 3 * (y / kTile) * tiles_x;
+    for (int i = 0, x = ox0; x <= ox1; ++i, ++x) {
+      sum += colsum[i + 2 * r];
+      if (sum >= need) {
+        std::int32_t* t = tile_row + 3 * (x / kTile);
+        t[0] += 1;
+        t[1] += x % kTile;
+        t[2] += y % kTile;
+        bx0 = std::min(bx0, x);
+        bx1 = std::max(bx1, x);
+        by0 = std::min(by0, y);
+        by1 = std::max(by1, y);
+      }
+      sum -= colsum[i];
+    }
+  }
+  if (by1 < 0) return out;
+  out.box = cv::Rect(bx0, by0, bx1 - bx0 + 1, by1 - by0 + 1);
+  // cv::moments(binary = true), OpenCV 4.6 imgproc/src/moments.cpp: each tile's integer moments of the
+  // 0/255 image are converted to double and scaled by 1./255 (not exact: 255 n * (1./255) may differ
+  // from n in the last bit), then added tile by tile in row order, m10 += m10' + x0 m00' (x0, y0 the
+  // tile's corner). The same operations in the same order; empty tiles add +0.0 and are skipped.
+  const double scale = 1. / 255;
+  for (int ty = 0; ty < tiles_y; ++ty) {
+    for (int tx = 0; tx < tiles_x; ++tx) {
+      const std::int32_t* t = tile + 3 * (ty * tiles_x + tx);
+      if (t[0] == 0) continue;
+      double mom0 = static_cast<double>(255 * t[0]), mom1 = static_cast<double>(255 * t[1]),
+             mom2 = static_cast<double>(255 * t[2]);
+      mom0 *= scale;
+      mom1 *= scale;
+      mom2 *= scale;
+      const double xm = (tx * kTile) * mom0, ym = (ty * kTile) * mom0;
+      out.m00 += mom0;
+      out.m10 += mom1 + xm;
+      out.m01 += mom2 + ym;
+    }
+  }
+  return out;
 }
 
 ScreenTargetDetector::ScreenTargetDetector(ScreenTargetDetectorConfig config)
@@ -60,13 +177,9 @@ Result<ScreenTargetMeasurement> ScreenTargetDetector::detect(const cv::Mat& imag
     level = cv::threshold(small_, binary_, 0, 255, type | cv::THRESH_OTSU);
   else
     cv::threshold(small_, binary_, level, 255, type);
-  // 4. median filter
-  if (config_.median_ksize > 1)
-    cv::medianBlur(binary_, filtered_, config_.median_ksize);
-  else
-    filtered_ = binary_;
-  // 5. centroid of the binary image
-  const cv::Moments m = cv::moments(filtered_, true);
+  // 4.-5. median filter, then the centroid and bounding box of the binary image (medianBlobMoments:
+  // cv::medianBlur + cv::moments + cv::boundingRect bit for bit, over the foreground's neighbourhood only).
+  const BinaryBlobMoments m = medianBlobMoments(binary_, config_.median_ksize, scratch_);
   const double full_area = m.m00 / (s * s);
   if (m.m00 <= 0.0)
     return Result<ScreenTargetMeasurement>::fail(FailureReason::NotFound,
@@ -74,8 +187,8 @@ Result<ScreenTargetMeasurement> ScreenTargetDetector::detect(const cv::Mat& imag
   if (full_area < config_.min_area_px)
     return Result<ScreenTargetMeasurement>::fail(
         FailureReason::TooSmall, "target area " + std::to_string(full_area) + " px < min_area_px");
-  const cv::Rect box = cv::boundingRect(filtered_);
-  if (touchesBorder(box, cv::Rect(0, 0, filtered_.cols, filtered_.rows)))
+  const cv::Rect& box = m.box;
+  if (touchesBorder(box, cv::Rect(0, 0, binary_.cols, binary_.rows)))
     return Result<ScreenTargetMeasurement>::fail(FailureReason::Clipped,
                                                  "target touches the crop border");
   const double fill = m.m00 / static_cast<double>(box.area());
