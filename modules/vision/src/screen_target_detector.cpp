@@ -144,6 +144,55 @@ BinaryBlobMoments medianBlobMoments(const cv::Mat& binary, int ksize, std::vecto
   return out;
 }
 
+void halfScaleBinary(const cv::Mat& image, int level, bool dark_target, cv::Mat& binary) {
+  if ((image.type() != CV_8UC1 && image.type() != CV_8UC3) || image.empty() || image.cols % 2 != 0 || image.rows % 2 != 0)
+    throw core::InvalidInput("halfScaleBinary: expected a non-empty CV_8UC1 or CV_8UC3 image of even size");
+  if (level < 0 || level > 255) throw core::InvalidInput("halfScaleBinary: level must be in [0, 255]");
+  const int cn = image.channels(), W = image.cols / 2, H = image.rows / 2;
+  binary.create(H, W, CV_8UC1);
+  // OpenCV 4.6, 8-bit: BGR2GRAY is (3735 B + 19235 G + 9798 R + 2^14) >> 15 (imgproc/src/color.hpp, BY15 GY15
+  // RY15 and gray_shift = 15, used by RGB2Gray<uchar> in color_rgb.simd.hpp; not the 14-bit yuv coefficients
+  // 1868 9617 4899 of OpenCV 3, which round differently near .5); INTER_AREA at exactly 1/2 is the fast area path, (a + b + c + d + 2) >> 2
+  // (imgproc/src/resize.cpp, ResizeAreaFastVec); THRESH_BINARY(_INV) at an integer level is v > level.
+  const auto grey = [cn](const std::uint8_t* p) {
+    return cn == 1 ? int{p[0]} : (3735 * p[0] + 19235 * p[1] + 9798 * p[2] + (1 << 14)) >> 15;
+  };
+  // The grey level lies between the smallest and the largest of a pixel's channels (the weights sum to
+  // 2^15, the rounding adds half), and so does the mean of four: a block whose bytes are all > level
+  // (dark target; all <= level for a bright one) is background whatever the exact values, and only the
+  // other blocks (the target's, dark clutter) are computed exactly.
+  constexpr int kBlock = 16;  // output pixels per block
+  for (int y = 0; y < H; ++y) {
+    const std::uint8_t* r0 = image.ptr<std::uint8_t>(2 * y);
+    const std::uint8_t* r1 = image.ptr<std::uint8_t>(2 * y + 1);
+    std::uint8_t* out = binary.ptr<std::uint8_t>(y);
+    for (int x0 = 0; x0 < W; x0 += kBlock) {
+      const int n = std::min(kBlock, W - x0), bytes = 2 * n * cn;
+      const std::uint8_t* a = r0 + 2 * x0 * cn;
+      const std::uint8_t* b = r1 + 2 * x0 * cn;
+      bool background;
+      if (dark_target) {
+        std::uint8_t lo = 255;
+        for (int i = 0; i < bytes; ++i) lo = std::min(lo, std::min(a[i], b[i]));
+        background = lo > level;
+      } else {
+        std::uint8_t hi = 0;
+        for (int i = 0; i < bytes; ++i) hi = std::max(hi, std::max(a[i], b[i]));
+        background = hi <= level;
+      }
+      if (background) {
+        std::memset(out + x0, 0, static_cast<std::size_t>(n));
+        continue;
+      }
+      for (int x = x0; x < x0 + n; ++x) {
+        const int sum = grey(r0 + 2 * x * cn) + grey(r0 + (2 * x + 1) * cn) + grey(r1 + 2 * x * cn) +
+                        grey(r1 + (2 * x + 1) * cn);
+        out[x] = ((sum + 2) >> 2 > level) != dark_target ? 255 : 0;
+      }
+    }
+  }
+}
+
 ScreenTargetDetector::ScreenTargetDetector(ScreenTargetDetectorConfig config)
     : config_(std::move(config)) {
   config_.validate();
@@ -159,24 +208,30 @@ Result<ScreenTargetMeasurement> ScreenTargetDetector::detect(const cv::Mat& imag
     throw core::InvalidInput("ScreenTargetDetectorConfig.crop_*: margins leave less than 8x8 px of a " +
                              std::to_string(image.cols) + "x" + std::to_string(image.rows) + " image");
   const cv::Rect crop(config_.crop_left, config_.crop_top, w, h);
-  // 1. crop, grey
-  if (image.channels() == 3)
-    cv::cvtColor(image(crop), gray_, cv::COLOR_BGR2GRAY);
-  else
-    gray_ = image(crop);
-  // 2. resize 50 %
   const double s = config_.scale;
-  if (s < 1.0)
-    cv::resize(gray_, small_, cv::Size(), s, s, cv::INTER_AREA);
-  else
-    small_ = gray_;
-  // 3. binarise (target = 255)
-  const int type = config_.dark_target ? cv::THRESH_BINARY_INV : cv::THRESH_BINARY;
   double level = config_.threshold;
-  if (config_.threshold < 0)
-    level = cv::threshold(small_, binary_, 0, 255, type | cv::THRESH_OTSU);
-  else
-    cv::threshold(small_, binary_, level, 255, type);
+  if (config_.threshold >= 0 && s == 0.5 && w % 2 == 0 && h % 2 == 0) {
+    // 1.-3. crop, grey, resize 50 %, binarise (target = 255) in one pass (halfScaleBinary: the same
+    // image as the OpenCV calls below, bit for bit)
+    halfScaleBinary(image(crop), config_.threshold, config_.dark_target, binary_);
+  } else {
+    // 1. crop, grey
+    if (image.channels() == 3)
+      cv::cvtColor(image(crop), gray_, cv::COLOR_BGR2GRAY);
+    else
+      gray_ = image(crop);
+    // 2. resize 50 %
+    if (s < 1.0)
+      cv::resize(gray_, small_, cv::Size(), s, s, cv::INTER_AREA);
+    else
+      small_ = gray_;
+    // 3. binarise (target = 255)
+    const int type = config_.dark_target ? cv::THRESH_BINARY_INV : cv::THRESH_BINARY;
+    if (config_.threshold < 0)
+      level = cv::threshold(small_, binary_, 0, 255, type | cv::THRESH_OTSU);
+    else
+      cv::threshold(small_, binary_, level, 255, type);
+  }
   // 4.-5. median filter, then the centroid and bounding box of the binary image (medianBlobMoments:
   // cv::medianBlur + cv::moments + cv::boundingRect bit for bit, over the foreground's neighbourhood only).
   const BinaryBlobMoments m = medianBlobMoments(binary_, config_.median_ksize, scratch_);

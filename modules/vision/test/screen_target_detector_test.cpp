@@ -132,6 +132,48 @@ TEST(ScreenTargetDetector, BlobMomentsEqualOpenCvOnRandomBinaryImages) {
   EXPECT_GT(inexact, 0);  // so the test would catch a kernel that summed exactly
 }
 
+TEST(ScreenTargetDetector, HalfScaleBinaryEqualsOpenCvAtEveryLevel) {
+  // Uniform noise (every block computed exactly) and bright frames with dark specks and a disc (most
+  // blocks skipped), grey and BGR, as a cropped view (rows not contiguous) and whole, at every level:
+  // equal binaries at all 256 levels mean equal half-resolution grey images.
+  core::Rng rng = core::makeRng(6);
+  cv::Mat expected, ours, g, small;
+  int levels = 0;
+  for (const int channels : {1, 3}) {
+    for (const bool bright : {false, true}) {
+      cv::Mat frame(102, 140, CV_8UC(channels));
+      cv::randu(frame, bright ? 150 : 0, 256);
+      if (bright) {
+        for (int k = 0; k < 40; ++k)
+          frame.at<std::uint8_t>(static_cast<int>(core::uniform(rng, 0.0, 102.0)),
+                                 static_cast<int>(core::uniform(rng, 0.0, 140.0 * channels))) =
+              static_cast<std::uint8_t>(core::uniform(rng, 0.0, 256.0));
+        cv::circle(frame, cv::Point(60, 50), 17, cv::Scalar::all(40), cv::FILLED);
+      }
+      for (const cv::Rect roi : {cv::Rect(0, 0, 140, 102), cv::Rect(6, 4, 50, 38)}) {
+        const cv::Mat view = frame(roi);
+        if (channels == 3)
+          cv::cvtColor(view, g, cv::COLOR_BGR2GRAY);
+        else
+          g = view;
+        cv::resize(g, small, cv::Size(), 0.5, 0.5, cv::INTER_AREA);
+        for (int level = 0; level <= 255; ++level) {
+          for (const bool dark : {true, false}) {
+            cv::threshold(small, expected, level, 255, dark ? cv::THRESH_BINARY_INV : cv::THRESH_BINARY);
+            halfScaleBinary(view, level, dark, ours);
+            ASSERT_EQ(ours.size(), expected.size());
+            ASSERT_EQ(cv::countNonZero(ours != expected), 0)
+                << channels << " channels, bright " << bright << ", roi " << roi << ", level " << level << ", dark " << dark;
+          }
+          ++levels;
+        }
+      }
+    }
+  }
+  EXPECT_EQ(levels, 2 * 2 * 2 * 256);
+  EXPECT_THROW(halfScaleBinary(cv::Mat(11, 10, CV_8UC1), 100, true, ours), core::InvalidInput);
+}
+
 TEST(ScreenTargetDetector, DetectionEqualsOpenCvPipelineOnRenderedFrames) {
   // The whole detector against [T]'s pipeline written with OpenCV calls (crop, grey, INTER_AREA 50 %,
   // threshold, cv::medianBlur, cv::moments, cv::boundingRect) on noisy BGR discs, fixed and Otsu levels.

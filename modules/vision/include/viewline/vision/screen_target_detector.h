@@ -61,6 +61,11 @@ struct BinaryBlobMoments {
 /// cv::boundingRect (OpenCV 4.6), but only over the foreground's neighbourhood. `scratch` is reused.
 BinaryBlobMoments medianBlobMoments(const cv::Mat& binary, int ksize, std::vector<std::int32_t>& scratch);
 
+/// Grey, 50 % INTER_AREA resize and a fixed threshold `level` in one pass over an 8-bit grey or BGR image of even
+/// size: equal bit for bit to cv::cvtColor(BGR2GRAY) + cv::resize(0.5, INTER_AREA) + cv::threshold(level, 255,
+/// dark_target ? THRESH_BINARY_INV : THRESH_BINARY) (OpenCV 4.6). `binary` gets the (cols/2 x rows/2) result.
+void halfScaleBinary(const cv::Mat& image, int level, bool dark_target, cv::Mat& binary);
+
 /// [T]'s screen target detector: crop, half-resolution, binarise, median filter, centroid.
 class ScreenTargetDetector {
 public:
