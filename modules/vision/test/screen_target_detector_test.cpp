@@ -185,7 +185,7 @@ TEST(ScreenTargetDetector, DetectionEqualsOpenCvPipelineOnRenderedFrames) {
     cfg.threshold = threshold;
     cfg.min_area_px = 200;
     ScreenTargetDetector det(cfg);
-    for (int i = 0; i < 12; ++i) {
+    for (int i = 0; i < 8; ++i) {
       const double u = core::uniform(rng, 20.0, 620.0), v = core::uniform(rng, 20.0, 460.0);
       cv::Mat gray = test::screenWithDisc(640, 480, u, v, core::uniform(rng, 6.0, 40.0));
       cv::Mat bgr;
@@ -215,7 +215,7 @@ TEST(ScreenTargetDetector, DetectionEqualsOpenCvPipelineOnRenderedFrames) {
       ++detected;
     }
   }
-  EXPECT_GE(detected, 16);  // most discs lie inside the crop
+  EXPECT_GE(detected, 10);  // most discs lie inside the crop
 }
 
 TEST(ScreenTargetDetector, RejectsBadConfigAndImages) {

@@ -16,6 +16,37 @@
 namespace viewline::tracking {
 
 namespace {
+bool sameMatrix(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
+  return a.rows() == b.rows() && a.cols() == b.cols() && a == b;
+}
+}  // namespace
+
+const estimation::LinearTransition& discretized(const estimation::ContinuousLinearModel& model, double dt) {
+  // The measurement intervals repeat (a camera's frame period) and so does the law's look-ahead: the last
+  // few results are kept per thread, keyed by the model's matrices and the exact dt. discretize() is a
+  // function of those alone (no input here), so a hit is the same transition to the last bit, without
+  // its matrix exponential.
+  struct Entry {
+    Eigen::MatrixXd A, B, G, Qc;
+    estimation::LinearTransition tr;
+  };
+  thread_local std::array<Entry, 8> cache;
+  thread_local std::size_t next = 0;
+  for (const Entry& e : cache)
+    if (e.tr.dt == dt && e.tr.Phi.size() > 0 && sameMatrix(e.A, model.A) && sameMatrix(e.B, model.B) &&
+        sameMatrix(e.G, model.G) && sameMatrix(e.Qc, model.Qc))
+      return e.tr;
+  Entry& e = cache[next];
+  next = (next + 1) % cache.size();
+  e.tr = estimation::discretize(model, dt);
+  e.A = model.A;
+  e.B = model.B;
+  e.G = model.G;
+  e.Qc = model.Qc;
+  return e.tr;
+}
+
+namespace {
 // CV on (p, v) with the turn rate carried along as a random walk (state (p, v, ω)).
 estimation::NonlinearTransition cvWithOmega(double q, double q_omega, double dt) {
   Eigen::MatrixXd Phi = Eigen::MatrixXd::Identity(5, 5);
@@ -313,7 +344,7 @@ PlanarTargetFilter::Update PlanarTargetFilter::step(core::Timestamp t, const Eig
     out.accepted = true;
     return out;
   }
-  if (dt > 1e-9) estimation::predict(state_, estimation::discretize(model_, dt));
+  if (dt > 1e-9) estimation::predict(state_, discretized(model_, dt));
   // The gate decides before the update, so the NIS is that of the predicted state, S = R + C P Cᵀ
   // factored by LDLT. estimation::update's UpdateReport has the same NIS but from its square-root array
   // (a triangular solve with S^½), equal only to the last bits: taking it would mean updating a copy
@@ -353,7 +384,7 @@ PlanarTargetFilter::Kinematics PlanarTargetFilter::at(core::Timestamp t) const {
     return k;
   }
   if (dt > 1e-9) {
-    const estimation::LinearTransition tr = estimation::discretize(model_, dt);
+    const estimation::LinearTransition& tr = discretized(model_, dt);
     x = tr.Phi * x;
     P = tr.Phi * P * tr.Phi.transpose() + tr.Q;
   }
