@@ -22,7 +22,8 @@
 // the cost per camera and the residual.
 //
 //   nice -n 10 build/bench/latency_frames [--frames 10000] [--scaling-seconds 2] [--throws 2]
-//       [--record-seconds 6] [--config config/ball_catching.yaml] [--check]
+//       [--record-seconds 6] [--config config/ball_catching.yaml] [--check] [--pan-tilt-only]
+// --pan-tilt-only: the pan-tilt rows alone (for profiling that pipeline; no budget check).
 
 #include <Eigen/Geometry>
 #include <opencv2/core/utility.hpp>
@@ -336,6 +337,21 @@ void printStats(const char* what, const latency::Stats& s) {
   std::printf("| %s | %zu | %.1f | %.1f | %.1f |\n", what, s.n, 1e6 * s.median, 1e6 * s.p99, 1e6 * s.mean);
 }
 
+// The pan-tilt rows of the report.
+PanTiltFigures panTiltRows(double record_seconds, std::size_t frames) {
+  std::size_t recorded = 0;
+  const PanTiltFigures f =
+      panTilt(std::string(VIEWLINE_SOURCE_DIR) + "/config/pan_tilt_rectangle.yaml", record_seconds, frames, recorded);
+  std::printf("\n## Pan-tilt, 640x480, detection + back-projection + target filter + control law (%zu recorded frames replayed)\n\n",
+              recorded);
+  std::printf("| sample | frames | median (us) | p99 (us) | mean (us) |\n|---|---|---|---|---|\n");
+  printStats("every frame", f.total);
+  printStats("  of which detection + back-projection", f.detect);
+  printStats("  of which target filter (observe)", f.filter);
+  printStats("  of which control law (command)", f.law);
+  return f;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -343,7 +359,7 @@ int main(int argc, char** argv) {
   std::size_t frames = 10000;
   double scaling_seconds = 2.0, record_seconds = 6.0;
   int throws = 2;
-  bool check = false;
+  bool check = false, pan_tilt_only = false;
   std::string config = std::string(VIEWLINE_SOURCE_DIR) + "/config/ball_catching.yaml";
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -353,10 +369,11 @@ int main(int argc, char** argv) {
     else if (i + 1 < argc && a == "--throws") throws = std::atoi(argv[++i]);
     else if (i + 1 < argc && a == "--record-seconds") record_seconds = std::atof(argv[++i]);
     else if (a == "--check") check = true;
+    else if (a == "--pan-tilt-only") pan_tilt_only = true;
     else {
       std::fprintf(stderr,
                    "usage: %s [--frames N>=1] [--scaling-seconds S>0] [--throws N>=1] [--record-seconds S>=1] "
-                   "[--config FILE] [--check]\n",
+                   "[--config FILE] [--check] [--pan-tilt-only]\n",
                    argv[0]);
       return 2;
     }
@@ -367,6 +384,10 @@ int main(int argc, char** argv) {
   }
   try {
     std::printf("# Per-frame processing (thread CPU time, one core); load %s\n\n", latency::loadAverage().c_str());
+    if (pan_tilt_only) {
+      panTiltRows(record_seconds, frames);
+      return 0;
+    }
     const CatchFigures bc = ballCatching(config, throws, frames);
     std::printf("## Ball catching, 656x480, detect + track + plan (%zu recorded frames replayed)\n\n", bc.recorded);
     std::printf("| sample | frames | median (us) | p99 (us) | mean (us) |\n|---|---|---|---|---|\n");
@@ -388,16 +409,7 @@ int main(int argc, char** argv) {
     printStats("  fast path (sides and ball tracked locally)", tb_frames.tracked);
     printStats("  full detection ([M]'s pipeline)", tb_frames.detected);
 
-    std::size_t pan_recorded = 0;
-    const PanTiltFigures pt_frames =
-        panTilt(std::string(VIEWLINE_SOURCE_DIR) + "/config/pan_tilt_rectangle.yaml", record_seconds, frames, pan_recorded);
-    std::printf("\n## Pan-tilt, 640x480, detection + back-projection + target filter + control law (%zu recorded frames replayed)\n\n",
-                pan_recorded);
-    std::printf("| sample | frames | median (us) | p99 (us) | mean (us) |\n|---|---|---|---|---|\n");
-    printStats("every frame", pt_frames.total);
-    printStats("  of which detection + back-projection", pt_frames.detect);
-    printStats("  of which target filter (observe)", pt_frames.filter);
-    printStats("  of which control law (command)", pt_frames.law);
+    const PanTiltFigures pt_frames = panTiltRows(record_seconds, frames);
 
     std::printf("\n## Scaling: K cameras at 100 Hz into one tracker (%.1f s of data each)\n\n", scaling_seconds);
     std::printf("| cameras | images | fused | share of one core (%%) |\n|---|---|---|---|\n");

@@ -9,6 +9,7 @@
 #include "viewline/core/error.h"
 #include "viewline/core/frames.h"
 #include "viewline/core/random.h"
+#include "viewline/tracking/planar_target/corner_detector.h"
 #include "viewline/tracking/planar_target/filter.h"
 #include "viewline/tracking/planar_target/waypoint_particles.h"
 
@@ -478,4 +479,165 @@ TEST(PlanarTargetFilter, MixtureGatesEveryPartOnTheMixturesPrediction) {
     EXPECT_LT((f.at((k - 1) / 30.0).p - (circle((k - 1) / 30.0) + offset)).norm(), 0.15);
     EXPECT_EQ(f.gateCounts().restarts, 1u);
   }
+}
+
+namespace {
+// scanForJump as first written (Eigen's 4x4 outer products per measurement): the reference the
+// streamlined scan must equal to the last bit.
+tracking::JumpScan scanForJumpAsWritten(const tracking::PlanarHistory& history, const tracking::JumpScanSettings& settings,
+                     const std::function<double(int)>& leg_bayes_factor, const std::vector<double>& region_odds) {
+  tracking::JumpScan out;
+  const int n = static_cast<int>(history.size());
+  const int m = settings.min_samples;
+  const bool soft = settings.soft;
+  if (n < (soft ? m + 3 : 2 * m + 1)) return out;
+  double best = settings.threshold;
+  int best_j = -1;
+  std::vector<double> tau(static_cast<std::size_t>(n));
+  std::vector<Eigen::Vector2d> r(static_cast<std::size_t>(n));
+  std::vector<std::pair<double, int>>& log_odds = out.log_odds;  // soft: log(π_j BF_j), j
+  const double prior_precision = soft ? 1.0 / (settings.prior_sigma * settings.prior_sigma) : 0.0;
+  const bool leg_bf = soft && static_cast<bool>(leg_bayes_factor);  // the soft mixture's Bayes factors from legs, not kinks
+  for (int j = m; j + (soft ? 2 : m) < n; ++j) {
+    const tracking::PlanarSnapshot& sj = history[static_cast<std::size_t>(j)];
+    for (int i = 0; i < n; ++i) {
+      const tracking::PlanarSnapshot& si = history[static_cast<std::size_t>(i)];
+      tau[static_cast<std::size_t>(i)] = si.t - sj.t;
+      r[static_cast<std::size_t>(i)] = si.z - tracking::extrapolatePosition(sj.state.x(), si.t - sj.t);
+    }
+    const Eigen::VectorXd& xj = sj.state.x();
+    double sigma_gamma = 0.0;
+    if (xj.size() == 5) sigma_gamma = 0.5 * xj.segment<2>(2).norm() * std::sqrt(std::max(sj.state.P()(4, 4), 0.0));
+    const bool curved = sigma_gamma > 0.0;  // (CV/CA: no γ column)
+    const double gamma_weight = curved ? 1.0 / (sigma_gamma * sigma_gamma) : 1.0;
+    double l = 0.0, log_bf = 0.0;
+    for (int a = 0; a < 2; ++a) {
+      Eigen::Matrix4d M = Eigen::Matrix4d::Zero();
+      Eigen::Vector4d g = Eigen::Vector4d::Zero();
+      for (int i = 0; i < n; ++i) {
+        const double w = 1.0 / history[static_cast<std::size_t>(i)].R(a, a);
+        const double ti = tau[static_cast<std::size_t>(i)];
+        const Eigen::Vector4d xi(1.0, ti, curved ? ti * ti : 0.0, std::max(ti, 0.0));
+        M += w * xi * xi.transpose();
+        g += w * r[static_cast<std::size_t>(i)](a) * xi;
+      }
+      M(2, 2) += gamma_weight;
+      const Eigen::Vector3d g0 = g.head<3>();
+      const auto ldlt0 = M.topLeftCorner<3, 3>().ldlt();
+      const double fit0 = g0.dot(ldlt0.solve(g0));
+      const double fit1 = g.dot(M.ldlt().solve(g));
+      l += fit1 - fit0;
+      if (soft && !leg_bf) {
+        Eigen::Matrix4d M1 = M;
+        M1(3, 3) += prior_precision;
+        const auto ldlt1 = M1.ldlt();
+        const double fit1p = g.dot(ldlt1.solve(g));
+        const double logdet1 = ldlt1.vectorD().array().log().sum(), logdet0 = ldlt0.vectorD().array().log().sum();
+        log_bf += 0.5 * (fit1p - fit0) - 0.5 * (logdet1 - logdet0) + 0.5 * std::log(prior_precision);
+      }
+    }
+    if (j + m < n && l > best) {
+      best = l;
+      best_j = j;
+    }
+    if (soft) {
+      if (leg_bf) log_bf = leg_bayes_factor(j);
+      const double dt_j = sj.t - history[static_cast<std::size_t>(j - 1)].t;
+      const double log_prior = region_odds.empty() ? std::log(std::max(settings.jump_rate * dt_j, 1e-300))
+                                                   : region_odds[static_cast<std::size_t>(j)];
+      log_odds.emplace_back(log_prior + log_bf, j);
+    }
+  }
+  if (settings.posterior_decision && soft) {
+    double top = 0.0;
+    for (const auto& entry : log_odds) top = std::max(top, entry.first);
+    double total = std::exp(-top);
+    for (const auto& entry : log_odds) total += std::exp(entry.first - top);
+    double mass = 0.0, best_p = 0.0;
+    int arg = -1;
+    for (const auto& [lo, j] : log_odds) {
+      if (j + m >= n) continue;
+      const double p = std::exp(lo - top) / total;
+      mass += p;
+      if (p > best_p) {
+        best_p = p;
+        arg = j;
+      }
+    }
+    best_j = mass > settings.posterior_mass ? arg : -1;
+  }
+  out.jump = best_j;
+  return out;
+}
+
+
+tracking::PlanarHistory randomHistory(core::Rng& rng, int n, int dim) {
+  tracking::PlanarHistory h;
+  double t = core::uniform(rng, 0.0, 10.0);
+  const double kink = core::uniform(rng, 0.2, 0.8) * n;
+  for (int i = 0; i < n; ++i) {
+    t += core::uniform(rng, 0.025, 0.04);
+    tracking::PlanarSnapshot s;
+    s.t = t;
+    const double turn = i > kink ? 0.15 * (i - kink) / 30.0 : 0.0;
+    s.z = Eigen::Vector2d(0.1 * i / 30.0 + 0.01 * core::gaussian(rng), turn + 0.01 * core::gaussian(rng));
+    s.R = Eigen::Vector2d(core::uniform(rng, 0.5e-4, 2e-4), core::uniform(rng, 0.5e-4, 2e-4)).asDiagonal();
+    Eigen::VectorXd x = Eigen::VectorXd::Zero(dim);
+    x.head<2>() = s.z + 0.005 * Eigen::Vector2d(core::gaussian(rng), core::gaussian(rng));
+    x(2) = 0.1 + 0.02 * core::gaussian(rng);
+    x(3) = 0.02 * core::gaussian(rng);
+    if (dim == 5) x(4) = 0.3 * core::gaussian(rng);
+    if (dim == 6) x.tail<2>() = 0.05 * Eigen::Vector2d(core::gaussian(rng), core::gaussian(rng));
+    Eigen::MatrixXd A(dim, dim);
+    for (Eigen::Index k = 0; k < A.size(); ++k) A.data()[k] = 0.01 * core::gaussian(rng);
+    s.state = estimation::StateEstimate(x, A * A.transpose() + 1e-4 * Eigen::MatrixXd::Identity(dim, dim), t);
+    h.push_back(s);
+  }
+  return h;
+}
+}  // namespace
+
+TEST(PlanarTargetFilter, JumpScanEqualsTheScanAsFirstWritten) {
+  // Constant-velocity, coordinated-turn (the curved fit) and constant-acceleration states; hard test and
+  // soft mixture (kink or given Bayes factors, region odds or not, test or posterior decision): the
+  // same jump and the same log odds to the last bit.
+  core::Rng rng = core::makeRng(17);
+  int scans = 0, jumps = 0;
+  std::size_t odds = 0;
+  for (const int dim : {4, 5, 6}) {
+    for (const int n : {12, 45, 90}) {
+      const tracking::PlanarHistory h = randomHistory(rng, n, dim);
+      std::vector<double> region(static_cast<std::size_t>(n));
+      for (double& v : region) v = core::uniform(rng, -6.0, -1.0);
+      for (const bool soft : {false, true}) {
+        for (const int variant : {0, 1, 2}) {
+          tracking::JumpScanSettings st;
+          st.min_samples = 3 + variant * 2;
+          st.threshold = 15.0;
+          st.soft = soft;
+          st.jump_rate = 1.0;
+          st.prior_sigma = 0.2;
+          st.posterior_decision = variant == 2;
+          st.posterior_mass = 0.99;
+          std::function<double(int)> leg;
+          if (variant == 1) leg = [](int j) { return 0.1 * j - 2.0; };
+          const std::vector<double> odds_j = variant == 2 ? region : std::vector<double>{};
+          const tracking::JumpScan ours = tracking::scanForJump(h, st, leg, odds_j);
+          const tracking::JumpScan ref = scanForJumpAsWritten(h, st, leg, odds_j);
+          EXPECT_EQ(ours.jump, ref.jump) << dim << " " << n << " " << soft << " " << variant;
+          ASSERT_EQ(ours.log_odds.size(), ref.log_odds.size());
+          for (std::size_t k = 0; k < ref.log_odds.size(); ++k) {
+            EXPECT_EQ(ours.log_odds[k].first, ref.log_odds[k].first) << dim << " " << n << " " << variant << " " << k;
+            EXPECT_EQ(ours.log_odds[k].second, ref.log_odds[k].second);
+          }
+          ++scans;
+          jumps += ref.jump >= 0;
+          odds += ref.log_odds.size();
+        }
+      }
+    }
+  }
+  EXPECT_EQ(scans, 3 * 3 * 2 * 3);
+  EXPECT_GT(jumps, 5);    // the kinks are found: the jump index is compared, not only -1
+  EXPECT_GT(odds, 500u);  // and many soft-mixture odds
 }

@@ -38,18 +38,29 @@ JumpScan scanForJump(const PlanarHistory& history, const JumpScanSettings& setti
   int best_j = -1;
   std::vector<double> tau(static_cast<std::size_t>(n));
   std::vector<Eigen::Vector2d> r(static_cast<std::size_t>(n));
+  // w_i = 1 / R_i,aa per axis, the same for every candidate j (computed once).
+  std::vector<Eigen::Vector2d> w(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) {
+    const Eigen::Matrix2d& R = history[static_cast<std::size_t>(i)].R;
+    w[static_cast<std::size_t>(i)] = Eigen::Vector2d(1.0 / R(0, 0), 1.0 / R(1, 1));
+  }
   std::vector<std::pair<double, int>>& log_odds = out.log_odds;  // soft: log(π_j BF_j), j
   const double prior_precision = soft ? 1.0 / (settings.prior_sigma * settings.prior_sigma) : 0.0;
   const bool leg_bf = soft && static_cast<bool>(leg_bayes_factor);  // the soft mixture's Bayes factors from legs, not kinks
   for (int j = m; j + (soft ? 2 : m) < n; ++j) {
     const PlanarSnapshot& sj = history[static_cast<std::size_t>(j)];
+    const Eigen::VectorXd& xj = sj.state.x();
     for (int i = 0; i < n; ++i) {
       const PlanarSnapshot& si = history[static_cast<std::size_t>(i)];
-      tau[static_cast<std::size_t>(i)] = si.t - sj.t;
-      r[static_cast<std::size_t>(i)] = si.z - extrapolatePosition(sj.state.x(), si.t - sj.t);
+      const double ti = si.t - sj.t;
+      tau[static_cast<std::size_t>(i)] = ti;
+      if (xj.size() == 4) {  // extrapolatePosition's constant velocity, inline: p + τ v
+        r[static_cast<std::size_t>(i)] = si.z - Eigen::Vector2d(xj(0) + ti * xj(2), xj(1) + ti * xj(3));
+      } else {
+        r[static_cast<std::size_t>(i)] = si.z - extrapolatePosition(xj, ti);
+      }
     }
     // Prior std of γ: the turn-rate uncertainty of x(j|j) bends the extrapolation by ½ |v| δω τ².
-    const Eigen::VectorXd& xj = sj.state.x();
     double sigma_gamma = 0.0;
     if (xj.size() == 5) sigma_gamma = 0.5 * xj.segment<2>(2).norm() * std::sqrt(std::max(sj.state.P()(4, 4), 0.0));
     const bool curved = sigma_gamma > 0.0;  // (CV/CA: no γ column)
@@ -58,15 +69,53 @@ JumpScan scanForJump(const PlanarHistory& history, const JumpScanSettings& setti
     for (int a = 0; a < 2; ++a) {
       // Penalised least squares (γ with its prior, α, β and Δv free) under H0 and H1:
       // min ‖r − X θ‖²_W + θᵀ Λ θ = rᵀ W r − (Xᵀ W r)ᵀ (Xᵀ W X + Λ)⁻¹ Xᵀ W r.
-      Eigen::Matrix4d M = Eigen::Matrix4d::Zero();
-      Eigen::Vector4d g = Eigen::Vector4d::Zero();
+      // M = Σ w_i x_i x_iᵀ, g = Σ w_i r_i x_i with x_i = (1, τ, c, p), c = τ² (curved) or 0, p = max(τ, 0).
+      // Each entry is summed over i in order with the rounding of Eigen's `M += w * x * xᵀ` (entry (k, l) adds
+      // x_l (w x_k)) and `g += w r x` ((w r) x_k), so M and g are the same to the last bit; the terms that
+      // are ±0 (c = 0 when not curved, p = 0 for τ <= 0) are skipped: a sum that starts at +0 is not changed
+      // by them. Only the distinct products are formed (x_0 = 1: (0, l) and (l, 0) are both w x_l).
+      double s00 = 0.0, s01 = 0.0, s02 = 0.0, s03 = 0.0, s11 = 0.0, s12 = 0.0, s13 = 0.0, s21 = 0.0, s22 = 0.0,
+             s23 = 0.0, s31 = 0.0, s32 = 0.0, s33 = 0.0;
+      double h0 = 0.0, h1 = 0.0, h2 = 0.0, h3 = 0.0;
       for (int i = 0; i < n; ++i) {
-        const double w = 1.0 / history[static_cast<std::size_t>(i)].R(a, a);
+        const double wi = w[static_cast<std::size_t>(i)](a);
         const double ti = tau[static_cast<std::size_t>(i)];
-        const Eigen::Vector4d xi(1.0, ti, curved ? ti * ti : 0.0, std::max(ti, 0.0));
-        M += w * xi * xi.transpose();
-        g += w * r[static_cast<std::size_t>(i)](a) * xi;
+        const double wr = wi * r[static_cast<std::size_t>(i)](a);
+        const double wt = wi * ti;
+        s00 += wi;
+        s01 += wt;
+        s11 += ti * wt;
+        h0 += wr;
+        h1 += wr * ti;
+        double ci = 0.0, wc = 0.0;
+        if (curved) {
+          ci = ti * ti;
+          wc = wi * ci;
+          s02 += wc;
+          s12 += ci * wt;
+          s21 += ti * wc;
+          s22 += ci * wc;
+          h2 += wr * ci;
+        }
+        if (ti > 0.0) {
+          const double wp = wi * ti;  // p = τ
+          s03 += wp;
+          s13 += ti * wt;
+          s31 += ti * wp;
+          s33 += ti * wp;
+          h3 += wr * ti;
+          if (curved) {
+            s23 += ti * wc;
+            s32 += ci * wp;
+          }
+        }
       }
+      Eigen::Matrix4d M;
+      M << s00, s01, s02, s03,
+           s01, s11, s12, s13,
+           s02, s21, s22, s23,
+           s03, s31, s32, s33;
+      Eigen::Vector4d g(h0, h1, h2, h3);
       M(2, 2) += gamma_weight;
       const Eigen::Vector3d g0 = g.head<3>();
       const auto ldlt0 = M.topLeftCorner<3, 3>().ldlt();

@@ -4,6 +4,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/LU>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -13,6 +14,37 @@
 #include "viewline/estimation/models/coordinated_turn.h"
 
 namespace viewline::tracking {
+
+namespace {
+bool sameMatrix(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
+  return a.rows() == b.rows() && a.cols() == b.cols() && a == b;
+}
+}  // namespace
+
+const estimation::LinearTransition& discretized(const estimation::ContinuousLinearModel& model, double dt) {
+  // The measurement intervals repeat (a camera's frame period) and so does the law's look-ahead: the last
+  // few results are kept per thread, keyed by the model's matrices and the exact dt. discretize() is a
+  // function of those alone (no input here), so a hit is the same transition to the last bit, without
+  // its matrix exponential.
+  struct Entry {
+    Eigen::MatrixXd A, B, G, Qc;
+    estimation::LinearTransition tr;
+  };
+  thread_local std::array<Entry, 8> cache;
+  thread_local std::size_t next = 0;
+  for (const Entry& e : cache)
+    if (e.tr.dt == dt && e.tr.Phi.size() > 0 && sameMatrix(e.A, model.A) && sameMatrix(e.B, model.B) &&
+        sameMatrix(e.G, model.G) && sameMatrix(e.Qc, model.Qc))
+      return e.tr;
+  Entry& e = cache[next];
+  next = (next + 1) % cache.size();
+  e.tr = estimation::discretize(model, dt);
+  e.A = model.A;
+  e.B = model.B;
+  e.G = model.G;
+  e.Qc = model.Qc;
+  return e.tr;
+}
 
 namespace {
 // CV on (p, v) with the turn rate carried along as a random walk (state (p, v, ω)).
@@ -312,7 +344,7 @@ PlanarTargetFilter::Update PlanarTargetFilter::step(core::Timestamp t, const Eig
     out.accepted = true;
     return out;
   }
-  if (dt > 1e-9) estimation::predict(state_, estimation::discretize(model_, dt));
+  if (dt > 1e-9) estimation::predict(state_, discretized(model_, dt));
   // The gate decides before the update, so the NIS is that of the predicted state, S = R + C P Cᵀ
   // factored by LDLT. estimation::update's UpdateReport has the same NIS but from its square-root array
   // (a triangular solve with S^½), equal only to the last bits: taking it would mean updating a copy
@@ -352,7 +384,7 @@ PlanarTargetFilter::Kinematics PlanarTargetFilter::at(core::Timestamp t) const {
     return k;
   }
   if (dt > 1e-9) {
-    const estimation::LinearTransition tr = estimation::discretize(model_, dt);
+    const estimation::LinearTransition& tr = discretized(model_, dt);
     x = tr.Phi * x;
     P = tr.Phi * P * tr.Phi.transpose() + tr.Q;
   }
@@ -365,9 +397,13 @@ PlanarTargetFilter::Kinematics PlanarTargetFilter::at(core::Timestamp t) const {
 }
 
 PlanarTargetFilter::Kinematics PlanarTargetFilter::mixtureAt(core::Timestamp t) const {
+  std::array<Kinematics, 2> ks;
+  for (std::size_t i = 0; i < ks.size(); ++i) ks[i] = parts_[i].at(t);
+  return mixtureOf(ks);
+}
+
+PlanarTargetFilter::Kinematics PlanarTargetFilter::mixtureOf(const std::array<Kinematics, 2>& ks) const {
   Kinematics k;
-  std::vector<Kinematics> ks;
-  for (const PlanarTargetFilter& f : parts_) ks.push_back(f.at(t));
   for (std::size_t i = 0; i < ks.size(); ++i) {
     const double w = part_probability_(static_cast<int>(i));
     k.p += w * ks[i].p;
@@ -418,8 +454,8 @@ PlanarTargetFilter::Update PlanarTargetFilter::updateMixture(core::Timestamp t, 
                         part_probability_(1) * (1.0 - e) + part_probability_(0) * e);
   // The predictive likelihood of each part, N(z; p̂ᵢ(t), Pᵢ + R).
   Eigen::Vector2d log_like;
-  std::vector<Kinematics> ks;
-  for (const PlanarTargetFilter& f : parts_) ks.push_back(f.at(t));
+  std::array<Kinematics, 2> ks;
+  for (std::size_t i = 0; i < ks.size(); ++i) ks[i] = parts_[i].at(t);
   for (int i = 0; i < 2; ++i) {
     const Eigen::Matrix2d S = ks[static_cast<std::size_t>(i)].P_pos + R;
     const Eigen::Vector2d d = z - ks[static_cast<std::size_t>(i)].p;
@@ -430,7 +466,7 @@ PlanarTargetFilter::Update PlanarTargetFilter::updateMixture(core::Timestamp t, 
   // part takes that decision. Gating each part on its own prediction would let the wider part (ct)
   // fuse an outlier the leading part rejects, and the mixture's estimate would move by that part's
   // share although the mixture reports the measurement as rejected (a 1 m outlier moved it 0.28 m).
-  const Kinematics mix = mixtureAt(t);
+  const Kinematics mix = mixtureOf(ks);  // = mixtureAt(t): the parts' predictions above, not computed twice
   const Eigen::Vector2d innovation = z - mix.p;
   const double nis = innovation.dot((mix.P_pos + R).ldlt().solve(innovation));
   const GateDecision decision = gate_.decide(t, nis);
@@ -439,8 +475,8 @@ PlanarTargetFilter::Update PlanarTargetFilter::updateMixture(core::Timestamp t, 
   // measurements of the new leg are the ones the gate rejects, and they are the evidence of the corner);
   // a detected corner then re-processes them under the cv part's own gate. A restart re-initialises
   // every part at the measurement.
-  std::vector<Update> ups;
-  for (PlanarTargetFilter& f : parts_) ups.push_back(f.updateUnder(t, z, R, decision));
+  std::array<Update, 2> ups;
+  for (std::size_t i = 0; i < ups.size(); ++i) ups[i] = parts_[i].updateUnder(t, z, R, decision);
   // Only a fused measurement is evidence about the motion: a rejected one (an outlier) or a restart
   // leaves the probabilities at the chain's prediction (otherwise the wider part would win it).
   Eigen::Vector2d post = prior;

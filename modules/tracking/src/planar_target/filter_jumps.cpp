@@ -16,6 +16,9 @@
 
 namespace viewline::tracking {
 
+// filter.cpp: estimation::discretize, memoised.
+const estimation::LinearTransition& discretized(const estimation::ContinuousLinearModel& model, double dt);
+
 bool PlanarTargetFilter::detectJump() {
   // The test and the soft mixture's odds: corner_detector.h. On a jump at t_j the filter goes back to
   // x(j|j), its velocity (and turn rate or acceleration) prior is re-opened as at initialisation, the
@@ -154,7 +157,7 @@ estimation::StateEstimate PlanarTargetFilter::alternative(int j) const {
   m.C.block(0, 0, 2, 2) = Eigen::Matrix2d::Identity();
   for (std::size_t i = static_cast<std::size_t>(j) + 1; i < n; ++i) {
     const double dt = history_[i].t - s.t();
-    if (dt > 1e-9) estimation::predict(s, estimation::discretize(model_, dt));
+    if (dt > 1e-9) estimation::predict(s, discretized(model_, dt));
     m.y = history_[i].z;
     m.R = history_[i].R;
     estimation::update(s, m);

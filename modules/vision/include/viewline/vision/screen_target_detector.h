@@ -16,6 +16,9 @@
 
 #include <opencv2/core.hpp>
 
+#include <cstdint>
+#include <vector>
+
 #include "viewline/vision/detection.h"
 
 namespace viewline::vision {
@@ -45,6 +48,24 @@ struct ScreenTargetMeasurement : Measurement {
   int threshold_used = 0;  ///< binarisation level actually used (Otsu's when config.threshold < 0)
 };
 
+/// The centroid moments and bounding box of a median-filtered binary image, in full-image pixels.
+struct BinaryBlobMoments {
+  double m00 = 0.0,  ///< foreground pixel count, as cv::moments(filtered, true).m00
+         m10 = 0.0,  ///< Σ x over the foreground (px), as cv::moments(filtered, true).m10
+         m01 = 0.0;  ///< Σ y over the foreground (px), as cv::moments(filtered, true).m01
+  cv::Rect box;      ///< cv::boundingRect(filtered): the foreground's bounding box (empty: no foreground)
+};
+
+/// Median filter of aperture `ksize` (odd, 1 = none) of a binary CV_8UC1 image (values 0 or 255), then the
+/// moments and box of the result, equal bit for bit to cv::medianBlur + cv::moments(binary = true) +
+/// cv::boundingRect (OpenCV 4.6), but only over the foreground's neighbourhood. `scratch` is reused.
+BinaryBlobMoments medianBlobMoments(const cv::Mat& binary, int ksize, std::vector<std::int32_t>& scratch);
+
+/// Grey, 50 % INTER_AREA resize and a fixed threshold `level` in one pass over an 8-bit grey or BGR image of even
+/// size: equal bit for bit to cv::cvtColor(BGR2GRAY) + cv::resize(0.5, INTER_AREA) + cv::threshold(level, 255,
+/// dark_target ? THRESH_BINARY_INV : THRESH_BINARY) (OpenCV 4.6). `binary` gets the (cols/2 x rows/2) result.
+void halfScaleBinary(const cv::Mat& image, int level, bool dark_target, cv::Mat& binary);
+
 /// [T]'s screen target detector: crop, half-resolution, binarise, median filter, centroid.
 class ScreenTargetDetector {
 public:
@@ -59,7 +80,8 @@ public:
 
 private:
   ScreenTargetDetectorConfig config_;
-  cv::Mat gray_, small_, binary_, filtered_;
+  cv::Mat gray_, small_, binary_;
+  std::vector<std::int32_t> scratch_;  ///< medianBlobMoments' buffers (kept: no allocation per frame)
 };
 
 }  // namespace viewline::vision

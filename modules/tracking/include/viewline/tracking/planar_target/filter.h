@@ -43,6 +43,7 @@
 // probabilities. Corner diagnostics (jumps, speed, turns, region) are the cv part's.
 
 #include <Eigen/Core>
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -169,6 +170,8 @@ private:
   /// update() of model mixture: both parts updated, their probabilities from the predictive likelihoods.
   Update updateMixture(core::Timestamp t, const Eigen::Vector2d& z, const Eigen::Matrix2d& R);
   Kinematics mixtureAt(core::Timestamp t) const;  ///< the parts' at(t) as one Gaussian
+  /// The parts' predictions ks (cv legs, ct) as one Gaussian under the current part probabilities.
+  Kinematics mixtureOf(const std::array<Kinematics, 2>& ks) const;
   void setMixtureState(core::Timestamp t);  ///< state_ = the parts' (p, v) estimates as one Gaussian
 
   TargetFilterConfig config_;
