@@ -131,7 +131,7 @@ TimeStats ProcessingTimer::cpu() const { return statsOf(cpu_s_); }
 
 std::string liveStatus(const LiveFrameSource& source, const ProcessingTimer& timer) {
   char text[160];
-  std::snprintf(text, sizeof text, "live: %llu of %llu frames missed (deadline %.1f ms), last frame %.1f ms",
+  std::snprintf(text, sizeof text, "missed %llu of %llu frames (deadline %.1f ms), last %.1f ms",
                 static_cast<unsigned long long>(source.dropped() + timer.late()),
                 static_cast<unsigned long long>(source.delivered()), 1e3 * timer.deadline(), timer.lastWallMs());
   return text;

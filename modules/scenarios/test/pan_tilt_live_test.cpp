@@ -92,7 +92,7 @@ TEST(PanTiltLive, ASlowFrameOnPacedFootageCountsTheFramesMissed) {
   EXPECT_DOUBLE_EQ(live.deadline_s, 0.05);
   EXPECT_NEAR(live.wall.max_ms, 110.0, 1.0);  // the test clock's 110 ms (real work is not on it)
   EXPECT_EQ(r.ours.frames, 19u);               // frames the loop captured
-  EXPECT_EQ(slow.last_status, "live: 2 of 20 frames missed (deadline 50.0 ms), last frame 10.0 ms");
+  EXPECT_EQ(slow.last_status, "missed 2 of 20 frames (deadline 50.0 ms), last 10.0 ms");
   const nlohmann::json j = r.toJson(footageRun(pattern, true));
   EXPECT_EQ(j["ours"]["live"]["frames_missed"], 2);
   EXPECT_EQ(j["ours"]["live"]["frames_dropped"], 1);

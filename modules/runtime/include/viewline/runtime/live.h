@@ -164,8 +164,8 @@ struct LiveReport {
   std::uint64_t missed() const { return dropped + late; }
 };
 
-/// A display's status line while the run goes on: "live: N of M frames missed (deadline D ms),
-/// last frame T ms".
+/// A display's status line while the run goes on (short enough for a 384 px wide image): "missed N
+/// of M frames (deadline D ms), last T ms", T the last frame's processing (wall).
 std::string liveStatus(const LiveFrameSource& source, const ProcessingTimer& timer);
 /// The report of `source` and `timer` after a run; `deadline_origin` says where the deadline came from.
 LiveReport liveReport(const LiveFrameSource& source, const ProcessingTimer& timer, const std::string& deadline_origin);
