@@ -37,6 +37,15 @@ TimeStats statsOf(const std::vector<double>& seconds) {
   return s;
 }
 
+/// A duration in ms as the reports print it: one decimal from 1 ms up (33.3), three significant
+/// digits below (0.02), so that a sub-millisecond deadline does not print as 0.0.
+std::string msText(double seconds) {
+  char text[32];
+  const double ms = 1e3 * seconds;
+  std::snprintf(text, sizeof text, ms >= 1.0 ? "%.1f" : "%.3g", ms);
+  return text;
+}
+
 }  // namespace
 
 WallClock& steadyWallClock() {
@@ -131,9 +140,9 @@ TimeStats ProcessingTimer::cpu() const { return statsOf(cpu_s_); }
 
 std::string liveStatus(const LiveFrameSource& source, const ProcessingTimer& timer) {
   char text[160];
-  std::snprintf(text, sizeof text, "missed %llu of %llu frames (deadline %.1f ms), last %.1f ms",
+  std::snprintf(text, sizeof text, "missed %llu of %llu frames (deadline %s ms), last %.1f ms",
                 static_cast<unsigned long long>(source.dropped() + timer.late()),
-                static_cast<unsigned long long>(source.delivered()), 1e3 * timer.deadline(), timer.lastWallMs());
+                static_cast<unsigned long long>(source.delivered()), msText(timer.deadline()).c_str(), timer.lastWallMs());
   return text;
 }
 
@@ -172,9 +181,9 @@ nlohmann::json toJson(const LiveReport& r) {
 std::string summaryLine(const LiveReport& r) {
   char text[400];
   std::snprintf(text, sizeof text,
-                "live: %llu of %llu frames missed their %.1f ms deadline (%s): %llu dropped while busy, %llu processed late",
+                "live: %llu of %llu frames missed their %s ms deadline (%s): %llu dropped while busy, %llu processed late",
                 static_cast<unsigned long long>(r.missed()), static_cast<unsigned long long>(r.delivered),
-                1e3 * r.deadline_s, r.deadline_origin.c_str(), static_cast<unsigned long long>(r.dropped),
+                msText(r.deadline_s).c_str(), r.deadline_origin.c_str(), static_cast<unsigned long long>(r.dropped),
                 static_cast<unsigned long long>(r.late));
   std::string line = text;
   if (r.queued_late > 0) line += "; " + std::to_string(r.queued_late) + " handed out over a period after capture";
