@@ -4,6 +4,7 @@
 
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <opencv2/videoio.hpp>
 #include <utility>
@@ -68,7 +69,11 @@ std::optional<Frame> V4l2Source::grab() {
   const double period = 1.0 / rate_;
   if (last_stamp_) {
     const double gap = (stamp - *last_stamp_) / period;
-    if (gap > 1.5) dropped_ += static_cast<std::uint64_t>(std::lround(gap)) - 1;
+    if (gap > 1.5) {
+      const auto skipped = static_cast<std::uint64_t>(std::lround(gap)) - 1;
+      dropped_ += skipped;
+      gaps_ += skipped;
+    }
   }
   if (t_grab - stamp > period) ++late_;
   last_stamp_ = stamp;
@@ -79,6 +84,12 @@ std::optional<Frame> V4l2Source::grab() {
   f.capture_time = stamp;
   f.image = std::move(image);
   return f;
+}
+
+std::string V4l2Source::describe() const {
+  char rate[32];
+  std::snprintf(rate, sizeof rate, "%g", rate_);
+  return "v4l2 camera " + opt_.device + " at " + rate + " fps (" + stampMethod() + ")";
 }
 
 std::string V4l2Source::stampMethod() const {

@@ -67,8 +67,11 @@ void printSummary(const PanTiltScenarioConfig& cfg, const PanTiltComparison& res
                cfg.image_height, cfg.fx, cfg.fy, tracking::toString(cfg.control.filter.model), cfg.control.servo.gain,
                cfg.control.gain > 0.0 ? cfg.control.gain : cfg.control.servo.gain);
   if (o.stopped) std::fprintf(out, "  (ended early by the viewer: the figures cover the frames run)\n");
-  if (!cfg.rig_folder.empty())
+  if (!cfg.rig_folder.empty() && cfg.source.simulated())
     std::fprintf(out, "  rig %s: renders with truth.yaml, controls with rig.yaml + e_M_c.yaml\n", cfg.rig_folder.c_str());
+  else if (!cfg.rig_folder.empty())  // nothing is rendered: truth.yaml, if the rig has one, is not used
+    std::fprintf(out, "  rig %s: frames from source %s, controls with rig.yaml + e_M_c.yaml\n", cfg.rig_folder.c_str(),
+                 runtime::toString(cfg.source.kind));
   std::fprintf(out, "  [T] noise sigma (cm)        x %.3f  y %.3f\n", o.noise_sigma_cm.x(), o.noise_sigma_cm.y());
   if (!o.scored)
     std::fprintf(out, "  source %s has no truth: rmse, Table 1 and image error not scored\n",
@@ -114,6 +117,13 @@ void printSummary(const PanTiltScenarioConfig& cfg, const PanTiltComparison& res
   if (o.filter_region_dropped) printRegionWarning(out);
   std::fprintf(out, "  %.1f ms per frame (render + detect + control)\n", o.wall_ms_per_frame);
   if (!o.faults.empty()) std::fprintf(out, "  %s (ours)\n", runtime::summaryLine(o.faults).c_str());
+  const auto printLive = [&](const PanTiltRunMetrics& m) {
+    if (!m.live) return;
+    std::fprintf(out, "  %s (%s)\n", runtime::summaryLine(*m.live).c_str(), m.controller.c_str());
+    std::fprintf(out, "    %s\n", runtime::processingLine(*m.live).c_str());
+  };
+  printLive(o);
+  if (result.has_baseline) printLive(result.baseline);
 }
 
 }  // namespace

@@ -114,6 +114,17 @@ FootageStep FootageTracker::track(const runtime::Frame& frame) {
 }
 
 FootageReport trackFootage(runtime::FrameSource& source, const FootageTrackerConfig& config, bool vpdot2) {
+  FootageRunOptions options;
+  options.vpdot2 = vpdot2;
+  return trackFootage(source, config, options);
+}
+
+FootageReport trackFootage(runtime::FrameSource& source, const FootageTrackerConfig& config,
+                           const FootageRunOptions& options) {
+  const bool vpdot2 = options.vpdot2;
+  const auto* live = dynamic_cast<const runtime::LiveFrameSource*>(&source);
+  std::optional<runtime::ProcessingTimer> timer;
+  if (live) timer.emplace(options.deadline_s, options.clock);
   FootageTracker tracker(config);
   FootageReport r;
   vpDot2 dot;
@@ -122,7 +133,8 @@ FootageReport trackFootage(runtime::FrameSource& source, const FootageTrackerCon
   double sum_d2 = 0.0, max_d = 0.0, sum_pred2 = 0.0, sum_hold2 = 0.0;
   bool has_previous = false;
   Eigen::Vector2d previous = Eigen::Vector2d::Zero();
-  while (source.nextReadyTime()) {
+  bool go_on = true;
+  while (go_on && source.nextReadyTime()) {
     const auto frame = source.grab();
     ++r.frames;
     if (!frame) {
@@ -130,6 +142,15 @@ FootageReport trackFootage(runtime::FrameSource& source, const FootageTrackerCon
       has_previous = false;
       continue;
     }
+    if (timer) timer->resume(r.frames);
+    // The frame's processing ends after the viewer's drawing, however the loop below goes on.
+    struct Finish {
+      std::optional<runtime::ProcessingTimer>& timer;
+      std::uint64_t id;
+      ~Finish() {
+        if (timer) timer->finish(id);
+      }
+    } finish{timer, r.frames};
     if (vpdot2) {
       cv::Mat grey = frame->image;
       if (grey.channels() == 3) cv::cvtColor(frame->image, grey, cv::COLOR_BGR2GRAY);
@@ -141,6 +162,9 @@ FootageReport trackFootage(runtime::FrameSource& source, const FootageTrackerCon
     }
     const FootageStep step = tracker.track(*frame);
     r.steps.push_back(step);
+    if (options.on_frame) {
+      go_on = options.on_frame(*frame, step, timer ? runtime::liveStatus(*live, *timer) : std::string());
+    }
     if (!step.detected) {
       ++r.lost;
       has_previous = false;
@@ -168,6 +192,7 @@ FootageReport trackFootage(runtime::FrameSource& source, const FootageTrackerCon
     r.predicted_rms_px = std::sqrt(sum_pred2 / static_cast<double>(r.predicted));
     r.hold_rms_px = std::sqrt(sum_hold2 / static_cast<double>(r.predicted));
   }
+  if (live) r.live = runtime::liveReport(*live, *timer, options.deadline_origin);
   return r;
 }
 

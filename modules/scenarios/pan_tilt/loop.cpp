@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <memory>
 #include <optional>
 #include <utility>
@@ -10,6 +11,7 @@
 #include "viewline/core/error.h"
 #include "viewline/core/random.h"
 #include "viewline/runtime/delay_line.h"
+#include "viewline/runtime/live.h"
 #include "viewline/runtime/recording.h"
 #include "viewline/runtime/stale_frames.h"
 #include "viewline/scenarios/pan_tilt/faults.h"
@@ -75,6 +77,13 @@ pan_tilt::FrameTruth truthFromValues(const std::vector<double>& v) {
   t.px = Vector2d(v[2], v[3]);
   t.error_px = v[4];
   return t;
+}
+
+/// "30" or "29.97": a frame rate as a person writes it.
+std::string fpsText(double fps) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", fps);
+  return text;
 }
 
 pan_tilt::FrameTruth noTruth() {
@@ -148,9 +157,13 @@ PanTiltRunMetrics runPanTilt(const PanTiltScenarioConfig& cfg, std::uint64_t see
     recorded = r.get();
     external = std::move(r);
   } else if (!cfg.source.simulated()) {
-    external = runtime::makeFrameSource(cfg.source);
+    external = runtime::makeFrameSource(cfg.source, io.clock);
     recorded = dynamic_cast<const runtime::RecordingSource*>(external.get());
   }
+  // A live source runs at its own pace: what the loop misses of it is counted and timed (live.h).
+  const runtime::LiveFrameSource* live = dynamic_cast<const runtime::LiveFrameSource*>(external.get());
+  std::optional<runtime::ProcessingTimer> timer;
+  if (live) timer.emplace(period, io.clock);
   const bool has_truth = !external || (recorded != nullptr && recorded->truthColumns() == kTruthColumns);
   runtime::FrameSource* grabber = external ? external.get() : &renderer;
   std::unique_ptr<runtime::RecordingWriter> writer;
@@ -174,6 +187,7 @@ PanTiltRunMetrics runPanTilt(const PanTiltScenarioConfig& cfg, std::uint64_t see
 
   // The controller's half of a frame, when its observation is delivered.
   const auto deliver = [&](double t_cmd, Processed& p) {
+    if (timer) timer->resume(p.index);
     const control::TargetObservation& obs = p.obs;
     const double tc = p.frame.capture_time;
     const bool had_track = ours != nullptr && ours->filter().initialized();
@@ -257,8 +271,10 @@ PanTiltRunMetrics runPanTilt(const PanTiltScenarioConfig& cfg, std::uint64_t see
       r.command = out.qdot;
       r.mode = static_cast<int>(out.mode);
       r.mode_name = control::toString(out.mode);
+      if (timer) r.live_status = runtime::liveStatus(*live, *timer);
       io.frames->frame(r);
     }
+    if (timer) timer->finish(p.index);
     if (io.progress && (p.index % 30 == 0 || p.index + 1 == n_frames))
       io.progress(static_cast<double>(p.index + 1) / static_cast<double>(n_frames));
   };
@@ -279,6 +295,7 @@ PanTiltRunMetrics runPanTilt(const PanTiltScenarioConfig& cfg, std::uint64_t see
       frame.reset();
     }
     if (frame) {
+      if (timer) timer->resume(k);
       Processed p;
       p.index = k;
       const double tc = frame->capture_time;
@@ -340,8 +357,10 @@ PanTiltRunMetrics runPanTilt(const PanTiltScenarioConfig& cfg, std::uint64_t see
         to_controller.receive(t, [&](double t_available, Processed& q) { deliver(t_available, q); });
         if (io.frames != nullptr && io.frames->quitRequested()) sched.requestStop();
       });
+      if (timer) timer->pause(k);  // until its control event
     }
-    if (grabbed >= n_frames) return;  // the run's duration (the renderer ends there by itself)
+    // The run's duration (the renderer ends there by itself); a live source's dropped frames count.
+    if ((live ? live->delivered() : grabbed) >= n_frames) return;
     if (const auto next = source.nextReadyTime()) sched.at(*next, runtime::priority::Capture, capture);
   };
   if (const auto first = source.nextReadyTime()) sched.at(*first, runtime::priority::Capture, capture);
@@ -361,6 +380,7 @@ PanTiltRunMetrics runPanTilt(const PanTiltScenarioConfig& cfg, std::uint64_t see
   m.stopped = sched.stopRequested();
   m.scored = has_truth;
   if (!faults.empty()) m.faults = faults.report();
+  if (live) m.live = runtime::liveReport(*live, *timer, "one frame period at " + fpsText(cfg.fps) + " fps");
   return m;
 }
 

@@ -63,6 +63,7 @@ nlohmann::json PanTiltRunMetrics::toJson() const {
   if (!scored) j["truth"] = "not scored (the frame source has no truth)";  // only then: reference summaries unchanged
   if (consistency.nis.count() > 0) j["consistency"] = consistency.toJson();
   if (!faults.empty()) j["faults"] = runtime::toJson(faults);  // only with injected faults (the same reason)
+  if (live) j["live"] = runtime::toJson(*live);                  // only on a live source (the same reason)
   return j;
 }
 

@@ -21,3 +21,5 @@ list(APPEND scenarios_tests test/calibrated_rig_test.cpp)
 # Guard of the headline figures: the shipped filter replayed on each path's synthetic measurements.
 list(APPEND scenarios_tests test/pan_tilt_headline_test.cpp)
 list(APPEND scenarios_tests test/pan_tilt_faults_test.cpp)
+# Live mode: paced footage with a slow frame counts the frames missed; unpaced footage runs them all.
+list(APPEND scenarios_tests test/pan_tilt_live_test.cpp)

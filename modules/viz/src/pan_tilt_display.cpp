@@ -47,15 +47,25 @@ void PanTiltDisplay::frame(const scenarios::pan_tilt::FrameRecord& v) {
   const vpImage<vpRGBa>& I = impl_->image;
   vpDisplay::display(I);
   vpDisplay::displayCross(I, ip(v.principal_px), 21, vpColor::white, 1);
-  vpDisplay::displayLine(I, ip(v.principal_px), ip(v.truth_px), vpColor::yellow, 1);
-  vpDisplay::displayPoint(I, ip(v.truth_px), vpColor::blue, 4);
+  const bool truth = v.truth_px.allFinite();  // footage and cameras have none
+  if (truth) {
+    vpDisplay::displayLine(I, ip(v.principal_px), ip(v.truth_px), vpColor::yellow, 1);
+    vpDisplay::displayPoint(I, ip(v.truth_px), vpColor::blue, 4);
+  }
   if (v.detected) vpDisplay::displayCross(I, ip(v.measured_px), 13, vpColor::red, 2);
   if (v.has_prediction) vpDisplay::displayCircle(I, ip(v.predicted_px), 9, vpColor::green, false, 2);
   char text[160];
-  std::snprintf(text, sizeof text, "%s  t=%.2f s  %s  error %.1f px", v.controller.c_str(), v.t, v.mode_name.c_str(),
-                v.error_px);
+  if (truth)
+    std::snprintf(text, sizeof text, "%s  t=%.2f s  %s  error %.1f px", v.controller.c_str(), v.t, v.mode_name.c_str(),
+                  v.error_px);
+  else
+    std::snprintf(text, sizeof text, "%s  t=%.2f s  %s", v.controller.c_str(), v.t, v.mode_name.c_str());
   vpDisplay::displayText(I, 14, 8, text, vpColor::red);
-  vpDisplay::displayText(I, 30, 8, "red: measured  green: predicted  blue: true  yellow: error", vpColor::yellow);
+  vpDisplay::displayText(I, 30, 8,
+                         truth ? "red: measured  green: predicted  blue: true  yellow: error  white: image centre"
+                               : "red: measured  green: predicted  white: image centre",
+                         vpColor::yellow);
+  if (!v.live_status.empty()) vpDisplay::displayText(I, 46, 8, v.live_status, vpColor::orange);
   impl_->controls.drawLegend(I);
   vpDisplay::flush(I);
   impl_->controls.poll(I);

@@ -4,6 +4,7 @@
 //   source: {kind: sim}                                            # the default: the scenario renders its own
 //   source: {kind: images, pattern: seq/image.%04d.pgm, first: 1, rate_hz: 25}   # or stamps: seq/stamps.csv
 //   source: {kind: video, path: run.mp4}                           # stamps from the container, or stamps: FILE
+//   source: {kind: video, path: run.mp4, pace: true}               # played as a live camera (live.h)
 //   source: {kind: v4l2, device: /dev/video0, width: 640, height: 480, rate_hz: 30, exposure: 100}
 //   source: {kind: recording, path: rec/}                          # a folder written by --record
 //
@@ -20,6 +21,7 @@
 #include "viewline/io/config_reference.h"
 #include "viewline/runtime/file_sources.h"
 #include "viewline/runtime/frame_source.h"
+#include "viewline/runtime/live.h"
 #include "viewline/runtime/v4l2_source.h"
 
 namespace viewline::runtime {
@@ -43,6 +45,11 @@ struct SourceConfig {
   VideoOptions video;                 ///< kind video
   V4l2Options v4l2;                   ///< kind v4l2
   std::string recording;              ///< kind recording: the folder
+  /// Kinds images and video: play the footage on the wall clock as a live camera at its stamps'
+  /// rate (runtime::PacedSource: frames the loop is too busy to take are dropped and counted).
+  bool pace = false;
+  /// True when the source runs at its own pace, not the loop's: a V4L2 camera, or paced footage.
+  bool live() const { return kind == SourceKind::V4l2 || pace; }
   /// True for the simulator (the scenario renders and knows the truth).
   bool simulated() const { return kind == SourceKind::Sim; }
 };
@@ -52,8 +59,9 @@ struct SourceConfig {
 SourceConfig readSourceConfig(const io::ConfigNode& root);
 
 /// Opens the source of a non-sim config; throws core::InvalidInput naming the file or device
-/// (kind sim: the scenario builds its renderer itself, and this throws).
-std::unique_ptr<FrameSource> makeFrameSource(const SourceConfig& config);
+/// (kind sim: the scenario builds its renderer itself, and this throws). A live() config gives a
+/// LiveFrameSource (paced footage on `clock`, null: steadyWallClock()).
+std::unique_ptr<FrameSource> makeFrameSource(const SourceConfig& config, WallClock* clock = nullptr);
 
 /// The key table of the `source:` block (for a scenario's config_keys.cpp).
 std::vector<io::ConfigKeyDoc> sourceConfigKeys();

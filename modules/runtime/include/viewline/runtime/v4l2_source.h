@@ -14,6 +14,9 @@
 // A camera that skipped frames shows a stamp gap: a gap of g nominal periods counts round(g) − 1
 // dropped frames; a frame delivered more than one period after its stamp counts as late.
 //
+// As a LiveFrameSource it paces the loop itself (grab() blocks until the driver has a frame) and
+// its drops and late frames go into the loop's live report (live.h).
+//
 // Not tested on hardware (the build machine has no camera): tests cover the errors (a missing
 // device, a file that is not a device), each naming the device.
 
@@ -23,7 +26,7 @@
 #include <optional>
 #include <string>
 
-#include "viewline/runtime/frame_source.h"
+#include "viewline/runtime/live.h"
 
 namespace cv {
 class VideoCapture;
@@ -42,7 +45,7 @@ struct V4l2Options {
 };
 
 /// A live V4L2 camera (one camera), stamped by the driver where it can be.
-class V4l2Source : public FrameSource {
+class V4l2Source : public LiveFrameSource {
 public:
   /// Opens and configures the device; throws core::InvalidInput naming the device when it does
   /// not exist, is not a character device, or cannot be opened as a V4L2 camera.
@@ -58,9 +61,15 @@ public:
   /// "driver buffer time stamps" or "time of grab (the driver gave no usable buffer time stamp)".
   std::string stampMethod() const;
   /// Frames the camera skipped (stamp gaps) or the driver failed to deliver.
-  std::uint64_t dropped() const { return dropped_; }
+  std::uint64_t dropped() const override { return dropped_; }
   /// Frames delivered more than one period after their capture stamp.
   std::uint64_t late() const { return late_; }
+  /// Frames the camera captured: read (or failed to read) plus the gaps in the stamps.
+  std::uint64_t delivered() const override { return sequence_ + gaps_; }
+  /// late(): frames that waited in the driver's queue for over a period.
+  std::uint64_t queuedLate() const override { return late_; }
+  /// "v4l2 camera DEVICE at RATE fps (STAMP METHOD)".
+  std::string describe() const override;
   /// The frame rate in force (the driver's answer to the request), Hz.
   double rate() const { return rate_; }
 
@@ -72,7 +81,7 @@ private:
   double rate_ = 0.0;
   bool buffer_stamps_ = true;
   std::optional<double> last_stamp_;
-  std::uint64_t sequence_ = 0, dropped_ = 0, late_ = 0;
+  std::uint64_t sequence_ = 0, dropped_ = 0, late_ = 0, gaps_ = 0;
 };
 
 }  // namespace viewline::runtime

@@ -3,6 +3,8 @@
 // (white cross), the measured target (detection + [T] noise, red cross), the predicted target at
 // the command's effect time (green circle), the true target (blue point), the error vector from
 // the centre to the true target (yellow line), and the controller, mode, time and error in pixels.
+// Footage and cameras have no truth: then only the centre, the measurement and the prediction; on a
+// live source also the frames missed so far and the last frame's processing time.
 // A frame sink of the loop (pan_tilt::FrameSink): the scheduler paces the run, the keys of
 // viz::DisplayControls pause, step and quit it, and close() keeps the window open at the end.
 

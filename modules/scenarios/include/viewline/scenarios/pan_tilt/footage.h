@@ -19,10 +19,13 @@
 #include <Eigen/Core>
 #include <opencv2/core/types.hpp>
 #include <cmath>
+#include <functional>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "viewline/runtime/frame_source.h"
+#include "viewline/runtime/live.h"
 #include "viewline/tracking/planar_target/filter.h"
 #include "viewline/vision/screen_target_detector.h"
 
@@ -85,11 +88,31 @@ struct FootageReport {
   double predicted_rms_px = std::nan("");  ///< RMS of (filter prediction at the stamp − measured centre), px
   double hold_rms_px = std::nan("");       ///< RMS of (previous measured centre − measured centre), px
   std::vector<FootageStep> steps;          ///< every frame's step
+  /// A live source (runtime::LiveFrameSource: a camera, paced footage): the frames missed and the
+  /// per-frame processing times; unset otherwise.
+  std::optional<runtime::LiveReport> live;
 };
 
-/// Runs `tracker` on every frame of `source` (until it ends). With `vpdot2`, also runs ViSP's
+/// How trackFootage runs beyond the tracker's own settings.
+struct FootageRunOptions {
+  bool vpdot2 = false;  ///< also run ViSP's vpDot2 on the same frames and compare the centres
+  /// Live source: a frame's processing (grab, track, on_frame) must take at most this long, s
+  /// (one frame period of the camera).
+  double deadline_s = 1.0 / 30.0;
+  std::string deadline_origin = "one frame period at 30 fps";  ///< why that deadline, for the report
+  runtime::WallClock* clock = nullptr;  ///< live source: the clock of the processing times (null: steady)
+  /// Called after each frame is tracked (a display), with the live status line ("" unless live);
+  /// part of the frame's processing. Returns false to end the run (a viewer's quit key).
+  std::function<bool(const runtime::Frame&, const FootageStep&, const std::string& live_status)> on_frame;
+};
+
+/// Runs `tracker` on every frame of `source` (until it ends). With options.vpdot2, also runs ViSP's
 /// vpDot2 blob tracker (initTracking at config.initial_px, then track()) on the same grey frames
-/// and compares the centres.
+/// and compares the centres. On a live source each frame's processing is timed against
+/// options.deadline_s and the report's `live` says how many frames were missed.
+FootageReport trackFootage(runtime::FrameSource& source, const FootageTrackerConfig& config,
+                           const FootageRunOptions& options);
+/// trackFootage with only the vpDot2 comparison chosen.
 FootageReport trackFootage(runtime::FrameSource& source, const FootageTrackerConfig& config, bool vpdot2);
 
 }  // namespace viewline::scenarios::pan_tilt

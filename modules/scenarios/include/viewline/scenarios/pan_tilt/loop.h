@@ -25,6 +25,10 @@
 // replay_dir) selects another runtime::FrameSource. The simulated unit, the [T] noise draws and the
 // controllers are the same whatever the source. Truth comes from the renderer or from a
 // recording's truth.csv; without it the truth figures are NaN and the metrics say "not scored".
+// A live source (a V4L2 camera, footage with source.pace; runtime/live.h) runs at its own pace:
+// the frames it delivered while the loop was busy are dropped and counted, and each frame's
+// processing (grab to command, without the wait for the control event) is timed against a
+// deadline of one frame period (1 / fps); the metrics' `live` report holds both.
 //
 // Reports: generic telemetry records (measurement and truth per frame, the innovation with the
 // filter's NIS and gate decision, the estimate, the command) to a runtime::TelemetrySink, and one
@@ -66,6 +70,9 @@ struct PanTiltRunIo {
   /// same config and seed the run, and its summary, are those of the recorded run ("" : none).
   std::string replay_dir;
   std::string config_text;  ///< the config as run (YAML), written into a recording
+  /// The wall clock of a live source (paced footage) and of its processing times (null: the
+  /// steady clock; a test passes a clock it advances itself).
+  runtime::WallClock* clock = nullptr;
 };
 
 /// Telemetry channels of a run of `controller`: the target's measurements, innovations, estimates

@@ -14,12 +14,14 @@
 #include <cmath>
 #include <cstdint>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <utility>
 
 #include "viewline/control/pan_tilt_servo.h"
 #include "viewline/core/statistics.h"
 #include "viewline/estimation/consistency.h"
+#include "viewline/runtime/live.h"
 #include "viewline/scenarios/pan_tilt/config.h"
 #include "viewline/tracking/track_gate.h"
 
@@ -93,6 +95,9 @@ struct PanTiltRunMetrics {
   /// every figure that needs the true target is NaN ("not scored" in the summary).
   bool scored = true;
   runtime::FaultReport faults;  ///< injected faults and what the loop did (empty without faults)
+  /// A live source (a V4L2 camera, paced footage): frames missed (dropped, processed past the
+  /// deadline), the deadline and the per-frame processing times (runtime/live.h); unset otherwise.
+  std::optional<runtime::LiveReport> live;
 
   /// Every figure above but the gate counts, as JSON (NaN as null; "truth": "not scored" when not scored).
   nlohmann::json toJson() const;

@@ -38,6 +38,8 @@ struct FrameRecord {
   Eigen::Vector2d command = Eigen::Vector2d::Zero();  ///< the joint velocity command (rad/s)
   int mode = 0;                            ///< control::TrackingMode
   std::string mode_name;                   ///< the mode as text (control::toString)
+  /// A live source: frames missed so far and the last frame's processing time ("" otherwise).
+  std::string live_status;
 };
 
 /// Receiver of the loop's FrameRecords (a display, the frames CSV); every hook defaults to nothing.
