@@ -4,9 +4,14 @@
 // a track and the detector found the ball in the window around its prediction. The test fails
 // when any of the first 1,000 such frames allocates, and prints the count per stage.
 //
-//   build/bench/latency_alloc_test [--frames 1000] [--config FILE]
+//   build/bench/latency_alloc_test [--frames 1000] [--config FILE] [--trace N]
+//
+// --trace N prints the call stack (glibc backtrace, to stderr) of the first N counted
+// allocations: where the hot path still allocates.
 
 #include <opencv2/core/utility.hpp>
+
+#include <execinfo.h>
 
 #include <cstdio>
 #include <cstdlib>
@@ -25,19 +30,37 @@ namespace {
 // everything outside the measured frames, are not counted).
 thread_local bool g_armed = false;
 thread_local std::size_t g_count = 0;
+std::size_t g_trace = 0;  // call stacks still to print (--trace)
+
+void traceAllocation(std::size_t n) {
+  if (g_trace == 0) return;
+  --g_trace;
+  g_armed = false;  // backtrace() may allocate on its first call
+  void* frames[24];
+  const int depth = backtrace(frames, 24);
+  std::fprintf(stderr, "allocation of %zu bytes:\n", n);
+  backtrace_symbols_fd(frames, depth, 2);
+  g_armed = true;
+}
 
 // process() takes a clock: this one returns the allocation count (as a "time"), so the stage
 // split of the count comes for free.
 double allocationClock() { return static_cast<double>(g_count); }
 
 void* allocate(std::size_t n) {
-  if (g_armed) ++g_count;
+  if (g_armed) {
+    ++g_count;
+    traceAllocation(n);
+  }
   if (void* p = std::malloc(n == 0 ? 1 : n)) return p;
   throw std::bad_alloc();
 }
 
 void* allocateAligned(std::size_t n, std::align_val_t al) {
-  if (g_armed) ++g_count;
+  if (g_armed) {
+    ++g_count;
+    traceAllocation(n);
+  }
   const auto a = static_cast<std::size_t>(al);
   if (void* p = std::aligned_alloc(a, (n + a - 1) / a * a)) return p;
   throw std::bad_alloc();
@@ -81,8 +104,9 @@ int main(int argc, char** argv) {
     const std::string a = argv[i];
     if (i + 1 < argc && a == "--frames") wanted = static_cast<std::size_t>(std::atol(argv[++i]));
     else if (i + 1 < argc && a == "--config") config = argv[++i];
+    else if (i + 1 < argc && a == "--trace") g_trace = static_cast<std::size_t>(std::atol(argv[++i]));
     else {
-      std::fprintf(stderr, "usage: %s [--frames N>=1] [--config FILE]\n", argv[0]);
+      std::fprintf(stderr, "usage: %s [--frames N>=1] [--config FILE] [--trace N]\n", argv[0]);
       return 2;
     }
   }
