@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <string>
 
@@ -360,9 +361,33 @@ std::optional<ChordPlan> chordPlan(const Eigen::Vector3d& p0, Eigen::Vector3d v0
 
 }  // namespace
 
+namespace {
+
+// NormProblem(p0, v0, pf, V, A).minimumTime(), the last answer kept per thread: the catch planner
+// asks twice per update with the same numbers (its arrival test, then the profile it plans to
+// the same goal from the same state). Keyed on the inputs' bits, so the answer is the same double.
+double euclideanMinimumTime(const NormProblem& np, const Eigen::Vector3d& p0, const Eigen::Vector3d& v0,
+                            const Eigen::Vector3d& pf, double v_max, double a_max) {
+  struct Key {
+    double v[11];
+  };
+  const Key key{{p0.x(), p0.y(), p0.z(), v0.x(), v0.y(), v0.z(), pf.x(), pf.y(), pf.z(), v_max, a_max}};
+  thread_local Key last_key{};
+  thread_local double last_T = 0.0;
+  thread_local bool have = false;
+  if (have && std::memcmp(key.v, last_key.v, sizeof key.v) == 0) return last_T;
+  const double T = np.minimumTime();
+  last_key = key;
+  last_T = T;
+  have = true;
+  return T;
+}
+
+}  // namespace
+
 double SyncProfile::minimumDurationEuclidean(const Eigen::Vector3d& p0, const Eigen::Vector3d& v0,
                                              const Eigen::Vector3d& pf, double v_max, double a_max) {
-  const double T = normProblem(p0, v0, pf, v_max, a_max).minimumTime();
+  const double T = euclideanMinimumTime(normProblem(p0, v0, pf, v_max, a_max), p0, v0, pf, v_max, a_max);
   const std::optional<ChordPlan> c = chordPlan(p0, v0, pf, v_max, a_max);
   return c ? std::min(T, c->T) : T;
 }
@@ -378,7 +403,7 @@ SyncProfile SyncProfile::planEuclidean(double t0, const Eigen::Vector3d& p0, con
   s.origin_ = p0;
   s.e1_ = np.e1;
   s.e2_ = np.e2;
-  s.T_ = np.minimumTime();
+  s.T_ = euclideanMinimumTime(np, p0, v0, pf, v_max, a_max);
   if (const std::optional<ChordPlan> c = chordPlan(p0, v0, pf, v_max, a_max); c && c->T < s.T_) {
     // The velocity chord is faster (a turn from a moving start): axis 1 along u, axis 2 across.
     const Eigen::Vector3d v = v0.norm() > v_max ? Eigen::Vector3d(v0 * (v_max / v0.norm())) : v0;
