@@ -3,7 +3,7 @@
 // frames of recorded ball-catching throws, after a warm-up pass. Tracked frame: the tracker holds
 // a track and the detector found the ball in the window around its prediction. The count per
 // stage is printed, and the test fails when a stage allocates more per tracked frame than its
-// limit: by default what the stages reach now (tracker and planner none; the detection's are
+// limit: by default what the stages reach (tracker and planner none; the detection's are
 // OpenCV's findContours storage and inRange's buffer, docs/results.md, Latency), so that a change
 // which allocates more fails. Eigen's dynamic matrices take their storage from malloc, not
 // operator new, and are not counted here.

@@ -209,10 +209,10 @@ struct NormProblem {
     }
     return b;
   }
-  // Whether both axes arrive at T within the Euclidean limits was: w0 = weightFor(0, T),
-  // w1 = weightFor(1, T), both finite and w0² + w1² <= 1 + 1e-12 (the test's reference,
-  // planning_test MotionProfile.EuclideanMinimumTimeEqualsTheNestedBisection); feasibleByBounds
-  // below gives the same answer with fewer steps.
+  // Both axes arrive at T within the Euclidean limits when w0 = weightFor(0, T) and
+  // w1 = weightFor(1, T) are finite and w0² + w1² <= 1 + 1e-12 (the nested bisection, the
+  // reference of planning_test MotionProfile.EuclideanMinimumTimeEqualsTheNestedBisection);
+  // feasibleByBounds below gives the same answer with fewer steps.
 
   // weightFor(k, T)'s bisection, run only as far as a caller needs it: the answer it would
   // return lies in [lower(), upper()] at every step (a only rises, b only falls, and the answer
