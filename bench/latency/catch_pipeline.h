@@ -6,7 +6,8 @@
 //
 //   predicted pixel (tracker.predictAt, camera.project) -> vision::BallDetector (window around
 //   it, or the full frame) -> tracking::ViewlineTracker::submit -> its outcome ->
-//   planning::CatchPlanner::update (when fused) -> CatchPlanner::setpoint.
+//   (when fused) scenarios::PlannerInput::after (the flight fit of the track's images) ->
+//   planning::CatchPlanner::update -> CatchPlanner::setpoint.
 //
 // The planner update and the set point run on every frame here (in the scenario they run on the
 // control tick): an upper bound of the per-frame work.
@@ -21,6 +22,7 @@
 #include "viewline/planning/catch_planner.h"
 #include "viewline/robots/cartesian_robot.h"
 #include "viewline/scenarios/ball_catching.h"
+#include "viewline/scenarios/ball_catching/planner_input.h"
 #include "viewline/tracking/tracker.h"
 #include "viewline/vision/ball_detector.h"
 
@@ -60,7 +62,11 @@ class CatchPipeline {
 public:
   /// The parts of one throw for `cfg` (which must outlive the pipeline).
   explicit CatchPipeline(const scenarios::BallCatchingConfig& cfg)
-      : cfg_(cfg), robot_(cfg.robot), planner_(cfg.plannerConfig(), robot_), tracker_(cameras(cfg), cfg.tracker) {
+      : cfg_(cfg),
+        robot_(cfg.robot),
+        planner_(cfg.plannerConfig(), robot_),
+        tracker_(cameras(cfg), cfg.tracker),
+        planner_input_(cfg, tracker_.cameras()) {
     for (const auto& c : tracker_.cameras()) detectors_.emplace_back(cfg.detector, c);
     reset();
   }
@@ -71,6 +77,7 @@ public:
     tracker_.reset();
     robot_.reset(0.0);
     planner_.reset(0.0, cfg_.robot.home);
+    planner_input_.reset();
     next_id_ = 1;
   }
 
@@ -78,7 +85,7 @@ public:
   struct StageTimes {
     double detect = 0.0;  ///< prediction of the pixel + detection
     double track = 0.0;   ///< submit + outcome
-    double plan = 0.0;    ///< planner update (when fused) + set point
+    double plan = 0.0;    ///< flight fit and planner update (when fused) + set point
   };
 
   /// One frame (a frame of another throw than the last restarts tracker and planner);
@@ -101,10 +108,11 @@ public:
     const auto det = detectors_[ci].detect(f.image, f.t, predicted);
     const double c1 = clock ? clock() : 0.0;
     bool in_window = false, fused = false;
+    tracking::ImageMeasurement m;
     if (det.ok()) {
       in_window = det.value().used_roi;
       const double sigma = std::max(cfg_.sigma_px_floor, std::sqrt(0.5 * det.value().pixel_covariance.trace()));
-      const tracking::ImageMeasurement m{next_id_++, ci, f.t, det.value().pixel, sigma};
+      m = {next_id_++, ci, f.t, det.value().pixel, sigma};
       if (tracker_.submit(m) == tracking::Refusal::None) {
         const auto o = tracker_.outcome(m.id);
         fused = o && o->fate == tracking::Fate::Fused && tracker_.initialised();
@@ -112,7 +120,7 @@ public:
     }
     const double c2 = clock ? clock() : 0.0;
     if (fused) {
-      const planning::PlannerUpdate u = planner_.update(f.t, tracker_.state());
+      const planning::PlannerUpdate u = planner_.update(f.t, planner_input_.after(m, tracker_));
       crossings_ += u.crossing.has_value();
     }
     const robots::CartesianState sp = planner_.setpoint(f.t);
@@ -140,6 +148,7 @@ private:
   robots::SimulatedCartesianRobot robot_;
   planning::CatchPlanner planner_;
   tracking::ViewlineTracker tracker_;
+  scenarios::PlannerInput planner_input_;  // the flight fit the planner predicts from
   std::vector<vision::BallDetector> detectors_;
   std::uint64_t next_id_ = 1;
   int throw_index_ = -1;

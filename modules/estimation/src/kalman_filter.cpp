@@ -267,7 +267,8 @@ UpdateReport predictorStep(StateEstimate& s, const LinearTransition& tr, const L
 
 Eigen::MatrixXd innovationCovariance(const StateEstimate& s, const Eigen::MatrixXd& C,
                                      const Eigen::MatrixXd& R) {
-  core::requireSize(C, R.rows(), s.dim(), "measurement matrix C");
+  // Test first: the message is a std::string (a heap allocation on every image otherwise).
+  if (C.rows() != R.rows() || C.cols() != s.dim()) core::requireSize(C, R.rows(), s.dim(), "measurement matrix C");
   const Eigen::MatrixXd CL = C * s.sqrtP();
   return R + CL * CL.transpose();
 }

@@ -1,15 +1,26 @@
 #include "viewline/estimation/state.h"
 
+#include <Eigen/Cholesky>
+#include <cmath>
+
 #include "viewline/core/checks.h"
 #include "viewline/estimation/square_root.h"
 
 namespace viewline::estimation {
 
+namespace {
+// requireSymmetricPositiveDefinite's test without its message (a std::string, built only when
+// the test fails: the tracker and the flight fit build estimates on every image).
+bool symmetricPositiveDefinite(const Eigen::MatrixXd& P) {
+  return P.allFinite() && core::isSymmetric(P) && (P.size() == 0 || Eigen::LLT<Eigen::MatrixXd>(P).info() == Eigen::Success);
+}
+}  // namespace
+
 StateEstimate::StateEstimate(const Eigen::VectorXd& x, const Eigen::MatrixXd& P, core::Timestamp t) {
-  core::requireFinite(x, "state mean x");
-  core::requireSize(P, x.size(), x.size(), "state covariance P");
-  core::requireSymmetricPositiveDefinite(P, "state covariance P");
-  core::requireFinite(t, "state time t");
+  if (!x.allFinite()) core::requireFinite(x, "state mean x");
+  if (P.rows() != x.size() || P.cols() != x.size()) core::requireSize(P, x.size(), x.size(), "state covariance P");
+  if (!symmetricPositiveDefinite(P)) core::requireSymmetricPositiveDefinite(P, "state covariance P");
+  if (!std::isfinite(t)) core::requireFinite(t, "state time t");
   x_ = x;
   L_ = psdSqrt(P, "state covariance P");
   t_ = t;

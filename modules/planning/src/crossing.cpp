@@ -152,7 +152,7 @@ std::optional<Crossing> predictCrossing(const estimation::StateEstimate& est, co
     estimation::DragBallisticModel d = dragModel(model);
     d.substeps = std::max(2, static_cast<int>(std::ceil(tau / 0.02)));
     F = d.jacobianFixed(x0, tau);
-    if (model.accel_psd > 0.0) Q = d.processNoise(x0, tau);
+    if (model.accel_psd > 0.0) Q = d.processNoiseFixed(x0, tau);  // no heap: the bits of processNoise()
   }
   // est.P() without its temporary: the same product, evaluated into a per-thread buffer.
   thread_local Eigen::MatrixXd P_buffer(6, 6);

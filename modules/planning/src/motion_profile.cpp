@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <string>
 
@@ -208,21 +209,81 @@ struct NormProblem {
     }
     return b;
   }
-  bool feasible(double T) const {
-    const double w0 = weightFor(0, T), w1 = weightFor(1, T);
-    return std::isfinite(w0) && std::isfinite(w1) && w0 * w0 + w1 * w1 <= 1.0 + 1e-12;
+  // Both axes arrive at T within the Euclidean limits when w0 = weightFor(0, T) and
+  // w1 = weightFor(1, T) are finite and w0² + w1² <= 1 + 1e-12 (the nested bisection, the
+  // reference of planning_test MotionProfile.EuclideanMinimumTimeEqualsTheNestedBisection);
+  // feasibleByBounds below gives the same answer with fewer steps.
+
+  // weightFor(k, T)'s bisection, run only as far as a caller needs it: the answer it would
+  // return lies in [lower(), upper()] at every step (a only rises, b only falls, and the answer
+  // is a later b, a midpoint that passed), and is exact once the loop of weightFor would stop.
+  struct Weight {
+    double a = 0.0, b = 0.0;
+    int it = 0;
+    bool exact = false;  // b is the answer
+    double lower() const { return exact ? b : a; }
+    double upper() const { return b; }
+  };
+  // Starts weightFor(k, T); false when it answers +inf (axis k cannot arrive at T).
+  bool startWeight(int k, double T, Weight& w) const {
+    if (idle(k)) {
+      w.b = 0.0;
+      w.exact = true;
+      return true;
+    }
+    if (!weightOk(k, 1.0, T)) return false;
+    if (weightOk(k, lo[k], T)) {
+      w.b = lo[k];
+      w.exact = true;
+      return true;
+    }
+    w.a = lo[k];
+    w.b = 1.0;
+    w.it = 0;
+    w.exact = !(w.it < 60 && w.b - w.a > 1e-14);
+    return true;
   }
+  // One step of weightFor's loop (the same midpoint, test and stop rule).
+  void refineWeight(int k, double T, Weight& w) const {
+    const double m = 0.5 * (w.a + w.b);
+    if (weightOk(k, m, T)) w.b = m;
+    else w.a = m;
+    ++w.it;
+    w.exact = !(w.it < 60 && w.b - w.a > 1e-14);
+  }
+  bool weightOk(int k, double w, double T) const {
+    return w > 0.0 && axisFeasible(0.0, v0[k], d[k], V * w, A * w, T);
+  }
+  // feasible(T) with the same answer, bisecting the weights only until the test is decided:
+  // w0² + w1² (rounded) is non-decreasing in each weight >= 0, so the bounds of both weights
+  // decide it as soon as both bounds fall on one side of the threshold. Most arrival times the
+  // outer bisection tries are far from the minimum; there a few steps of the weights decide.
+  bool feasibleByBounds(double T) const {
+    Weight w[2];
+    if (!startWeight(0, T, w[0]) || !startWeight(1, T, w[1])) return false;
+    const double limit = 1.0 + 1e-12;
+    for (;;) {
+      const double up0 = w[0].upper(), up1 = w[1].upper();
+      if (up0 * up0 + up1 * up1 <= limit) return true;
+      const double lo0 = w[0].lower(), lo1 = w[1].lower();
+      if (lo0 * lo0 + lo1 * lo1 > limit) return false;
+      // Undecided: at least one weight is still a bracket; narrow the wider one.
+      const int k = w[0].exact ? 1 : w[1].exact ? 0 : (w[0].b - w[0].a >= w[1].b - w[1].a ? 0 : 1);
+      refineWeight(k, T, w[k]);
+    }
+  }
+
   double minimumTime() const {
     if (idle(0) && idle(1)) return 0.0;
     double lo_t = 0.0, hi_t = 1e-3;
-    for (int k = 0; !feasible(hi_t); ++k) {
+    for (int k = 0; !feasibleByBounds(hi_t); ++k) {
       if (k > 60) throw core::NumericalError("SyncProfile::planEuclidean: no feasible arrival time");
       lo_t = hi_t;
       hi_t *= 2.0;
     }
     for (int it = 0; it < 200 && hi_t - lo_t > 1e-13 * (1.0 + hi_t); ++it) {
       const double mid = 0.5 * (lo_t + hi_t);
-      if (feasible(mid)) hi_t = mid;
+      if (feasibleByBounds(mid)) hi_t = mid;
       else lo_t = mid;
     }
     return hi_t;
@@ -300,9 +361,33 @@ std::optional<ChordPlan> chordPlan(const Eigen::Vector3d& p0, Eigen::Vector3d v0
 
 }  // namespace
 
+namespace {
+
+// NormProblem(p0, v0, pf, V, A).minimumTime(), the last answer kept per thread: the catch planner
+// asks twice per update with the same numbers (its arrival test, then the profile it plans to
+// the same goal from the same state). Keyed on the inputs' bits, so the answer is the same double.
+double euclideanMinimumTime(const NormProblem& np, const Eigen::Vector3d& p0, const Eigen::Vector3d& v0,
+                            const Eigen::Vector3d& pf, double v_max, double a_max) {
+  struct Key {
+    double v[11];
+  };
+  const Key key{{p0.x(), p0.y(), p0.z(), v0.x(), v0.y(), v0.z(), pf.x(), pf.y(), pf.z(), v_max, a_max}};
+  thread_local Key last_key{};
+  thread_local double last_T = 0.0;
+  thread_local bool have = false;
+  if (have && std::memcmp(key.v, last_key.v, sizeof key.v) == 0) return last_T;
+  const double T = np.minimumTime();
+  last_key = key;
+  last_T = T;
+  have = true;
+  return T;
+}
+
+}  // namespace
+
 double SyncProfile::minimumDurationEuclidean(const Eigen::Vector3d& p0, const Eigen::Vector3d& v0,
                                              const Eigen::Vector3d& pf, double v_max, double a_max) {
-  const double T = normProblem(p0, v0, pf, v_max, a_max).minimumTime();
+  const double T = euclideanMinimumTime(normProblem(p0, v0, pf, v_max, a_max), p0, v0, pf, v_max, a_max);
   const std::optional<ChordPlan> c = chordPlan(p0, v0, pf, v_max, a_max);
   return c ? std::min(T, c->T) : T;
 }
@@ -318,7 +403,7 @@ SyncProfile SyncProfile::planEuclidean(double t0, const Eigen::Vector3d& p0, con
   s.origin_ = p0;
   s.e1_ = np.e1;
   s.e2_ = np.e2;
-  s.T_ = np.minimumTime();
+  s.T_ = euclideanMinimumTime(np, p0, v0, pf, v_max, a_max);
   if (const std::optional<ChordPlan> c = chordPlan(p0, v0, pf, v_max, a_max); c && c->T < s.T_) {
     // The velocity chord is faster (a turn from a moving start): axis 1 along u, axis 2 across.
     const Eigen::Vector3d v = v0.norm() > v_max ? Eigen::Vector3d(v0 * (v_max / v0.norm())) : v0;

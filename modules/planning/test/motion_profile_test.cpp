@@ -2,7 +2,9 @@
 // of replanning from a moving state.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "viewline/core/error.h"
 #include "viewline/core/random.h"
@@ -246,4 +248,110 @@ TEST(MotionProfile, EuclideanTurnAtFullSpeedBeatsStoppingFirst) {
     EXPECT_LT((pr.at(0.0).v - v0).norm(), 1e-12);
     expectWithinNormLimits(pr, V, A);
   }
+}
+
+namespace {
+
+// The Euclidean minimum time as the plain nested bisection computes it (every weight bisected to
+// its end at every arrival time the outer bisection tries), kept here as the reference of the
+// library's faster search, which must give the same double.
+namespace reference {
+
+double profileDistance(double v0, double vc, double a, double T) {
+  const double t1 = std::abs(vc - v0) / a;
+  const double t3 = std::abs(vc) / a;
+  const double tc = std::max(0.0, T - t1 - t3);
+  return 0.5 * (v0 + vc) * t1 + vc * tc + 0.5 * vc * t3;
+}
+
+bool axisFeasible(double v0, double D, double v_max, double a, double T) {
+  if (T < std::abs(v0) / a - 1e-12) return false;
+  const double lo = std::max(-v_max, 0.5 * (v0 - a * T));
+  const double hi = std::min(v_max, 0.5 * (v0 + a * T));
+  if (!(lo <= hi)) return false;
+  const double tol = 1e-12 * (1.0 + std::abs(D));
+  return D >= profileDistance(v0, lo, a, T) - tol && D <= profileDistance(v0, hi, a, T) + tol;
+}
+
+double euclideanMinimumTime(const Eigen::Vector3d& p0, const Eigen::Vector3d& v0_in, const Eigen::Vector3d& pf,
+                            double V, double A) {
+  Eigen::Vector3d v0 = v0_in;
+  if (v0.norm() > V) v0 *= V / v0.norm();
+  const Eigen::Vector3d D = pf - p0;
+  const double dist = D.norm();
+  Eigen::Vector3d e1 = Eigen::Vector3d::UnitX();
+  if (dist > 0.0) e1 = D / dist;
+  else if (v0.norm() > 0.0) e1 = v0.normalized();
+  double d[2] = {dist, 0.0}, v[2] = {v0.dot(e1), 0.0}, lo[2];
+  const Eigen::Vector3d across = v0 - v[0] * e1;
+  if (across.norm() > 1e-12 * V) v[1] = across.norm();
+  lo[0] = std::abs(v[0]) / V;
+  lo[1] = v[1] / V;
+  const double l = std::hypot(lo[0], lo[1]);
+  if (l > 1.0) {
+    lo[0] /= l;
+    lo[1] /= l;
+  }
+  auto idle = [&](int k) { return d[k] == 0.0 && v[k] == 0.0; };
+  auto weightFor = [&](int k, double T) {
+    if (idle(k)) return 0.0;
+    auto ok = [&](double w) { return w > 0.0 && axisFeasible(v[k], d[k], V * w, A * w, T); };
+    if (!ok(1.0)) return std::numeric_limits<double>::infinity();
+    if (ok(lo[k])) return lo[k];
+    double a = lo[k], b = 1.0;
+    for (int it = 0; it < 60 && b - a > 1e-14; ++it) {
+      const double m = 0.5 * (a + b);
+      if (ok(m)) b = m;
+      else a = m;
+    }
+    return b;
+  };
+  auto feasible = [&](double T) {
+    const double w0 = weightFor(0, T), w1 = weightFor(1, T);
+    return std::isfinite(w0) && std::isfinite(w1) && w0 * w0 + w1 * w1 <= 1.0 + 1e-12;
+  };
+  if (idle(0) && idle(1)) return 0.0;
+  double lo_t = 0.0, hi_t = 1e-3;
+  while (!feasible(hi_t)) {
+    lo_t = hi_t;
+    hi_t *= 2.0;
+  }
+  for (int it = 0; it < 200 && hi_t - lo_t > 1e-13 * (1.0 + hi_t); ++it) {
+    const double mid = 0.5 * (lo_t + hi_t);
+    if (feasible(mid)) hi_t = mid;
+    else lo_t = mid;
+  }
+  return hi_t;
+}
+
+}  // namespace reference
+
+}  // namespace
+
+// The search that decides each arrival time from the weights' bounds returns the same double as
+// the nested bisection: planEuclidean's duration is the reference's, bit for bit, unless the
+// velocity chord (not changed) is faster.
+TEST(MotionProfile, EuclideanMinimumTimeEqualsTheNestedBisection) {
+  core::Rng rng = core::makeRng(23);
+  int compared = 0;
+  for (int k = 0; k < 400; ++k) {
+    Eigen::Vector3d p0, v0, pf;
+    for (int i = 0; i < 3; ++i) {
+      p0(i) = core::uniform(rng, -0.4, 0.4);
+      pf(i) = core::uniform(rng, -0.4, 0.4);
+      v0(i) = core::uniform(rng, -1, 1);
+    }
+    if (k % 7 == 0) pf = p0;
+    if (k % 11 == 0) v0.setZero();
+    else v0 *= (k % 3 == 0 ? 0.5 : core::uniform(rng, 0.0, 0.6)) / v0.norm();  // some above V (clamped)
+    const double a_max = k % 2 == 0 ? 13.0 : 0.6;  // the chord needs a goal beyond V²/2A: rarer at 0.6
+    const double ref = reference::euclideanMinimumTime(p0, v0, pf, 0.5, a_max);
+    const double T = SyncProfile::minimumDurationEuclidean(p0, v0, pf, 0.5, a_max);
+    const SyncProfile pr = SyncProfile::planEuclidean(0.0, p0, v0, pf, 0.5, a_max);
+    if (T < ref) continue;  // the chord is faster: not the bisection's answer
+    ++compared;
+    EXPECT_EQ(T, ref) << "case " << k;
+    EXPECT_EQ(pr.duration(), ref) << "case " << k;
+  }
+  EXPECT_GT(compared, 150);
 }

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <set>
 
 #include "viewline/core/error.h"
 
@@ -31,6 +30,8 @@ FlightFit::FlightFit(FlightFitConfig cfg, std::vector<core::Camera> cameras, est
   if (cfg_.max_iterations < 1) throw core::InvalidInput("flight_fit.max_iterations: expected >= 1");
   model_.q = 0.0;
   model_.validate();
+  camera_seen_.assign(cams_.size(), 0);
+  images_.reserve(kReservedImages);
 }
 
 void FlightFit::reset() {
@@ -48,9 +49,15 @@ std::optional<estimation::StateEstimate> FlightFit::add(const FitImage& image, c
   const bool new_front = pos == images_.begin();
   images_.insert(pos, image);
   if (static_cast<int>(images_.size()) < cfg_.min_images) return std::nullopt;
-  std::set<std::size_t> cams;
-  for (const FitImage& f : images_) cams.insert(f.camera);
-  if (static_cast<int>(cams.size()) < cfg_.min_cameras) return std::nullopt;
+  // Distinct cameras among the images (flags per camera, kept between calls: no allocation).
+  std::fill(camera_seen_.begin(), camera_seen_.end(), static_cast<unsigned char>(0));
+  int cameras_seen = 0;
+  for (const FitImage& f : images_)
+    if (!camera_seen_[f.camera]) {
+      camera_seen_[f.camera] = 1;
+      ++cameras_seen;
+    }
+  if (cameras_seen < cfg_.min_cameras) return std::nullopt;
   if (!x_ref_ || new_front) {
     // Seed: the tracker's (drag-free) state carried back to the first image, x(t) = x_ref + ...
     // under gravity alone; Gauss-Newton removes the drag's share.
@@ -70,10 +77,7 @@ std::optional<estimation::StateEstimate> FlightFit::add(const FitImage& image, c
   Vec6 x = *x_ref_;
   Mat6 Phi = Mat6::Identity();
   const double dt = images_.back().t - images_.front().t;
-  if (dt > 0.0) {
-    Phi = model_.jacobianFixed(x, dt);
-    x = model_.propagateFixed(x, dt);
-  }
+  if (dt > 0.0) x = model_.propagateWithJacobianFixed(x, dt, Phi);
   const Mat6 P = Phi * H_.ldlt().solve(Mat6::Identity()) * Phi.transpose();
   return estimation::StateEstimate(x, 0.5 * (P + P.transpose()), images_.back().t);
 }
@@ -88,8 +92,9 @@ bool FlightFit::solve() {
     for (const FitImage& f : images_) {
       const double dt = f.t - t_prev;
       if (dt > 0.0) {
-        Phi = model_.jacobianFixed(x, dt) * Phi;
-        x = model_.propagateFixed(x, dt);
+        Mat6 step;  // one pass gives the step's mean and Jacobian (the bits of the two calls)
+        x = model_.propagateWithJacobianFixed(x, dt, step);
+        Phi = step * Phi;
         t_prev = f.t;
       }
       const core::Camera& cam = cams_[f.camera];
@@ -145,20 +150,22 @@ void FlightFit::addPrior(const Vec6& x, Mat6& H, Vec6& b) const {
     s = model_.propagateFixed(s, step);
     tau += step;
   }
+  Mat6 F_tau = Mat6::Identity();  // ∂x(τ)/∂x at the final τ: set with the last iterate's propagation
   for (int it = 0; it < 8; ++it) {
     const double nv = n.dot(s.tail<3>());
     if (!(nv < 0.0)) return;
     const double dtau = -side(s) / nv;
     tau += dtau;
     if (!(tau > 0.0 && tau < horizon)) return;
-    s = model_.propagateFixed(x, tau);
+    const bool last = std::abs(dtau) < 1e-9 || it == 7;
+    s = last ? model_.propagateWithJacobianFixed(x, tau, F_tau) : model_.propagateFixed(x, tau);
     if (std::abs(dtau) < 1e-9) break;
   }
   const double nv = n.dot(s.tail<3>());
   if (!(tau > 0.0) || !(nv < 0.0) || !s.allFinite()) return;
   // δc = A δp(τ), A = I − v nᵀ / (n·v): the point moves along the flight to stay in the plane.
   const Eigen::Matrix3d A = Eigen::Matrix3d::Identity() - s.tail<3>() * n.transpose() / nv;
-  const Eigen::Matrix<double, 2, 6> Jc = E_.transpose() * A * model_.jacobianFixed(x, tau).topRows<3>();
+  const Eigen::Matrix<double, 2, 6> Jc = E_.transpose() * A * F_tau.topRows<3>();
   const double w = 1.0 / (cfg_.aim_prior_std * cfg_.aim_prior_std);
   H += w * Jc.transpose() * Jc;
   b += w * Jc.transpose() * (E_.transpose() * (aim_.centre - s.head<3>()));

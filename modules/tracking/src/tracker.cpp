@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <tuple>
+#include <unordered_map>
 
 #include "viewline/core/checks.h"
 #include "viewline/estimation/kalman_filter.h"
@@ -127,7 +128,7 @@ ViewlineTracker::ViewlineTracker(std::vector<core::Camera> cameras, TrackerConfi
 void ViewlineTracker::reset() {
   state_ = fresh_;
   last_update_.reset();
-  buffer_.clear();
+  head_ = count_ = 0;  // the ring keeps its slots
   final_.clear();
   refusals_.fill(0);
   any_ = false;
@@ -152,7 +153,8 @@ Refusal ViewlineTracker::check(const ImageMeasurement& m) const {
   if (any_) {
     if (m.t < newest_ - cfg_.late_horizon) return Refusal::TooOld;
     if (m.t > newest_ + cfg_.max_forward_gap) return Refusal::FarFuture;
-    for (const Entry& e : buffer_) {
+    for (std::size_t i = 0; i < count_; ++i) {
+      const Entry& e = entry(i);
       if (e.m.id == m.id) return Refusal::Duplicate;
       if (e.m.camera == m.camera && std::abs(e.m.t - m.t) <= 1e-9) return Refusal::Duplicate;
     }
@@ -277,19 +279,24 @@ Refusal ViewlineTracker::submit(const ImageMeasurement& m) {
   }
   ImageUpdate update;
   auto key = [](const ImageMeasurement& a) { return std::make_tuple(a.t, a.camera, a.id); };
-  const auto pos = std::upper_bound(buffer_.begin(), buffer_.end(), m,
-                                    [&](const ImageMeasurement& a, const Entry& e) { return key(a) < key(e.m); });
-  if (pos == buffer_.end()) {
-    buffer_.push_back({m, state_});
+  // Upper bound of m in the buffer (the first entry after it in processing order).
+  std::size_t idx = 0;
+  for (std::size_t hi = count_; idx < hi;) {
+    const std::size_t mid = idx + (hi - idx) / 2;
+    if (key(m) < key(entry(mid).m)) hi = mid;
+    else idx = mid + 1;
+  }
+  if (idx == count_) {
+    pushEntry(m, state_);
     step(state_, m, &update);
   } else {
     // Late: insert in order and re-process everything after it from the snapshot.
-    const auto idx = static_cast<std::size_t>(pos - buffer_.begin());
-    TrackState ts = pos->before;
-    buffer_.insert(pos, Entry{m, ts});
-    for (std::size_t j = idx; j < buffer_.size(); ++j) {
-      buffer_[j].before = ts;
-      step(ts, buffer_[j].m, j == idx ? &update : nullptr);
+    TrackState ts = entry(idx).before;
+    pushEntry(m, ts);
+    for (std::size_t j = count_ - 1; j > idx; --j) std::swap(entry(j), entry(j - 1));
+    for (std::size_t j = idx; j < count_; ++j) {
+      entry(j).before = ts;
+      step(ts, entry(j).m, j == idx ? &update : nullptr);
     }
     state_ = std::move(ts);
     ++late_inserted_;
@@ -297,8 +304,34 @@ Refusal ViewlineTracker::submit(const ImageMeasurement& m) {
   newest_ = any_ ? std::max(newest_, m.t) : m.t;
   any_ = true;
   last_update_ = std::move(update);
-  while (!buffer_.empty() && buffer_.front().m.t < newest_ - cfg_.late_horizon) buffer_.pop_front();
+  while (count_ > 0 && entry(0).m.t < newest_ - cfg_.late_horizon) {
+    head_ = (head_ + 1) % ring_.size();
+    --count_;
+  }
   return Refusal::None;
+}
+
+void ViewlineTracker::pushEntry(const ImageMeasurement& m, const TrackState& s) {
+  if (count_ == ring_.size()) {
+    // Full: unroll the ring (entries from slot 0) and grow it by one slot.
+    std::rotate(ring_.begin(), ring_.begin() + static_cast<std::ptrdiff_t>(head_), ring_.end());
+    head_ = 0;
+    ring_.push_back(Entry{m, s});
+  } else {
+    Entry& e = ring_[(head_ + count_) % ring_.size()];
+    e.m = m;
+    e.before = s;  // copy-assignment: the slot's vectors and matrices keep their storage
+  }
+  ++count_;
+}
+
+void ViewlineTracker::evict(const MeasurementOutcome& o) {
+  // Ids mostly arrive in increasing order: the outcome is appended (amortised: no allocation
+  // once the vector has grown to a run's size), or replaces the one it was before a restart.
+  const auto it = std::lower_bound(final_.begin(), final_.end(), o.m.id,
+                                   [](const MeasurementOutcome& a, std::uint64_t id) { return a.m.id < id; });
+  if (it != final_.end() && it->m.id == o.m.id) *it = o;
+  else final_.insert(it, o);
 }
 
 estimation::StateEstimate ViewlineTracker::predictAt(core::Timestamp t) const {
@@ -316,8 +349,9 @@ estimation::StateEstimate ViewlineTracker::predictAt(core::Timestamp t) const {
 std::optional<MeasurementOutcome> ViewlineTracker::outcome(std::uint64_t id) const {
   for (const MeasurementOutcome& o : state_.history)
     if (o.m.id == id) return o;
-  const auto it = final_.find(id);
-  if (it != final_.end()) return it->second;
+  const auto it = std::lower_bound(final_.begin(), final_.end(), id,
+                                   [](const MeasurementOutcome& a, std::uint64_t i) { return a.m.id < i; });
+  if (it != final_.end() && it->m.id == id) return *it;
   return std::nullopt;
 }
 
@@ -326,8 +360,8 @@ std::vector<MeasurementOutcome> ViewlineTracker::outcomes() const {
   out.reserve(final_.size() + state_.history.size());
   std::unordered_map<std::uint64_t, bool> in_history;
   for (const MeasurementOutcome& o : state_.history) in_history[o.m.id] = true;
-  for (const auto& kv : final_)
-    if (in_history.find(kv.first) == in_history.end()) out.push_back(kv.second);
+  for (const MeasurementOutcome& o : final_)
+    if (in_history.find(o.m.id) == in_history.end()) out.push_back(o);
   for (const MeasurementOutcome& o : state_.history) out.push_back(o);
   std::sort(out.begin(), out.end(), [](const MeasurementOutcome& a, const MeasurementOutcome& b) {
     return std::make_tuple(a.m.t, a.m.camera, a.m.id) < std::make_tuple(b.m.t, b.m.camera, b.m.id);

@@ -37,6 +37,33 @@ struct Candidate {
 
 }  // namespace
 
+void morphologyStep(const cv::Mat& src, cv::Mat& dst, const cv::Mat& kernel, bool erode) {
+  if (src.type() != CV_8UC1 || kernel.type() != CV_8UC1 || kernel.empty() || src.data == dst.data)
+    throw core::InvalidInput("morphologyStep: expected 8-bit single-channel src and kernel, dst not src");
+  dst.create(src.size(), CV_8UC1);
+  const int rows = src.rows, cols = src.cols;
+  const uchar neutral = erode ? 255 : 0;
+  for (int y = 0; y < rows; ++y) std::fill_n(dst.ptr<uchar>(y), cols, neutral);
+  // dst = min (max) over the kernel's offsets of src shifted by the offset. Outside the image
+  // src is the neutral value of the min (max), so only the overlapping part of each shift is
+  // visited; the result is the same whatever the order of the offsets (min and max are exact).
+  const int ax = kernel.cols / 2, ay = kernel.rows / 2;
+  for (int ky = 0; ky < kernel.rows; ++ky)
+    for (int kx = 0; kx < kernel.cols; ++kx) {
+      if (kernel.at<uchar>(ky, kx) == 0) continue;
+      const int dx = kx - ax, dy = ky - ay;
+      const int x0 = std::max(0, -dx), x1 = std::min(cols, cols - dx);
+      for (int y = std::max(0, -dy); y < std::min(rows, rows - dy); ++y) {
+        uchar* d = dst.ptr<uchar>(y);
+        const uchar* s = src.ptr<uchar>(y + dy);
+        if (erode)
+          for (int x = x0; x < x1; ++x) d[x] = std::min(d[x], s[x + dx]);
+        else
+          for (int x = x0; x < x1; ++x) d[x] = std::max(d[x], s[x + dx]);
+      }
+    }
+}
+
 void BallDetectorConfig::validate() const {
   hsv.validate("BallDetectorConfig.hsv");
   requireKernel(open_kernel_px, "open_kernel_px");
@@ -205,8 +232,16 @@ void BallDetector::collect(const cv::Mat& bgr, const cv::Rect& window,
                            const std::optional<Eigen::Vector2d>& predicted) {
   cv::cvtColor(bgr(window), hsv_, cv::COLOR_BGR2HSV);
   thresholdColor(hsv_, config_.hsv, mask_);
-  if (!open_kernel_.empty()) cv::morphologyEx(mask_, mask_, cv::MORPH_OPEN, open_kernel_);
-  if (!close_kernel_.empty()) cv::morphologyEx(mask_, mask_, cv::MORPH_CLOSE, close_kernel_);
+  // cv::morphologyEx's opening (erode, dilate) and closing (dilate, erode), step by step on the
+  // detector's buffers (the same values: vision_test BallDetector.MorphologyStepIsOpenCVs).
+  if (!open_kernel_.empty()) {
+    morphologyStep(mask_, morph_, open_kernel_, true);
+    morphologyStep(morph_, mask_, open_kernel_, false);
+  }
+  if (!close_kernel_.empty()) {
+    morphologyStep(mask_, morph_, close_kernel_, false);
+    morphologyStep(morph_, mask_, close_kernel_, true);
+  }
   cv::findContours(mask_, contours_, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_NONE, window.tl());
 
   for (const auto& c : contours_) {

@@ -214,3 +214,47 @@ TEST(BallDetector, RejectsBadInputNamingTheField) {
 
 }  // namespace
 }  // namespace viewline::vision
+
+namespace viewline::vision {
+namespace {
+
+// The detector's opening and closing (morphologyStep) against OpenCV's erode, dilate and
+// morphologyEx with their default border: the same mask, value for value, on blobs and noise,
+// on windows smaller and larger than the kernel and at every image edge.
+TEST(BallDetector, MorphologyStepIsOpenCVs) {
+  cv::RNG rng(5);
+  cv::Mat a, b;
+  for (int k = 0; k < 120; ++k) {
+    const int rows = 1 + rng.uniform(0, 70), cols = 1 + rng.uniform(0, 70);
+    cv::Mat src(rows, cols, CV_8UC1);
+    if (k % 3 == 0) {
+      rng.fill(src, cv::RNG::UNIFORM, 0, 256);  // any values: min and max, not only masks
+    } else {
+      src.setTo(0);
+      for (int i = 0; i < 4; ++i)
+        cv::circle(src, {rng.uniform(-5, cols + 5), rng.uniform(-5, rows + 5)}, rng.uniform(1, 20), 255, -1);
+      for (int i = 0; i < 30; ++i) src.at<uchar>(rng.uniform(0, rows), rng.uniform(0, cols)) ^= 255;  // speckle
+    }
+    const int size = 3 + 2 * (k % 4);
+    const cv::Mat kernel = cv::getStructuringElement(k % 5 == 4 ? cv::MORPH_RECT : cv::MORPH_ELLIPSE, {size, size});
+    for (const bool erode : {true, false}) {
+      morphologyStep(src, a, kernel, erode);
+      if (erode) cv::erode(src, b, kernel);
+      else cv::dilate(src, b, kernel);
+      ASSERT_EQ(cv::countNonZero(a != b), 0) << "case " << k << (erode ? " erode" : " dilate");
+    }
+    cv::Mat t, opened = src.clone(), closed = src.clone();
+    morphologyStep(src, t, kernel, true);
+    morphologyStep(t, opened, kernel, false);
+    morphologyStep(src, t, kernel, false);
+    morphologyStep(t, closed, kernel, true);
+    cv::morphologyEx(src, b, cv::MORPH_OPEN, kernel);
+    ASSERT_EQ(cv::countNonZero(opened != b), 0) << "case " << k << " open";
+    cv::morphologyEx(src, b, cv::MORPH_CLOSE, kernel);
+    ASSERT_EQ(cv::countNonZero(closed != b), 0) << "case " << k << " close";
+  }
+  EXPECT_THROW(morphologyStep(a, a, cv::getStructuringElement(cv::MORPH_ELLIPSE, {3, 3}), true), core::InvalidInput);
+}
+
+}  // namespace
+}  // namespace viewline::vision

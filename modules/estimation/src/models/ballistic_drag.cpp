@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <sstream>
+#include <unsupported/Eigen/MatrixFunctions>
 
 #include "model_checks.h"
 #include "viewline/estimation/discretization.h"
@@ -46,13 +47,17 @@ void DragBallisticModel::validate() const {
 
 Eigen::Vector3d DragBallisticModel::gravity() const { return -g * up.normalized(); }
 
-Vec6 DragBallisticModel::derivative(const Vec6& x) const {
+namespace {
+// ṗ = v, v̇ = g_vec − k |v| v, with g_vec given (the propagations compute it once per call).
+Vec6 derivativeWith(const Vec6& x, const Eigen::Vector3d& g_vec, double k) {
   const Eigen::Vector3d v = x.tail<3>();
   Vec6 d;
-  // ṗ = v, v̇ = g_vec − k |v| v
-  d << v, gravity() - k * v.norm() * v;
+  d << v, g_vec - k * v.norm() * v;
   return d;
 }
+}  // namespace
+
+Vec6 DragBallisticModel::derivative(const Vec6& x) const { return derivativeWith(x, gravity(), k); }
 
 Mat6 DragBallisticModel::derivativeJacobian(const Vec6& x) const {
   const Eigen::Vector3d v = x.tail<3>();
@@ -86,13 +91,14 @@ Eigen::VectorXd DragBallisticModel::propagate(const Eigen::VectorXd& x0, double 
 
 Vec6 DragBallisticModel::propagateFixed(const Vec6& x0, double dt) const {
   checkStep(*this, x0, dt);
+  const Eigen::Vector3d gv = gravity();  // once per call (derivative() normalises `up` every time)
   Vec6 x = x0;
   const double h = dt / substeps;
   for (int i = 0; i < substeps; ++i) {
-    const Vec6 k1 = derivative(x);
-    const Vec6 k2 = derivative(x + 0.5 * h * k1);
-    const Vec6 k3 = derivative(x + 0.5 * h * k2);
-    const Vec6 k4 = derivative(x + h * k3);
+    const Vec6 k1 = derivativeWith(x, gv, k);
+    const Vec6 k2 = derivativeWith(x + 0.5 * h * k1, gv, k);
+    const Vec6 k3 = derivativeWith(x + 0.5 * h * k2, gv, k);
+    const Vec6 k4 = derivativeWith(x + h * k3, gv, k);
     x += h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
   }
   return x;
@@ -105,31 +111,65 @@ Eigen::MatrixXd DragBallisticModel::jacobian(const Eigen::VectorXd& x0, double d
 }
 
 Mat6 DragBallisticModel::jacobianFixed(const Vec6& x0, double dt) const {
+  Mat6 S;
+  propagateWithJacobianFixed(x0, dt, S);
+  return S;
+}
+
+namespace {
+
+// J(x) S for J = [0 I; 0 D(v)] (derivativeJacobian), without the products by J's zeros and
+// ones: the top rows are S's bottom rows, the bottom rows D S_bottom, each entry summed over
+// the same terms in the same order as the full 6x6 product, which adds only zero products
+// before them. Entries that are not zero are therefore the same doubles; a zero may differ
+// in sign, and only ever reaches S through additions to S, whose zeros are +0 (S starts at the
+// identity and is only added to), so S itself is the same to the bit (estimation_models_test
+// DragBallisticModel.OnePassJacobianIsTheFullProducts).
+Mat6 derivativeJacobianTimes(const Vec6& x, double k, const Mat6& S) {
+  const Eigen::Vector3d v = x.tail<3>();
+  const double speed = v.norm();
+  Mat6 d;
+  d.topRows<3>() = S.bottomRows<3>();
+  if (speed > 0.0) {
+    const Eigen::Matrix3d D = -k * (speed * Eigen::Matrix3d::Identity() + v * v.transpose() / speed);
+    for (int j = 0; j < 6; ++j)
+      for (int i = 0; i < 3; ++i) d(3 + i, j) = D(i, 0) * S(3, j) + D(i, 1) * S(4, j) + D(i, 2) * S(5, j);
+  } else {
+    d.bottomRows<3>().setZero();
+  }
+  return d;
+}
+
+}  // namespace
+
+Vec6 DragBallisticModel::propagateWithJacobianFixed(const Vec6& x0, double dt, Mat6& S) const {
   checkStep(*this, x0, dt);
+  const Eigen::Vector3d gv = gravity();
   Vec6 x = x0;
-  // RK4 on (x, S) with Ṡ = J(x) S: each stage's S-part is the derivative of the x-stage.
-  Mat6 S = Mat6::Identity();
+  // RK4 on (x, S) with Ṡ = J(x) S: each stage's S-part is the derivative of the x-stage. The
+  // x-part is propagateFixed's arithmetic, operation for operation.
+  S = Mat6::Identity();
   const double h = dt / substeps;
   for (int i = 0; i < substeps; ++i) {
     const Vec6 x1 = x;
-    const Vec6 k1 = derivative(x1);
-    const Mat6 d1 = derivativeJacobian(x1) * S;
+    const Vec6 k1 = derivativeWith(x1, gv, k);
+    const Mat6 d1 = derivativeJacobianTimes(x1, k, S);
     const Vec6 x2 = x + 0.5 * h * k1;
     const Mat6 S2 = S + 0.5 * h * d1;
-    const Vec6 k2 = derivative(x2);
-    const Mat6 d2 = derivativeJacobian(x2) * S2;
+    const Vec6 k2 = derivativeWith(x2, gv, k);
+    const Mat6 d2 = derivativeJacobianTimes(x2, k, S2);
     const Vec6 x3 = x + 0.5 * h * k2;
     const Mat6 S3 = S + 0.5 * h * d2;
-    const Vec6 k3 = derivative(x3);
-    const Mat6 d3 = derivativeJacobian(x3) * S3;
+    const Vec6 k3 = derivativeWith(x3, gv, k);
+    const Mat6 d3 = derivativeJacobianTimes(x3, k, S3);
     const Vec6 x4 = x + h * k3;
     const Mat6 S4 = S + h * d3;
-    const Vec6 k4 = derivative(x4);
-    const Mat6 d4 = derivativeJacobian(x4) * S4;
+    const Vec6 k4 = derivativeWith(x4, gv, k);
+    const Mat6 d4 = derivativeJacobianTimes(x4, k, S4);
     x += h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
     S += h / 6.0 * (d1 + 2.0 * d2 + 2.0 * d3 + d4);
   }
-  return S;
+  return x;
 }
 
 Eigen::MatrixXd DragBallisticModel::processNoise(const Eigen::VectorXd& x0, double dt) const {
@@ -142,6 +182,28 @@ Eigen::MatrixXd DragBallisticModel::processNoise(const Eigen::VectorXd& x0, doub
   lin.G.bottomRows(3).setIdentity();
   lin.Qc = q * Eigen::MatrixXd::Identity(3, 3);
   return discretize(lin, dt).Q;
+}
+
+Mat6 DragBallisticModel::processNoiseFixed(const Vec6& x, double dt) const {
+  checkStep(*this, x, dt);  // the checks of processNoise (and discretize: dt > 0, q >= 0) first
+  // discretize() (discretization.cpp) with n = 6, G = [0; I], Qc = q I, on fixed-size storage:
+  // Eigen picks the same product kernels (and blocking) for these sizes, so the bits are those of
+  // the dynamic path (estimation_test DragBallistic.FixedSizeProcessNoiseIsTheDynamicOne).
+  using Mat12 = Eigen::Matrix<double, 12, 12>;
+  const Mat6 A = derivativeJacobian(x);
+  if (!A.allFinite()) core::requireFinite(A, "continuous model A");
+  Eigen::Matrix<double, 6, 3> G = Eigen::Matrix<double, 6, 3>::Zero();
+  G.bottomRows<3>().setIdentity();
+  const Eigen::Matrix3d Qc = q * Eigen::Matrix3d::Identity();
+  Mat12 M = Mat12::Zero();
+  M.topLeftCorner<6, 6>() = -A * dt;
+  M.topRightCorner<6, 6>() = G * Qc * G.transpose() * dt;
+  M.bottomRightCorner<6, 6>() = A.transpose() * dt;
+  const Mat12 E = M.exp();
+  const Mat6 Phi = E.bottomRightCorner<6, 6>().transpose();
+  Mat6 Q = Phi * E.topRightCorner<6, 6>();
+  Q = 0.5 * (Q + Q.transpose()).eval();  // core::symmetrize
+  return Q;
 }
 
 NonlinearTransition DragBallisticModel::transition(double dt, const Eigen::VectorXd& x_lin) const {

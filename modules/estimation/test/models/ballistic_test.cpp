@@ -2,6 +2,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <limits>
 
 #include "monte_carlo.h"
@@ -231,3 +233,100 @@ ConsistencyStats dragMc(double q_scale) {
 
 TEST(DragBallisticModel, MonteCarloNeesConsistent) { expectConsistent(dragMc(1.0)); }
 TEST(DragBallisticModel, TooSmallProcessNoiseDetected) { expectOverconfident(dragMc(0.1)); }
+
+// The planner's fixed-size Van Loan gives the dynamic path's bits (the scenario outputs depend on
+// them), over the durations and speeds of crossing predictions (tau 0-1.5 s, |v| 0-15 m/s: the
+// Padé degrees 3 to 13 and the scaling and squaring of the matrix exponential).
+TEST(DragBallisticModel, FixedSizeProcessNoiseIsTheDynamicOne) {
+  DragBallisticModel m;
+  m.k = 0.02;
+  m.q = 0.02;
+  m.substeps = 2;
+  std::uint64_t state = 7;
+  auto uniform = [&](double lo, double hi) {  // a small LCG: the test needs no distribution
+    state = state * 6364136223846793005ULL + 1442695040888963407ULL;
+    return lo + (hi - lo) * static_cast<double>(state >> 11) / 9007199254740992.0;
+  };
+  for (int k = 0; k < 200; ++k) {
+    Vec6 x;
+    for (int i = 0; i < 3; ++i) x(i) = uniform(-2.0, 2.0);
+    for (int i = 3; i < 6; ++i) x(i) = uniform(-9.0, 9.0);
+    const double dt = k < 10 ? 0.001 * (k + 1) : uniform(0.01, 1.5);
+    const Eigen::MatrixXd dyn = m.processNoise(Eigen::VectorXd(x), dt);
+    const Eigen::Matrix<double, 6, 6> fix = m.processNoiseFixed(x, dt);
+    ASSERT_TRUE(dyn.allFinite());
+    for (int r = 0; r < 6; ++r)
+      for (int c = 0; c < 6; ++c) ASSERT_EQ(fix(r, c), dyn(r, c)) << "case " << k << " (" << r << "," << c << ")";
+  }
+  EXPECT_THROW(m.processNoiseFixed(Vec6::Zero(), 0.0), core::InvalidInput);
+  EXPECT_THROW(m.processNoiseFixed(Vec6::Constant(kNaN), 0.1), core::InvalidInput);
+}
+
+namespace {
+// The variational RK4 step with the full products J(x) S (derivativeJacobian), as the one-pass
+// propagation's reference.
+Vec6 referenceStepWithJacobian(const DragBallisticModel& m, const Vec6& x0, double dt, Eigen::Matrix<double, 6, 6>& S) {
+  using Mat6 = Eigen::Matrix<double, 6, 6>;
+  Vec6 x = x0;
+  S = Mat6::Identity();
+  const double h = dt / m.substeps;
+  for (int i = 0; i < m.substeps; ++i) {
+    const Vec6 x1 = x;
+    const Vec6 k1 = m.derivative(x1);
+    const Mat6 d1 = m.derivativeJacobian(x1) * S;
+    const Vec6 x2 = x + 0.5 * h * k1;
+    const Mat6 S2 = S + 0.5 * h * d1;
+    const Vec6 k2 = m.derivative(x2);
+    const Mat6 d2 = m.derivativeJacobian(x2) * S2;
+    const Vec6 x3 = x + 0.5 * h * k2;
+    const Mat6 S3 = S + 0.5 * h * d2;
+    const Vec6 k3 = m.derivative(x3);
+    const Mat6 d3 = m.derivativeJacobian(x3) * S3;
+    const Vec6 x4 = x + h * k3;
+    const Mat6 S4 = S + h * d3;
+    const Vec6 k4 = m.derivative(x4);
+    const Mat6 d4 = m.derivativeJacobian(x4) * S4;
+    x += h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
+    S += h / 6.0 * (d1 + 2.0 * d2 + 2.0 * d3 + d4);
+  }
+  return x;
+}
+
+std::uint64_t bitsOf(double v) {
+  std::uint64_t b = 0;
+  std::memcpy(&b, &v, sizeof b);
+  return b;
+}
+}  // namespace
+
+// propagateWithJacobianFixed skips J's zero and unit products: the same bits as the full products
+// (signed zeros included) and as propagateFixed / jacobianFixed, at rest and in flight.
+TEST(DragBallisticModel, OnePassJacobianIsTheFullProducts) {
+  DragBallisticModel m;
+  m.k = 0.02;
+  m.up = Eigen::Vector3d(0.1, 0.2, 1.0);
+  std::uint64_t state = 11;
+  auto uniform = [&](double lo, double hi) {
+    state = state * 6364136223846793005ULL + 1442695040888963407ULL;
+    return lo + (hi - lo) * static_cast<double>(state >> 11) / 9007199254740992.0;
+  };
+  for (int k = 0; k < 300; ++k) {
+    m.substeps = 1 + k % 5;
+    Vec6 x;
+    for (int i = 0; i < 6; ++i) x(i) = k % 10 == 0 && i >= 3 ? 0.0 : uniform(-9.0, 9.0);  // some at rest
+    const double dt = uniform(0.001, 1.0);
+    Eigen::Matrix<double, 6, 6> S, S_ref;
+    const Vec6 xe = m.propagateWithJacobianFixed(x, dt, S);
+    const Vec6 x_ref = referenceStepWithJacobian(m, x, dt, S_ref);
+    const Vec6 x_prop = m.propagateFixed(x, dt);
+    const Eigen::Matrix<double, 6, 6> J = m.jacobianFixed(x, dt);
+    for (int r = 0; r < 6; ++r) {
+      ASSERT_EQ(bitsOf(xe(r)), bitsOf(x_ref(r))) << "case " << k;
+      ASSERT_EQ(bitsOf(xe(r)), bitsOf(x_prop(r))) << "case " << k;
+      for (int c = 0; c < 6; ++c) {
+        ASSERT_EQ(bitsOf(S(r, c)), bitsOf(S_ref(r, c))) << "case " << k << " (" << r << "," << c << ")";
+        ASSERT_EQ(bitsOf(J(r, c)), bitsOf(S_ref(r, c))) << "case " << k;
+      }
+    }
+  }
+}

@@ -220,7 +220,7 @@ public:
   /// How many late measurements were inserted into the buffer (and the later ones re-processed).
   std::size_t lateInserted() const { return late_inserted_; }
   /// Measurements kept in the late-data buffer.
-  std::size_t bufferSize() const { return buffer_.size(); }
+  std::size_t bufferSize() const { return count_; }
   /// The update of the image the last submit() processed (as it was processed then: a later
   /// restart or late insertion may change its outcome); empty when that image was refused.
   const std::optional<ImageUpdate>& lastUpdate() const { return last_update_; }
@@ -257,7 +257,13 @@ private:
   void refitConfirmed(TrackState& ts) const;
   /// Restart of a confirmed track under the robust start: tentative again over its newest images.
   void restartTentative(TrackState& ts);
-  void evict(const MeasurementOutcome& o) { final_[o.m.id] = o; }
+  void evict(const MeasurementOutcome& o);
+  /// Late-data buffer entry i (0: the oldest) in the ring.
+  Entry& entry(std::size_t i) { return ring_[(head_ + i) % ring_.size()]; }
+  /// Late-data buffer entry i (0: the oldest) in the ring.
+  const Entry& entry(std::size_t i) const { return ring_[(head_ + i) % ring_.size()]; }
+  /// Appends (m, s) to the buffer, copying into a free slot's storage when there is one.
+  void pushEntry(const ImageMeasurement& m, const TrackState& s);
   core::Timestamp sampleTime(core::Timestamp t) const;
 
   std::vector<core::Camera> cameras_;
@@ -265,8 +271,11 @@ private:
   TrackState fresh_;  ///< no track yet (what reset() returns to)
   TrackState state_;
   std::optional<ImageUpdate> last_update_;
-  std::deque<Entry> buffer_;
-  std::unordered_map<std::uint64_t, MeasurementOutcome> final_;
+  // The late-data buffer: a ring whose slots keep their storage (a new entry copy-assigns into
+  // a slot an old one left, so the steady state does not allocate); count_ entries from head_.
+  std::vector<Entry> ring_;
+  std::size_t head_ = 0, count_ = 0;
+  std::vector<MeasurementOutcome> final_;  ///< outcomes that left the history, sorted by id
   std::array<std::size_t, static_cast<std::size_t>(Refusal::kCount)> refusals_{};
   bool any_ = false;
   core::Timestamp newest_ = 0.0;

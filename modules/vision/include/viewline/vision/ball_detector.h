@@ -93,6 +93,13 @@ struct BallMeasurement : Measurement {
   Eigen::Vector2d blob_center = Eigen::Vector2d::Zero();  ///< contour centroid (px)
 };
 
+/// One step of a morphological opening or closing: the erosion (erode = true) or dilation of a
+/// single-channel 8-bit image `src` by the non-zero entries of `kernel` (anchor at its centre),
+/// the outside of the image neutral (255 for the erosion, 0 for the dilation): cv::erode /
+/// cv::dilate with their default border, value for value, into `dst` (not `src`), with no heap
+/// allocation once `dst` has src's size (OpenCV builds a filter engine on every call).
+void morphologyStep(const cv::Mat& src, cv::Mat& dst, const cv::Mat& kernel, bool erode);
+
 /// Colour-blob ball detector with sub-pixel centre, covariance from the edge noise and an optional search window.
 class BallDetector {
 public:
@@ -121,7 +128,7 @@ private:
   BallDetectorConfig config_;
   std::optional<core::Camera> camera_;
   cv::Mat open_kernel_, close_kernel_;
-  cv::Mat hsv_, mask_;  // reused buffers
+  cv::Mat hsv_, mask_, morph_;  // reused buffers (morph_: between the opening's / closing's two steps)
   std::vector<std::vector<cv::Point>> contours_;
   std::vector<std::vector<cv::Point>> kept_;  // candidates' contours (capacity reused)
   std::size_t kept_count_ = 0;

@@ -58,6 +58,13 @@ struct DragBallisticModel {
   Eigen::Matrix<double, 6, 1> propagateFixed(const Eigen::Matrix<double, 6, 1>& x, double dt) const;
   /// jacobian() on a fixed-size state: the same arithmetic and checks, no heap allocation.
   Eigen::Matrix<double, 6, 6> jacobianFixed(const Eigen::Matrix<double, 6, 1>& x, double dt) const;
+  /// propagateFixed(x, dt), and its Jacobian jacobianFixed(x, dt) into S, in one pass (the same
+  /// bits as the two calls: the variational equations already carry the mean).
+  Eigen::Matrix<double, 6, 1> propagateWithJacobianFixed(const Eigen::Matrix<double, 6, 1>& x, double dt,
+                                                         Eigen::Matrix<double, 6, 6>& S) const;
+  /// processNoise() on fixed-size matrices (Van Loan on a 12x12 matrix exponential, m², m²/s, m²/s²):
+  /// the same arithmetic, no heap allocation (the planner's crossing covariance on every update).
+  Eigen::Matrix<double, 6, 6> processNoiseFixed(const Eigen::Matrix<double, 6, 1>& x, double dt) const;
   /// f, F and Q (Q linearised at x_lin, normally the current estimate) for dt > 0.
   NonlinearTransition transition(double dt, const Eigen::VectorXd& x_lin) const;
   /// Throws core::InvalidInput naming the field (up, g, k, q, substeps).

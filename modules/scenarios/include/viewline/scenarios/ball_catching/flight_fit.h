@@ -101,7 +101,11 @@ private:
   Eigen::Matrix<double, 3, 2> E_ = Eigen::Matrix<double, 3, 2>::Zero();  ///< in-plane basis of the aim plane
   std::vector<core::Camera> cams_;
   estimation::DragBallisticModel model_;
+  /// Images reserved for at first: a throw's track (2 cameras at 50 Hz for under 1 s) fits, so
+  /// the steady state does not allocate; a longer track grows the vector.
+  static constexpr std::size_t kReservedImages = 256;
   std::vector<FitImage> images_;  ///< sorted by stamp
+  std::vector<unsigned char> camera_seen_;  ///< per camera: has an image in the fit (add's scratch)
   std::optional<Eigen::Matrix<double, 6, 1>> x_ref_;  ///< state at images_.front().t
   Eigen::Matrix<double, 6, 6> H_ = Eigen::Matrix<double, 6, 6>::Zero();
 };
