@@ -121,7 +121,7 @@ struct BallCatchingConfig {
   bool render_box = true;            ///< draw the box in the images (it can occlude the ball)
   robots::SimulatedCartesianConfig robot;   ///< kind, limits, latency, home, workspace, arm geometry (w_R_box from box_normal)
   double control_period = 0.004;     ///< s between set points (250 Hz)
-  double processing_latency = 0.008; ///< s from capture to the tracker/planner update
+  double processing_latency = 0.0025; ///< s from capture to the tracker/planner update
   double post_crossing_s = 0.05;     ///< s simulated after the true crossing
   double prediction_lead_s = 0.2;    ///< the early-prediction metric uses the last prediction this long before the crossing
   vision::BallDetectorConfig detector;  ///< colour segmentation of the ball in every frame
