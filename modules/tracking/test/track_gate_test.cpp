@@ -67,6 +67,40 @@ TEST(TrackGate, RejectionsAreCountedPerSource) {
   EXPECT_THROW(g.decide(0.4, 1.0, 2), core::InvalidInput);
 }
 
+TEST(TrackGate, ARunOfOneSourceIsOutvotedByTwoOtherSourcesThatAgree) {
+  TrackGate g(2, {0.99, 2}, 4);  // outvoted_by 2 (default)
+  g.decide(0.0, 0.0, 0);
+  EXPECT_EQ(g.decide(0.1, 100.0, 3), GateDecision::Reject);  // source 3's run begins
+  EXPECT_EQ(g.decide(0.2, 1.0, 0), GateDecision::Accept);    // one other source agrees...
+  EXPECT_EQ(g.decide(0.3, 1.0, 1), GateDecision::Accept);    // ...and a second one
+  EXPECT_EQ(g.decide(0.4, 100.0, 3), GateDecision::Reject);  // outvoted: the track stays
+  EXPECT_EQ(g.counts().outvoted, 1u);
+  EXPECT_EQ(g.counts().restarts, 0u);
+  EXPECT_EQ(g.decide(0.5, 100.0, 3), GateDecision::Reject);  // still outvoted (the run goes on)
+  // Accepts that came before the run do not vote: a new run of source 2 with no agreement since.
+  EXPECT_EQ(g.decide(0.6, 100.0, 2), GateDecision::Reject);
+  EXPECT_EQ(g.decide(0.7, 100.0, 2), GateDecision::Restart);
+  EXPECT_EQ(g.counts().restarts, 1u);
+}
+
+TEST(TrackGate, OneAgreeingSourceDoesNotOutvoteAndZeroTurnsOutvotingOff) {
+  TrackGate one(2, {0.99, 2}, 4);
+  one.decide(0.0, 0.0, 0);
+  EXPECT_EQ(one.decide(0.1, 100.0, 3), GateDecision::Reject);
+  EXPECT_EQ(one.decide(0.2, 1.0, 0), GateDecision::Accept);  // only one other view agrees
+  EXPECT_EQ(one.decide(0.3, 100.0, 3), GateDecision::Restart);
+  tracking::TrackGateConfig off{0.99, 2};
+  off.outvoted_by = 0;
+  TrackGate g(2, off, 4);
+  g.decide(0.0, 0.0, 0);
+  g.decide(0.1, 100.0, 3);
+  g.decide(0.2, 1.0, 0);
+  g.decide(0.3, 1.0, 1);
+  EXPECT_EQ(g.decide(0.4, 100.0, 3), GateDecision::Restart);
+  off.outvoted_by = -1;
+  EXPECT_THROW(TrackGate(2, off, 4), core::InvalidInput);
+}
+
 TEST(TrackGate, AcceptanceRateOfConsistentInnovationsIsTheGateProbability) {
   // Innovations drawn from N(0, I2) have NIS ~ chi-square(2): the gate accepts a fraction p.
   TrackGate g(2, {0.95, 1000000});

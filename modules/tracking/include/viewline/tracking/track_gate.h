@@ -49,6 +49,11 @@ struct TrackGateConfig {
   double probability = 0.999;
   int restart_after = 3;       ///< rejections in a row (of one source) that restart the track, >= 1
   double max_coast_s = std::numeric_limits<double>::infinity();  ///< > 0; inf: a track never goes stale
+  /// A source's run of rejections does not restart the track while at least this many OTHER sources
+  /// had a measurement accepted during the run (0: never outvoted). Two other views that agree with
+  /// the track triangulate it: the one that disagrees is biased (an unregistered camera), not the
+  /// track. With two sources or fewer the default changes nothing.
+  int outvoted_by = 2;
   void validate(const char* what = "gate") const;  ///< throws core::InvalidInput naming `what`
 };
 
@@ -57,7 +62,8 @@ struct GateCounts {
   std::uint64_t starts = 0,    ///< Start decisions
                 accepted = 0,  ///< Accept decisions
                 rejected = 0,  ///< Reject decisions
-                restarts = 0;  ///< Restart decisions
+                restarts = 0,  ///< Restart decisions
+                outvoted = 0;  ///< Reject decisions that would have restarted the track but were outvoted
   /// Every decision counted.
   std::uint64_t total() const { return starts + accepted + rejected + restarts; }
 };
@@ -95,6 +101,9 @@ private:
   TrackGateConfig config_;
   double threshold_;
   std::vector<int> rejected_;
+  std::vector<std::uint64_t> run_start_;    // per source: the decision that began its run of rejections
+  std::vector<std::uint64_t> last_accept_;  // per source: its last accepted decision in this track (0: none)
+  std::uint64_t decisions_ = 0;             // decisions since construction (1, 2, ...)
   bool active_ = false;
   double last_used_t_ = 0.0;
   GateCounts counts_;

@@ -37,7 +37,11 @@
 // camera: a track seeded by an outlier of camera A can keep agreeing with A while B disagrees)
 // the track is judged to have been seeded by a bad measurement: its seed (oldest measurement of
 // the track history) is dropped and a new track is started from the prior and re-fed with the
-// rest of the history and the current image (gated as usual). The state therefore depends only
+// rest of the history and the current image (gated as usual). A camera's run is outvoted, and
+// does not restart the track, when images of at least two other cameras were fused during it
+// (TrackGateConfig::outvoted_by): two agreeing views triangulate the track, so the camera that
+// disagrees is the biased one (e.g. an unregistered camera of a four-camera rig); with one or two
+// cameras this never happens. The state therefore depends only
 // on past measurements (causal), which keeps the late-data replay exact.
 //
 // Robust start (TrackerConfig::start, off by default; track_start.cpp). With confirm_images > 0 a
