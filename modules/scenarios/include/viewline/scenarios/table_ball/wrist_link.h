@@ -14,10 +14,11 @@
 //    (control::TableBalancer::hold) so that its tilt model, and the table pose the observer
 //    predicts from it, follow what the wrist holds.
 //  - The first command accepted after a failure is counted robot_resumed. From then until a
-//    command passes unchanged, a command whose step from the previous one exceeds the wrist's
-//    rate limit (or whose angle exceeds its angle limit) is replaced by a ramp towards it at the
-//    rate limit from the held set point, counted robot_commands_ramped: the wrist is never
-//    commanded outside its limits on resuming, whatever the loop asks.
+//    command passes unchanged, a command farther from the held set point than the wrist's rate
+//    limit allows since the previous command (or outside its angle limit) is replaced by the
+//    step towards it at the rate limit, counted robot_commands_ramped: the wrist is never
+//    commanded outside its limits on resuming, whatever the loop asks (the table-ball loop
+//    itself resumes from the held tilt, so it needs none).
 //
 // Without robot faults every command goes straight to the wrist, unchanged.
 
