@@ -126,6 +126,14 @@ void TableBalancer::reset(const Eigen::Vector2d& tilt) {
   phi_cmd_ = phi;
 }
 
+void TableBalancer::hold(const Eigen::Vector2d& tilt) {
+  core::requireFinite(tilt, "TableBalancer::hold: tilt");
+  const Eigen::Vector2d phi(tilt.y(), -tilt.x());
+  z_.row(kPhi) = phi.transpose();
+  z_.bottomRows(nz_ - kBuf).setZero();  // no input in flight: the refused ramps never started
+  phi_cmd_ = phi;
+}
+
 Eigen::Vector2d TableBalancer::commandedTilt() const { return {-phi_cmd_.y(), phi_cmd_.x()}; }
 Eigen::Vector2d TableBalancer::modelTilt() const { return {-z_(kPhi, 1), z_(kPhi, 0)}; }
 

@@ -123,3 +123,31 @@ TEST(TableBalancer, RejectsBadConfig) {
   EXPECT_THROW(ok.update(0.0, Eigen::Vector2d(NAN, 0.0), Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero()),
                viewline::core::InvalidInput);
 }
+
+// A wrist that did not take the last ramps holds its tilt: after hold() the model's tilt and the
+// next ramp's start are that tilt (no step for the wrist), the next ramp stays within the limits,
+// and the integral is kept (frozen), not reset.
+TEST(TableBalancer, HoldPutsTheHeldTiltIntoTheModelAndKeepsTheIntegral) {
+  TableBalancerConfig cfg;
+  cfg.q_integral = 200.0;
+  cfg.delay = 0.03;
+  TableBalancer ctl(cfg);
+  // 0.01 m off the set point, inside integral_band: the integral grows over these updates.
+  for (int k = 0; k < 20; ++k) ctl.update(0.02 * k, Eigen::Vector2d(0.01, -0.01), Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero());
+  const Eigen::Vector2d held(0.03, -0.02);
+  ASSERT_GT((ctl.commandedTilt() - held).norm(), 1e-3);  // the refused ramps went elsewhere
+  TableBalancer fresh(cfg);
+  fresh.reset(held);
+  ctl.hold(held);
+  EXPECT_EQ(ctl.modelTilt(), held);
+  EXPECT_EQ(ctl.commandedTilt(), held);
+  const Eigen::Vector2d p(0.01, -0.01), v = Eigen::Vector2d::Zero(), sp = Eigen::Vector2d::Zero();
+  const TiltRamp r = ctl.update(0.4, p, v, sp);
+  EXPECT_EQ(r.start, held);
+  EXPECT_LE(r.rate.cwiseAbs().maxCoeff(), cfg.max_rate);
+  EXPECT_LE(r.end().cwiseAbs().maxCoeff(), cfg.max_angle + 1e-12);
+  // Same state, same tilt, nothing in flight: only the kept integral tells them apart.
+  const TiltRamp rf = fresh.update(0.4, p, v, sp);
+  EXPECT_GT((r.rate - rf.rate).norm(), 1e-6);
+  EXPECT_THROW(ctl.hold(Eigen::Vector2d(NAN, 0.0)), viewline::core::InvalidInput);
+}

@@ -14,6 +14,7 @@
 #include "viewline/runtime/recording.h"
 #include "viewline/runtime/stale_frames.h"
 #include "viewline/scenarios/table_ball/world.h"
+#include "viewline/scenarios/table_ball/wrist_link.h"
 #include "viewline/vision/table_detector.h"
 
 namespace viewline::scenarios {
@@ -163,6 +164,10 @@ TableBallResult runTableBall(const TableBallConfig& cfg, std::uint64_t seed, con
   current.t0 = -1.0;
   current.period = period;
   bool frame_pending = false;
+  // The wrist behind the fault plan (wrist_link.h). wrist_failed: a command failed since the
+  // controller last heard of it (the controller's model must then take the held tilt).
+  WristLink wrist(world.wrist(), faults);
+  bool wrist_failed = false;
   double last_stamp = -std::numeric_limits<double>::infinity();  // of the last frame the loop used
 
   // --- physics: tick k at k · kTick (scheduled from k, not accumulated) -----------------------
@@ -170,9 +175,18 @@ TableBallResult runTableBall(const TableBallConfig& cfg, std::uint64_t seed, con
     const double t = world.time();
     if (!frame_pending && t >= cfg.duration - kTimeTolerance) return;  // past the last frame and the duration
     to_arm.receive(t, [&](double, const control::TiltRamp& r) { current = r; });
-    const Eigen::Vector2d cmd = current.commandAt(t);
+    if (!wrist.send(t, current.commandAt(t))) {
+      // Not taken: the wrist holds its set point, and so does the loop's command (the ramps
+      // planned before the failure assumed it would move; none of them is sent).
+      current = control::TiltRamp{};
+      current.t0 = t;
+      current.start = wrist.held();
+      current.period = period;
+      to_arm.clear();
+      wrist_failed = true;
+    }
+    const Eigen::Vector2d cmd = wrist.lastCommand();
     metrics.command(cmd);
-    world.wrist().command(t, cmd);
     world.step();
     metrics.tick(world.time(), world.state().p);
     if (sink != nullptr && world.ticks() % 5 == 0) sink->command({"wrist", t, cmd});
@@ -229,6 +243,13 @@ TableBallResult runTableBall(const TableBallConfig& cfg, std::uint64_t seed, con
     last_stamp = t;
     const sim::TiltTableState truth = world.stateAt(cap.capture_time);
     const Eigen::Vector2d ref = cfg.setpointAt(t);
+    if (wrist_failed) {
+      // The wrist did not take the ramps since its last accepted set point: the controller's
+      // tilt model (and the nominal table pose below) take the tilt it holds; while it does not
+      // answer the controller is not stepped, so its integral does not grow.
+      controller.hold(wrist.held());
+      wrist_failed = wrist.down();
+    }
     const Eigen::Isometry3d w_M_t_nominal = world.tablePose(controller.modelTilt());
 
     const ObserverFrame* of = nullptr;
@@ -256,7 +277,7 @@ TableBallResult runTableBall(const TableBallConfig& cfg, std::uint64_t seed, con
     }
     metrics.frame(t, truth, *of, observer.tracker(), side);
 
-    if (of->estimate_valid) {
+    if (of->estimate_valid && !wrist.down()) {
       control::TiltRamp ramp = controller.update(t, positionOf(of->x), velocityOf(of->x), ref);
       ramp.t0 = cap.capture_time + cfg.latency;
       to_arm.clear();

@@ -205,6 +205,29 @@ void TableBallMetrics::scoreEvents(TableBallResult& res) const {
     m.recovery_s = last_out >= t_end - 2.0 * kTick ? kInf : last_out - p.t;
     res.pushes.push_back(m);
   }
+  const double on_border = 0.5 * cfg_.table_side - cfg_.ball_radius - 1e-9;  // the physics clamps the centre there
+  for (const runtime::FaultSpec& f : cfg_.faults.faults) {
+    if (f.kind != runtime::FaultKind::RobotSilent && f.kind != runtime::FaultKind::RobotLimitError) continue;
+    if (f.from_s >= cfg_.duration) continue;
+    const double t_end = windowEnd(f.from_s);
+    RobotFaultMetrics m;
+    m.kind = runtime::toString(f.kind);
+    m.from_s = f.from_s;
+    m.to_s = f.to_s;
+    double last_out = f.to_s;
+    bool out_at_end = false;
+    for (std::size_t k = idx(f.from_s); k < tick_t_.size() && tick_t_[k] < t_end - 1e-9; ++k) {
+      const double e = (tick_p_[k] - cfg_.setpointAt(tick_t_[k])).norm();
+      m.peak_excursion_mm = std::max(m.peak_excursion_mm, 1000.0 * e);
+      m.border_contact = m.border_contact || tick_p_[k].cwiseAbs().maxCoeff() >= on_border;
+      if (tick_t_[k] >= f.to_s && e > cfg_.push_band) {
+        last_out = tick_t_[k];
+        out_at_end = last_out >= t_end - 2.0 * kTick;
+      }
+    }
+    m.resettle_s = out_at_end || f.to_s >= t_end ? kInf : last_out - f.to_s;
+    res.robot_faults.push_back(m);
+  }
   auto worst = [](const auto& v, auto field) {
     double w = v.empty() ? kNaN : -kInf;
     for (const auto& e : v) w = std::max(w, std::isnan(e.*field) ? kInf : e.*field);
@@ -278,6 +301,14 @@ nlohmann::json toJson(const TableBallResult& r) {
                       {"peak_excursion_mm", num(p.peak_excursion_mm)}});
   }
   j["pushes"] = pushes;
+  if (!r.robot_faults.empty()) {  // only with robot faults in the config
+    nlohmann::json rf = nlohmann::json::array();
+    for (const auto& m : r.robot_faults) {
+      rf.push_back({{"kind", m.kind}, {"from_s", m.from_s}, {"to_s", m.to_s}, {"peak_excursion_mm", m.peak_excursion_mm},
+                    {"resettle_s", num(m.resettle_s)}, {"border_contact", m.border_contact}});
+    }
+    j["robot_faults"] = rf;
+  }
   j["wall_seconds"] = r.wall_seconds;
   if (!r.faults.empty()) j["faults"] = runtime::toJson(r.faults);  // only with injected faults
   return j;
@@ -367,6 +398,13 @@ void printTableBallSummary(std::FILE* out, const TableBallResult& r, const Table
                r.max_commanded_angle_deg, r.max_commanded_rate_deg_s, r.limits_respected ? "respected" : "VIOLATED",
                r.wall_seconds);
   if (!r.faults.empty()) std::fprintf(out, "  %s\n", runtime::summaryLine(r.faults).c_str());
+  for (const auto& m : r.robot_faults) {
+    const std::string back =
+        std::isinf(m.resettle_s) ? "never (before the next event)" : "after " + f(m.resettle_s, 2, "?") + " s";
+    std::fprintf(out, "  %s %.3f-%.3f s: largest |p - set point| %.1f mm, back within %.0f mm %s\n", m.kind.c_str(),
+                 m.from_s, m.to_s, m.peak_excursion_mm, 1000.0 * cfg.push_band, back.c_str());
+    if (m.border_contact) std::fprintf(out, "    the ball reached a border\n");
+  }
 }
 
 }  // namespace viewline::scenarios

@@ -28,6 +28,11 @@
 // ramp's end inside ±max_angle: |φ_k + T u_k| <= max_angle. The internal tilt φ and the
 // inputs in flight are propagated with the *applied* (clipped) inputs, so the model stays
 // true after saturation.
+//
+// A wrist that does not take commands (it stops answering, or refuses them with a limit error)
+// holds its last accepted tilt: hold() puts that tilt into the model in place of what the
+// refused ramps would have done, so the next ramp starts from where the wrist is, and the
+// integral does not grow on an error the controller cannot act on.
 
 #include <Eigen/Core>
 
@@ -74,6 +79,11 @@ public:
 
   /// Forget the integral and the inputs in flight; the table is at rest at `tilt` (θx, θy).
   void reset(const Eigen::Vector2d& tilt = Eigen::Vector2d::Zero());
+
+  /// The wrist did not take the ramps since the last accepted command and holds `tilt` (θx, θy),
+  /// rad: the model's tilt and commanded tilt become `tilt`, the inputs in flight zero; the
+  /// integral is kept as it is (frozen while the loop does not call update()).
+  void hold(const Eigen::Vector2d& tilt);
 
   /// Augmented per-axis model (z as in the file comment) and the LQR gain (1 x nz).
   const Eigen::MatrixXd& A() const { return A_; }

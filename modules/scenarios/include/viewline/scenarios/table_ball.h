@@ -48,6 +48,10 @@
 //     event. The summary reports the worst step.
 //   push_recovery_s         time after a push until |p − ref| stays within `push_band`
 //                           (worst push).
+//   robot_faults            (only with robot_silent / robot_limit_error faults) per window:
+//                           the largest |p − ref| from its start, the time from its end until
+//                           |p − ref| stays within `push_band`, and whether the ball reached a
+//                           border, up to the next event (scenarios/table_ball/wrist_link.h).
 //   nis_sampled             the filter's NIS every `nis_spacing` s (2 dof; the measurement errors
 //                           decorrelate within about 5 frames) against its two-sided 99 % band
 //   nees_position_velocity  (p, v) error against the truth in units of the filter's covariance

@@ -1,11 +1,15 @@
 #pragma once
 // The table-ball closed loop on one runtime::Scheduler (timing in table_ball.h):
 //
-//   physics tick     every 1 ms at k · kTick: the wrist takes the interpolated ramp command,
-//                    the table and ball advance one tick
+//   physics tick     every 1 ms at k · kTick: the wrist takes the interpolated ramp command
+//                    (through WristLink: a robot fault makes it hold its tilt, the loop then
+//                    holds its command and drops the ramps planned before), the table and ball
+//                    advance one tick
 //   frame ready      capture_time + exposure / 2 (RenderedHeadCamera): detection, observer,
 //                    side filters, metrics, controller; the new tilt ramp goes down a
-//                    DelayLine to the arm, available at capture_time + latency
+//                    DelayLine to the arm, available at capture_time + latency. After a failed
+//                    wrist command the controller's model takes the held tilt
+//                    (TableBalancer::hold); while the wrist does not answer it is not stepped
 //
 // At equal times a frame runs before a physics tick: the frame shows the world up to its ready
 // time, and a tick starting there simulates what comes after.

@@ -34,6 +34,18 @@ struct PushMetrics {
   double recovery_s = 0.0;        ///< +inf when it never recovers in its window
   double peak_excursion_mm = 0.0;  ///< largest |p − set point| in the push's window, mm
 };
+/// One robot fault window (robot_silent, robot_limit_error in the config's `faults:`), scored
+/// on the ball's true path up to the next event (set-point change or push) or the run's end.
+struct RobotFaultMetrics {
+  std::string kind;                ///< "robot_silent" or "robot_limit_error"
+  double from_s = 0.0;             ///< start of the window, s
+  double to_s = 0.0;               ///< end of the window, s
+  double peak_excursion_mm = 0.0;  ///< largest |p − set point| from the window's start, mm
+  /// From the window's end until |p − set point| <= push_band for good, s (0: within it
+  /// already; +inf: not within it before the next event).
+  double resettle_s = 0.0;
+  bool border_contact = false;  ///< the ball reached a border (|p_i| = L/2 − r) from the window's start
+};
 
 /// The figures of one run (definitions in table_ball.h): counts, observer and prediction errors,
 /// step and push responses, timing and command limits. NaN: not scored.
@@ -63,6 +75,8 @@ struct TableBallResult {
   estimation::ConsistencyStats nees;
   std::vector<StepMetrics> steps;    ///< every scored step, in time order
   std::vector<PushMetrics> pushes;   ///< every scored push, in time order
+  /// Every robot fault window of the config that starts within the run (empty without them).
+  std::vector<RobotFaultMetrics> robot_faults;
   double overshoot_pct = 0.0,          ///< worst step overshoot, %
          settling_time_s = 0.0,        ///< worst step settling time, s (+inf: one never settled)
          settling_time_2d_s = 0.0,     ///< worst step 2-D settling time, s (+inf: one never settled)
