@@ -376,7 +376,7 @@ CatchFootageSummary runCatchFootage(const BallCatchingConfig& cfg, std::uint64_t
   // period of the fastest camera.
   std::optional<runtime::ProcessingTimer> timer;
   double rate = 0.0;
-  for (std::size_t i = 0; i < cfg.activeCameras(); ++i) rate = std::max(rate, cfg.cameras[i].rate_hz);
+  for (std::size_t i = 0; i < cfg.activeCameras(); ++i) rate = std::max(rate, cfg.throwRate(i));
   char origin[96];
   std::snprintf(origin, sizeof origin, "one frame period at %.4g fps (the fastest camera's rate_hz)", rate);
   if (source.live()) timer.emplace(1.0 / rate, clock);

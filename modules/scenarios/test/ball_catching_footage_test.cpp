@@ -34,8 +34,9 @@ namespace {
 constexpr int kThrows = 2;
 constexpr std::uint64_t kSeed = 1;  // both throws reachable, neither given up in the simulated run
 constexpr double kPause = 1.5;  // s between the end of a throw's footage and the next one (> max_coast_s)
-// The registration renders its own frames and needs the marker in them: off, as on footage.
-const std::vector<std::string> kSim = {"registration.enabled=false"};
+// The registration renders its own frames and needs the marker in them: off, as on footage; the
+// cameras at 25 Hz keep the rendering short.
+const std::vector<std::string> kSim = {"registration.enabled=false", "rate_override_hz=25"};
 
 struct Footage {
   fs::path dir;
@@ -96,7 +97,7 @@ Footage makeFootage() {
       const cv::Mat image = cv::imread((throw_dir / e.file).string(), cv::IMREAD_COLOR);
       if (!videos[c].isOpened())
         videos[c].open((f.dir / ("cam" + std::to_string(c) + ".mkv")).string(), cv::CAP_FFMPEG,
-                       cv::VideoWriter::fourcc('F', 'F', 'V', '1'), 50.0, image.size());
+                       cv::VideoWriter::fourcc('F', 'F', 'V', '1'), 25.0, image.size());
       EXPECT_TRUE(videos[c].isOpened()) << "OpenCV's FFmpeg back end cannot write FFV1";
       videos[c].write(image);
       ++f.frames[c];
@@ -209,7 +210,7 @@ TEST_F(BallCatchingFootage, PacedFootageReportsItsProcessingTimes) {
     void sleepUntil(double until) override { t = std::max(t, until); }
   } clock;
   std::vector<std::string> sets = footage_->image_sets;
-  for (std::size_t c = 0; c < sets.size(); ++c) sets.push_back("cameras[" + std::to_string(c) + "].source.pace=true");
+  for (std::size_t c = 0; c < footage_->image_sets.size(); ++c) sets.push_back("cameras[" + std::to_string(c) + "].source.pace=true");
   const auto cfg = configWith(sets);
   const auto s = scenarios::runCatchFootage(cfg, kSeed, {}, &clock);
   ASSERT_TRUE(s.live.has_value());
