@@ -50,6 +50,8 @@ int main(int argc, char** argv) {
     if (cfg.onFootage()) {
       // One session over the cameras' footage: no throws to count, nothing to record or replay.
       if (cli.count("--throws") > 0) throw core::InvalidInput("--throws: footage runs as one session");
+      if (cli.count("--realtime") > 0)
+        throw core::InvalidInput("--realtime: footage is paced by its source (cameras[].source.pace: true)");
       io::LogDirectory log(opt.log_dir);
       if (log.enabled()) hooks.telemetry = scenarios::csvTelemetry(opt.log_dir);
       std::unique_ptr<viz::BallCatchingDisplay> view;
