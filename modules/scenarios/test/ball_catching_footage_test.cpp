@@ -36,7 +36,8 @@ constexpr std::uint64_t kSeed = 1;  // both throws reachable, neither given up i
 constexpr double kPause = 1.5;  // s between the end of a throw's footage and the next one (> max_coast_s)
 // The registration renders its own frames and needs the marker in them: off, as on footage; the
 // cameras at 25 Hz keep the rendering short.
-const std::vector<std::string> kSim = {"registration.enabled=false", "rate_override_hz=25"};
+const std::vector<std::string> kSim = {"registration.enabled=false", "rate_override_hz=25", "cameras[0].blur_samples=1",
+                                       "cameras[1].blur_samples=1"};
 
 struct Footage {
   fs::path dir;
@@ -61,8 +62,8 @@ void writeText(const fs::path& file, const std::string& text) {
   ASSERT_TRUE(out.good()) << file;
 }
 
-// Renders and records the throws, then writes each camera's frames as an image sequence and as a
-// video, both with a stamps file on the session's clock.
+// Renders and records the throws, then writes each camera's frames as an image sequence with a
+// stamps file on the session's clock (and the stamps of the videos writeVideos() makes).
 Footage makeFootage() {
   Footage f;
   f.dir = fs::path(testing::TempDir()) / ("viewline_bc_footage_" + std::to_string(::getpid()));
@@ -74,7 +75,6 @@ Footage makeFootage() {
   const std::size_t cameras = cfg.activeCameras();
   f.frames.assign(cameras, 0);
   std::vector<std::string> image_stamps(cameras, "index,stamp\n"), video_stamps(cameras, "index,stamp\n");
-  std::vector<cv::VideoWriter> videos(cameras);
   double end = 0.0;  // last stamp so far on the footage clock
   for (int k = 0; k < kThrows; ++k) {
     const double offset = k == 0 ? 0.0 : end + kPause;
@@ -94,18 +94,11 @@ Footage makeFootage() {
       std::snprintf(line, sizeof line, "%zu,%.17g\n", f.frames[c], e.stamp + offset);
       image_stamps[c] += line;
       video_stamps[c] += line;  // video frame n is image n
-      const cv::Mat image = cv::imread((throw_dir / e.file).string(), cv::IMREAD_COLOR);
-      if (!videos[c].isOpened())
-        videos[c].open((f.dir / ("cam" + std::to_string(c) + ".mkv")).string(), cv::CAP_FFMPEG,
-                       cv::VideoWriter::fourcc('F', 'F', 'V', '1'), 25.0, image.size());
-      EXPECT_TRUE(videos[c].isOpened()) << "OpenCV's FFmpeg back end cannot write FFV1";
-      videos[c].write(image);
       ++f.frames[c];
       end = std::max(end, e.stamp + offset);
     }
   }
   for (std::size_t c = 0; c < cameras; ++c) {
-    videos[c].release();
     const std::string cam = "cam" + std::to_string(c);
     writeText(f.dir / cam / "stamps.csv", image_stamps[c]);
     writeText(f.dir / (cam + "_stamps.csv"), video_stamps[c]);
@@ -116,6 +109,24 @@ Footage makeFootage() {
                            ", stamps: " + (f.dir / (cam + "_stamps.csv")).string() + "}");
   }
   return f;
+}
+
+// Each camera's image sequence as an FFV1 video (lossless) beside it (frame n = image n).
+void writeVideos(const Footage& f) {
+  for (std::size_t c = 0; c < f.frames.size(); ++c) {
+    const std::string cam = "cam" + std::to_string(c);
+    cv::VideoWriter video;
+    for (std::size_t n = 0; n < f.frames[c]; ++n) {
+      char name[32];
+      std::snprintf(name, sizeof name, "image.%04zu.png", n);
+      const cv::Mat image = cv::imread((f.dir / cam / name).string(), cv::IMREAD_COLOR);
+      if (!video.isOpened())
+        video.open((f.dir / (cam + ".mkv")).string(), cv::CAP_FFMPEG, cv::VideoWriter::fourcc('F', 'F', 'V', '1'), 25.0,
+                   image.size());
+      ASSERT_TRUE(video.isOpened()) << "OpenCV's FFmpeg back end cannot write FFV1";
+      video.write(image);
+    }
+  }
 }
 
 class BallCatchingFootage : public testing::Test {
@@ -193,61 +204,67 @@ TEST_F(BallCatchingFootage, ImageSequencesGiveTheSimulatedThrowsTargets) {
   EXPECT_EQ(j.at("truth"), "not scored (the frame source has no truth)");
   EXPECT_NE(scenarios::footageSummaryText(s, cfg).find("not scored: no truth"), std::string::npos);
   EXPECT_FALSE(j.contains("live"));  // unpaced files: no live figures
-}
 
-TEST_F(BallCatchingFootage, VideosPerCameraPredictTheCrossings) {
-  const auto cfg = configWith(footage_->video_sets);
-  const auto s = scenarios::runCatchFootage(cfg, kSeed);
-  checkSession(s, cfg, 30.0, -1.0);
-}
-
-TEST_F(BallCatchingFootage, PacedFootageReportsItsProcessingTimes) {
-  // Played as live cameras on a clock that is never waited on (the test's own): no frame arrives
-  // before the loop asks for it, so none is dropped, and every frame is timed.
+  // The same footage played as live cameras on a clock that is never waited on (the test's own):
+  // no frame arrives before the loop asks for it, so none is dropped, and every frame is timed.
   struct InstantClock : runtime::WallClock {
     double t = 0.0;
     double now() const override { return t; }
     void sleepUntil(double until) override { t = std::max(t, until); }
   } clock;
   std::vector<std::string> sets = footage_->image_sets;
-  for (std::size_t c = 0; c < footage_->image_sets.size(); ++c) sets.push_back("cameras[" + std::to_string(c) + "].source.pace=true");
-  const auto cfg = configWith(sets);
-  const auto s = scenarios::runCatchFootage(cfg, kSeed, {}, &clock);
-  ASSERT_TRUE(s.live.has_value());
-  EXPECT_EQ(s.live->processed, s.frames);
-  EXPECT_EQ(s.live->dropped, 0u);
-  EXPECT_EQ(s.frames, footage_->frames[0] + footage_->frames[1]);
-  EXPECT_TRUE(scenarios::footageSummaryJson(s, cfg).contains("live"));
+  for (std::size_t c = 0; c < footage_->image_sets.size(); ++c)
+    sets.push_back("cameras[" + std::to_string(c) + "].source.pace=true");
+  const auto paced_cfg = configWith(sets);
+  const auto paced = scenarios::runCatchFootage(paced_cfg, kSeed, {}, &clock);
+  ASSERT_TRUE(paced.live.has_value());
+  EXPECT_EQ(paced.live->processed, paced.frames);
+  EXPECT_EQ(paced.live->dropped, 0u);
+  EXPECT_EQ(paced.frames, footage_->frames[0] + footage_->frames[1]);
+  EXPECT_TRUE(scenarios::footageSummaryJson(paced, paced_cfg).contains("live"));
+  ASSERT_EQ(paced.tracks.size(), s.tracks.size());
+  EXPECT_EQ(paced.tracks[1].target->p, s.tracks[1].target->p);  // pacing changes when, never what
 }
 
-TEST_F(BallCatchingFootage, AMissingFileOrABadPatternIsNamed) {
-  const std::string missing = (footage_->dir / "nowhere" / "image.%04d.png").string();
-  std::vector<std::string> sets = footage_->image_sets;
-  sets[1] = "cameras[1].source={kind: images, pattern: " + missing + "}";
-  const auto cfg = configWith(sets);
-  const std::string e = errorOf([&] { scenarios::runCatchFootage(cfg, kSeed); });
-  EXPECT_NE(e.find("cameras[behind].source"), std::string::npos) << e;
-  EXPECT_NE(e.find((footage_->dir / "nowhere" / "image.0000.png").string()), std::string::npos) << e;
+TEST_F(BallCatchingFootage, VideosPerCameraPredictTheCrossings) {
+  writeVideos(*footage_);
+  const auto cfg = configWith(footage_->video_sets);
+  const auto s = scenarios::runCatchFootage(cfg, kSeed);
+  checkSession(s, cfg, 30.0, -1.0);
+}
 
-  sets[1] = "cameras[1].source={kind: video, path: " + (footage_->dir / "none.mkv").string() + "}";
+TEST(BallCatchingFootageConfig, AMissingFileOrABadPatternIsNamed) {
+  const fs::path dir = fs::path(testing::TempDir()) / ("viewline_bc_nofootage_" + std::to_string(::getpid()));
+  const std::string missing = (dir / "image.%04d.png").string();
+  auto configWith = [](const std::vector<std::string>& sets) {
+    std::vector<std::string> all = kSim;
+    all.insert(all.end(), sets.begin(), sets.end());
+    return scenarios::loadBallCatchingConfig(io::loadConfigWithValues("config/ball_catching.yaml", all));
+  };
+  std::vector<std::string> sets = {"cameras[0].source={kind: images, pattern: " + missing + "}",
+                                   "cameras[1].source={kind: images, pattern: " + missing + "}"};
+  const std::string e = errorOf([&] { scenarios::runCatchFootage(configWith(sets), kSeed); });
+  EXPECT_NE(e.find("cameras[right].source"), std::string::npos) << e;
+  EXPECT_NE(e.find((dir / "image.0000.png").string()), std::string::npos) << e;
+
+  sets[0] = "cameras[0].source={kind: video, path: " + (dir / "none.mkv").string() + "}";
   const std::string v = errorOf([&] { scenarios::runCatchFootage(configWith(sets), kSeed); });
-  EXPECT_NE(v.find((footage_->dir / "none.mkv").string()), std::string::npos) << v;
+  EXPECT_NE(v.find((dir / "none.mkv").string()), std::string::npos) << v;
 
   // Two conversions in a pattern: refused when the config is read, naming the pattern.
   sets[1] = "cameras[1].source={kind: images, pattern: /tmp/a%d_%d.png}";
   const std::string p = errorOf([&] { configWith(sets); });
   EXPECT_NE(p.find("/tmp/a%d_%d.png"), std::string::npos) << p;
-}
 
-TEST_F(BallCatchingFootage, MixedOrMisplacedSourcesAreRefused) {
   // One camera with footage, the other rendered: refused (two clocks).
-  const std::string one = errorOf([&] { configWith({footage_->image_sets[0]}); });
+  const std::string one = errorOf([&] { configWith({sets[0]}); });
   EXPECT_NE(one.find("every active camera needs footage"), std::string::npos) << one;
   // A recording is the session's source, not a camera's.
   const std::string rec = errorOf([&] { configWith({"cameras[0].source={kind: recording, path: /tmp}"}); });
   EXPECT_NE(rec.find("cameras[].source.kind recording is not a camera's source"), std::string::npos) << rec;
-  // Footage runs as one session, not throw by throw.
-  const auto cfg = configWith(footage_->image_sets);
+  // Footage runs as one session, not throw by throw (refused before anything is opened).
+  const auto cfg = configWith({"cameras[0].source={kind: images, pattern: " + missing + "}",
+                               "cameras[1].source={kind: images, pattern: " + missing + "}"});
   const std::string throws = errorOf([&] { scenarios::runBallCatching(cfg, 1, kSeed); });
   EXPECT_NE(throws.find("footage runs as one session"), std::string::npos) << throws;
 }
