@@ -14,6 +14,7 @@
 #include "viewline/runtime/delay_line.h"
 #include "viewline/runtime/scheduler.h"
 #include "viewline/runtime/stale_frames.h"
+#include "viewline/runtime/v4l2_source.h"
 #include "viewline/scenarios/ball_catching/planner_input.h"
 #include "viewline/scenarios/ball_catching/robot_guard.h"
 #include "viewline/tracking/tracker.h"
@@ -66,12 +67,24 @@ std::optional<core::Timestamp> CatchFootageFrames::nextReadyTime() const {
 std::optional<runtime::Frame> CatchFootageFrames::grab() {
   std::size_t best = cameras_.size();
   core::Timestamp t = std::numeric_limits<double>::infinity();
-  for (std::size_t i = 0; i < cameras_.size(); ++i)
-    if (const auto r = cameras_[i].source->nextReadyTime(); r && *r < t) {
+  // A V4L2 camera is always ready "now" (its grab waits for the driver's next frame), so the
+  // earliest ready time would always be the first camera's: V4L2 cameras are taken in turn,
+  // starting after the one grabbed last; footage goes by its stamps.
+  for (std::size_t k = 0; k < cameras_.size(); ++k) {
+    const std::size_t i = (last_ + 1 + k) % cameras_.size();
+    const auto r = cameras_[i].source->nextReadyTime();
+    if (!r) continue;
+    if (dynamic_cast<const runtime::V4l2Source*>(cameras_[i].source.get())) {
+      best = i;
+      break;
+    }
+    if (*r < t || (*r == t && i < best)) {
       t = *r;
       best = i;
     }
+  }
   if (best == cameras_.size()) return std::nullopt;
+  last_ = best;
   Camera& c = cameras_[best];
   std::optional<runtime::Frame> f = c.source->grab();
   if (!f) {

@@ -59,7 +59,8 @@ std::string describeSource(const runtime::SourceConfig& source);
 
 /// The footage of the rig's active cameras (cameras[i].source), merged into one multi-camera
 /// source in stamp order: the next frame is the camera's whose next frame is ready first (ties:
-/// the lower index), handed out with `camera` set to its index in the rig.
+/// the lower index; V4L2 cameras, always ready, in turn), handed out with `camera` set to its
+/// index in the rig.
 class CatchFootageFrames : public runtime::LiveFrameSource {
 public:
   /// Opens every active camera's source (runtime::makeFrameSource; throws core::InvalidInput
@@ -97,6 +98,7 @@ private:
     std::uint64_t frames = 0, lost = 0;
   };
   std::vector<Camera> cameras_;
+  std::size_t last_ = 0;  // the camera grabbed last (V4L2 cameras are taken in turn)
 };
 
 /// One track of a footage session (one attempt of the planner) and what the planner made of it.
