@@ -2,7 +2,8 @@
 // setting is a config key: --set camera_count=1, --set rate_override_hz=100,
 // --set noise_sigma_override=8, --set robot.v_max=1, --set robot.a_max=26, --set planner.model=ballistic,
 // --set robot.kind=arm, --set threads=4), --record DIR / --replay DIR (ball_catching/recording.h),
-// scenarios::runBallCatching, the summary. The loop is documented in
+// scenarios::runBallCatching, the summary; with footage per camera (cameras[].source) one session
+// over it instead (scenarios::runCatchFootage, ball_catching/footage.h). The loop is documented in
 // modules/scenarios/include/viewline/scenarios/ball_catching/loop.h.
 
 #include <CLI/CLI.hpp>
@@ -10,6 +11,7 @@
 #include <memory>
 
 #include "app_options.h"
+#include "viewline/core/error.h"
 #include "viewline/io/config_edit.h"
 #include "viewline/io/files.h"
 #include "viewline/io/log.h"
@@ -44,6 +46,27 @@ int main(int argc, char** argv) {
       YAML::Emitter yaml;
       yaml << root.yaml();
       hooks.config_text = std::string(yaml.c_str()) + "\n";
+    }
+    if (cfg.onFootage()) {
+      // One session over the cameras' footage: no throws to count, nothing to record or replay.
+      if (cli.count("--throws") > 0) throw core::InvalidInput("--throws: footage runs as one session");
+      if (cli.count("--realtime") > 0)
+        throw core::InvalidInput("--realtime: footage is paced by its source (cameras[].source.pace: true)");
+      io::LogDirectory log(opt.log_dir);
+      if (log.enabled()) hooks.telemetry = scenarios::csvTelemetry(opt.log_dir);
+      std::unique_ptr<viz::BallCatchingDisplay> view;
+      if (opt.wantDisplay("ball_catching")) {
+        view = std::make_unique<viz::BallCatchingDisplay>(cfg);
+        hooks.on_frame = [&](const scenarios::CatchFrame& f) { return view->show(f); };
+      }
+      const auto s = scenarios::runCatchFootage(cfg, opt.seed, hooks);
+      log.flush();
+      nlohmann::json j = scenarios::footageSummaryJson(s, cfg);
+      if (!opt.sets.empty()) j["config_set"] = opt.sets;
+      if (!opt.summary_path.empty()) io::writeSummaryFile(opt.summary_path, j);
+      std::fputs(scenarios::footageSummaryText(s, cfg).c_str(), stdout);
+      if (view) view->waitForClose();
+      return 0;
     }
     // A replay runs the recording's throws unless --throws asks for fewer.
     const std::string replay = scenarios::catchReplayRoot(cfg, &hooks);

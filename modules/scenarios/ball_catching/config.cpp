@@ -87,6 +87,10 @@ CatchCameraConfig readCamera(const io::ConfigNode& n, const std::optional<Simula
     k.position = *f.position;
     k.look_at = *f.look_at;
   }
+  k.source = runtime::readSourceConfig(n);  // absent: sim (the rendered camera)
+  if (k.source.kind == runtime::SourceKind::Recording)
+    throw core::InvalidInput(n.location("source") + ": cameras[].source.kind recording is not a camera's source (a "
+                             "recording holds every camera of a throw: the top-level source: {kind: recording})");
   k.rate_hz = n.getOr<double>("rate_hz", k.rate_hz);
   k.drift = n.getOr<double>("clock_drift", k.drift);
   k.exposure_s = n.getOr<double>("exposure_s", k.exposure_s);
@@ -231,9 +235,24 @@ planning::CatchPlannerConfig BallCatchingConfig::plannerConfig() const {
   return p;
 }
 
+bool BallCatchingConfig::onFootage() const {
+  for (std::size_t i = 0; i < activeCameras() && i < cameras.size(); ++i)
+    if (!cameras[i].source.simulated()) return true;
+  return false;
+}
+
 void BallCatchingConfig::validate() const {
   if (cameras.empty()) throw InvalidInput("cameras: expected at least one camera");
   if (camera_count > cameras.size()) throw InvalidInput("camera_count: more than the cameras listed");
+  if (onFootage()) {
+    // One clock for the session: footage cannot be fused with a camera rendered on a throw's clock.
+    for (std::size_t i = 0; i < activeCameras(); ++i)
+      if (cameras[i].source.simulated())
+        throw InvalidInput("cameras[" + cameras[i].name + "].source: every active camera needs footage when one has "
+                           "it (the rendered cameras run on a simulated throw's clock)");
+    if (!source.simulated())
+      throw InvalidInput("source: kind recording and cameras[].source footage are exclusive (one or the other)");
+  }
   for (const auto& c : cameras) {
     if (!(c.rate_hz > 0.0)) throw InvalidInput("cameras[" + c.name + "].rate_hz: expected > 0");
     if (c.width == 0 || c.height == 0) throw InvalidInput("cameras[" + c.name + "].width/height: expected > 0");

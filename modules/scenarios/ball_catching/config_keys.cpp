@@ -20,6 +20,12 @@ io::ConfigReferenceSection ballCatchingConfigReference() {
       "cameras:\n  - {name: a, position: [0.0, -3.0, 1.5], look_at: [2.0, 0.0, 1.3], cx: 320, cy: 240}\n"
       "robot: {kind: stage}\n",
       "source: {kind: recording, path: rec}\n", runtime::faultConfigProbe()};
+  // A camera's footage: one probe per kind (a recording is refused per camera, so not probed).
+  for (const std::string& p : runtime::sourceConfigProbes("    ")) {
+    if (p.find("kind: recording") != std::string::npos) continue;
+    s.probes.push_back("cameras:\n  - name: a\n    position: [0.0, -3.0, 1.5]\n    look_at: [2.0, 0.0, 1.3]\n" + p +
+                       "robot: {kind: stage}\n");
+  }
   s.read = [](const io::ConfigNode& root) { loadBallCatchingConfig(root); };
   s.keys = {
       {"name", "", "scenario name in summaries"},
@@ -150,10 +156,24 @@ io::ConfigReferenceSection ballCatchingConfigReference() {
       {"room.walls", "", "render walls around the floor"},
       {"room.floor_size", "m", "side of the floor square"},
       {"source", "", "where the frames come from (absent: the rendered cameras)"},
-      {"source.kind", "", "sim (the rendered cameras) or recording (a folder written by --record); other kinds are refused"},
+      {"source.kind", "", "sim (the rendered cameras) or recording (a folder written by --record); footage goes per camera "
+                          "(cameras[].source)"},
       {"source.path", "", "recording: the folder written by --record (as --replay)"},
   };
   for (io::ConfigKeyDoc& d : runtime::faultConfigKeys()) s.keys.push_back(std::move(d));
+  // Footage per camera (ball_catching/footage.h): the runtime's `source:` keys under each camera.
+  for (io::ConfigKeyDoc d : runtime::sourceConfigKeys()) {
+    if (d.key == "source") {
+      d.meaning = "this camera's footage (absent: rendered); every active camera has footage or none: one session "
+                  "over it, no truth (ball_catching/footage.h)";
+    } else if (d.key == "source.kind") {
+      d.meaning = "sim (rendered), images, video or v4l2 (recording is the top-level source's)";
+    } else if (d.key == "source.path") {
+      d.meaning = "video: the file";
+    }
+    d.key = "cameras[]." + d.key;
+    s.keys.push_back(std::move(d));
+  }
   return s;
 }
 

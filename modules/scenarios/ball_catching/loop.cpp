@@ -318,6 +318,8 @@ std::function<std::shared_ptr<runtime::TelemetrySink>(int)> csvTelemetry(const s
 CatchSummary runBallCatching(const BallCatchingConfig& cfg, int throws, std::uint64_t seed, const CatchHooks& hooks) {
   if (throws < 1) throw core::InvalidInput("throws: expected >= 1");
   cfg.validate();
+  if (cfg.onFootage())
+    throw core::InvalidInput("cameras[].source: footage runs as one session (runCatchFootage, footage.h), not throw by throw");
   const auto wall0 = std::chrono::steady_clock::now();
   if (!hooks.record_dir.empty()) beginCatchRecording(hooks.record_dir, seed, throws, hooks.config_text);
   if (const std::string replay = catchReplayRoot(cfg, &hooks); !replay.empty()) checkCatchReplay(replay, seed, throws);

@@ -47,9 +47,9 @@ runtime::SourceConfig readCatchSource(const io::ConfigNode& root) {
   runtime::SourceConfig s = runtime::readSourceConfig(root);
   if (!s.simulated() && s.kind != runtime::SourceKind::Recording)
     throw core::InvalidInput(root.location("source") + ": source.kind " + runtime::toString(s.kind) +
-                             " is not supported by ball_catching (sim or recording: a throw is scored against its "
-                             "flight and runs on its own clock, which footage from " + runtime::toString(s.kind) +
-                             " does not have)");
+                             " is not supported by ball_catching at the top level (sim or recording); footage is "
+                             "given per camera of the rig, in the cameras' order: cameras: [{name: right, source: "
+                             "{kind: " + runtime::toString(s.kind) + ", ...}}, ...]");
   return s;
 }
 

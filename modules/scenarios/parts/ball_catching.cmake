@@ -4,6 +4,7 @@
 list(APPEND scenarios_sources
   ball_catching/config.cpp
   ball_catching/flight_fit.cpp
+  ball_catching/footage.cpp
   ball_catching/loop.cpp
   ball_catching/metrics.cpp
   ball_catching/planner_input.cpp
@@ -15,3 +16,5 @@ list(APPEND scenarios_tests test/summary_text_test.cpp test/flight_fit_test.cpp 
 # Unit and meaning of every key its config reader reads (docs/config_reference.md is generated from it).
 list(APPEND scenarios_sources ball_catching/config_keys.cpp)
 list(APPEND scenarios_tests test/ball_catching_faults_test.cpp)
+# The catcher on footage: one session over the cameras' frames, no truth (ball_catching/footage.h).
+list(APPEND scenarios_tests test/ball_catching_footage_test.cpp)

@@ -1,6 +1,6 @@
 // Ball catching on a recording of its throws (ball_catching/recording.h): a recorded session
 // replayed with the same config and seed gives the same summary bit for bit (the wall-clock figures
-// aside); sources without a flight to score against are refused; a replay with another seed, or of
+// aside); footage at the top level is refused (it goes per camera: footage.h); a replay with another seed, or of
 // a folder that is not a recording, is refused with a message.
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -105,10 +105,11 @@ TEST(BallCatchingSources, AFolderThatIsNotARecordingIsRefused) {
   fs::remove_all(dir);
 }
 
-TEST(BallCatchingSources, SourcesWithoutAFlightAreRefused) {
+TEST(BallCatchingSources, FootageAtTheTopLevelIsRefusedAndPointsToTheCameras) {
   const std::string e = errorOf([] {
     scenarios::loadBallCatchingConfig(
         io::loadConfigWithValues("config/ball_catching.yaml", {"source.kind=video", "source.path=x.mp4"}));
   });
-  EXPECT_NE(e.find("source.kind video is not supported by ball_catching"), std::string::npos) << e;
+  EXPECT_NE(e.find("source.kind video is not supported by ball_catching at the top level"), std::string::npos) << e;
+  EXPECT_NE(e.find("cameras: [{name: right, source: {kind: video"), std::string::npos) << e;  // where footage goes
 }

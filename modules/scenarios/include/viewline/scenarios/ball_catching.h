@@ -7,9 +7,11 @@
 //   registration.h  camera-to-robot registration before the throws
 //   loop.h          one throw and a session on runtime::Scheduler, telemetry, live-view hooks
 //   metrics.h       outcome of a throw (caught, oracle, miss reason), session summary, JSON
+//   footage.h       one session on the cameras' footage (cameras[].source), no truth
 
 #include "viewline/scenarios/ball_catching/config.h"
 #include "viewline/scenarios/ball_catching/flight_fit.h"
+#include "viewline/scenarios/ball_catching/footage.h"
 #include "viewline/scenarios/ball_catching/loop.h"
 #include "viewline/scenarios/ball_catching/metrics.h"
 #include "viewline/scenarios/ball_catching/registration.h"

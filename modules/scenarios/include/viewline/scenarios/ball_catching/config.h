@@ -55,6 +55,9 @@ struct CatchCameraConfig {
   /// built from the fields above: a perfectly calibrated rig.
   std::optional<core::Camera> true_camera,  ///< rig truth: what the simulator renders with
                               calibrated_camera;  ///< rig calibration: what the estimators use
+  /// Where this camera's frames come from: sim (rendered, the default) or footage (images, video,
+  /// v4l2; footage.h). Every active camera renders, or every one has footage.
+  runtime::SourceConfig source;
   core::Camera renderCamera() const;     ///< true_camera, or the one built from the fields
   core::Camera estimatorCamera() const;  ///< calibrated_camera, or the one built from the fields
 };
@@ -150,6 +153,9 @@ struct BallCatchingConfig {
 
   /// The cameras a throw uses: the first camera_count (all when 0).
   std::size_t activeCameras() const { return camera_count > 0 ? camera_count : cameras.size(); }
+  /// True when the active cameras take their frames from footage (cameras[].source, footage.h):
+  /// one session over the footage instead of simulated throws.
+  bool onFootage() const;
   /// Frame rate of camera i in a throw (rate_override_hz when set).
   double throwRate(std::size_t i) const { return rate_override_hz > 0.0 ? rate_override_hz : cameras[i].rate_hz; }
   /// The planner settings with what the planner takes from the world: the crossing plane (home,

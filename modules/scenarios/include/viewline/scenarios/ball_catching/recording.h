@@ -26,8 +26,8 @@
 // What stays simulated, as live: the robot (the planner drives it from the replayed estimates), and
 // the registration before the throws when enabled (it renders its own frames, from the seed).
 //
-// Other sources (images, video, v4l2) are refused by the config reader: a throw needs a flight to
-// score the catch against and a clock of its own, and a single-camera footage has neither.
+// Footage (images, video, v4l2) is not a recording: it is given per camera (cameras[].source) and
+// runs as one session without truth (footage.h); a top-level `source:` of those kinds is refused.
 
 #include <cstdint>
 #include <memory>
@@ -53,7 +53,7 @@ struct CatchFrameTruth {
 };
 
 /// Reads the config's `source:` (runtime::readSourceConfig): sim or recording; other kinds are
-/// refused with core::InvalidInput naming file:line (see the file comment).
+/// refused with core::InvalidInput naming file:line and pointing to cameras[].source (footage.h).
 runtime::SourceConfig readCatchSource(const io::ConfigNode& root);
 
 /// The folder of throw `index` in a session recording: DIR/throw_iii.
