@@ -15,12 +15,14 @@ set -uo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build="${VIEWLINE_BUILD_DIR:-$root/build}-asan"
 reports="$build/sanitizer-reports"
+# shellcheck disable=SC2034  # used by the option lines read from scripts/test below
 supp="$root/fuzz/sanitizer-suppressions"
 jobs="${VIEWLINE_JOBS:-2}"
 mkdir -p "$reports"
 eval "$(grep -E '^export (ASAN|LSAN|UBSAN)_OPTIONS=' "$root/scripts/test")"
-eval "$(grep -E '^opt=' "$root/scripts/test")"
+eval "$(grep -E '^opt=' "$root/scripts/test")"   # opt=(...): the optimisation level of the tree
 export CCACHE_BASEDIR="$root"
+# shellcheck disable=SC2154  # opt comes from the eval above
 cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_COMPILER_LAUNCHER=ccache \
   -DCMAKE_CXX_COMPILER=g++ -DVIEWLINE_SANITIZE=address,undefined "${opt[@]}" >/dev/null || exit 1
 done_list="$build/sanitize-by-target.done"
