@@ -116,6 +116,33 @@ TEST(Tracker, OneBadCameraDoesNotVetoTheOthers) {
   EXPECT_LT((tr.state().x().head<3>() - p).norm(), 0.02);
 }
 
+TEST(Tracker, ABiasedThirdCameraIsOutvotedByTheTwoThatAgreeAndDoesNotRestartTheTrack) {
+  // Cameras 0 and 1 as the dart rig; camera 2 at camera 0's pose, 4 px off (an unregistered
+  // camera), joining once the track is determined: its images are rejected, and the two others,
+  // which agree with the track, keep it (without outvoting, its third rejection restarts it).
+  Fixture f;
+  core::Rng rng = core::makeRng(5);
+  const scenarios::DartFlight fl = simulateFlight(f.cfg, f.cams, DartClockMode::Alternating, 0.0, rng);
+  std::vector<core::Camera> cams = f.cams;
+  cams.push_back(f.cams[0]);
+  ViewlineTracker tr(cams, f.cfg.tracker);
+  std::uint64_t id = 100000;
+  std::size_t biased_gated = 0, biased = 0;
+  for (const scenarios::DartDetection& d : fl.detections) {
+    tr.submit(d.m);
+    if (d.m.camera != 0 || tr.trackState().fused_in_track < 10) continue;
+    ImageMeasurement b = inlier(cams[2], 2, id++, d.m.t, d.truth.head<3>());
+    b.uv += Eigen::Vector2d(4.0, 0.0);
+    tr.submit(b);
+    ++biased;
+    biased_gated += tr.outcome(b.id)->fate != Fate::Fused;
+  }
+  EXPECT_EQ(tr.trackState().restarts, 0);
+  EXPECT_GE(biased, 3u);
+  EXPECT_EQ(biased_gated, biased);
+  EXPECT_LT((tr.state().x().head<3>() - fl.detections.back().truth.head<3>()).norm(), 0.02);
+}
+
 TEST(Tracker, TrackSeededByAnOutlierIsRestartedAndTheOutlierDropped) {
   Fixture f;
   core::Rng rng = core::makeRng(9);
