@@ -52,26 +52,12 @@ int main(int argc, char** argv) {
       if (cli.count("--throws") > 0) throw core::InvalidInput("--throws: footage runs as one session");
       if (cli.count("--realtime") > 0)
         throw core::InvalidInput("--realtime: footage is paced by its source (cameras[].source.pace: true)");
-      io::LogDirectory log(opt.log_dir);
-      if (log.enabled()) hooks.telemetry = scenarios::csvTelemetry(opt.log_dir);
-      std::unique_ptr<viz::BallCatchingDisplay> view;
-      if (opt.wantDisplay("ball_catching")) {
-        view = std::make_unique<viz::BallCatchingDisplay>(cfg);
-        hooks.on_frame = [&](const scenarios::CatchFrame& f) { return view->show(f); };
-      }
-      const auto s = scenarios::runCatchFootage(cfg, opt.seed, hooks);
-      log.flush();
-      nlohmann::json j = scenarios::footageSummaryJson(s, cfg);
-      if (!opt.sets.empty()) j["config_set"] = opt.sets;
-      if (!opt.summary_path.empty()) io::writeSummaryFile(opt.summary_path, j);
-      std::fputs(scenarios::footageSummaryText(s, cfg).c_str(), stdout);
-      if (view) view->waitForClose();
-      return 0;
+    } else {
+      // A replay runs the recording's throws unless --throws asks for fewer.
+      const std::string replay = scenarios::catchReplayRoot(cfg, &hooks);
+      if (!replay.empty() && cli.count("--throws") == 0) throws = scenarios::recordedCatchThrows(replay);
     }
-    // A replay runs the recording's throws unless --throws asks for fewer.
-    const std::string replay = scenarios::catchReplayRoot(cfg, &hooks);
-    if (!replay.empty() && cli.count("--throws") == 0) throws = scenarios::recordedCatchThrows(replay);
-    // --log DIR: one folder per throw (throw_007/, the runtime's CSV files), throws.csv on top.
+    // --log DIR: the runtime's CSV files (with throws, one folder per throw, throw_007/, and throws.csv on top).
     io::LogDirectory log(opt.log_dir);
     if (log.enabled()) hooks.telemetry = scenarios::csvTelemetry(opt.log_dir);
     std::unique_ptr<viz::BallCatchingDisplay> view;
@@ -79,16 +65,26 @@ int main(int argc, char** argv) {
       view = std::make_unique<viz::BallCatchingDisplay>(cfg);
       hooks.on_frame = [&](const scenarios::CatchFrame& f) { return view->show(f); };
     }
-    runtime::Progress progress = opt.quiet ? runtime::Progress::quiet() : runtime::Progress("throws", throws);
-    hooks.progress = [&](int done, int) { progress.update(done); };
-    const auto s = scenarios::runBallCatching(cfg, throws, opt.seed, hooks);
-    progress.finish();
-    scenarios::writeThrowsCsv(log, s.results);
-    log.flush();
-    nlohmann::json j = scenarios::summaryJson(s, cfg);
+    nlohmann::json j;
+    std::string text;
+    if (cfg.onFootage()) {
+      const auto s = scenarios::runCatchFootage(cfg, opt.seed, hooks);
+      log.flush();
+      j = scenarios::footageSummaryJson(s, cfg);
+      text = scenarios::footageSummaryText(s, cfg);
+    } else {
+      runtime::Progress progress = opt.quiet ? runtime::Progress::quiet() : runtime::Progress("throws", throws);
+      hooks.progress = [&](int done, int) { progress.update(done); };
+      const auto s = scenarios::runBallCatching(cfg, throws, opt.seed, hooks);
+      progress.finish();
+      scenarios::writeThrowsCsv(log, s.results);
+      log.flush();
+      j = scenarios::summaryJson(s, cfg);
+      text = scenarios::summaryText(s, cfg);
+    }
     if (!opt.sets.empty()) j["config_set"] = opt.sets;
     if (!opt.summary_path.empty()) io::writeSummaryFile(opt.summary_path, j);
-    std::fputs(scenarios::summaryText(s, cfg).c_str(), stdout);
+    std::fputs(text.c_str(), stdout);
     if (view) view->waitForClose();
     return 0;
   });

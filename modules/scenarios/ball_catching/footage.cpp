@@ -15,6 +15,7 @@
 #include "viewline/runtime/scheduler.h"
 #include "viewline/runtime/stale_frames.h"
 #include "viewline/runtime/v4l2_source.h"
+#include "viewline/scenarios/ball_catching/detection.h"
 #include "viewline/scenarios/ball_catching/planner_input.h"
 #include "viewline/scenarios/ball_catching/robot_guard.h"
 #include "viewline/tracking/tracker.h"
@@ -293,23 +294,12 @@ private:
       const double tp = std::max(frame.stamp, tracker_.state().t());
       if (auto uv = est_cams_[ci].project(tracker_.predictAt(tp).x().head<3>())) predicted = *uv;
     }
-    const auto det = runtime::guardedDetect(faults_, ci, frame.stamp, [&] {
-      return detectors_[ci].detect(frame.image, frame.stamp, predicted);
-    });
-    if (!det || !det->ok()) return std::nullopt;
-    const Eigen::Vector2d det_px =
-        faults_.detected(ci, frame.stamp, det->value().pixel, frame.image.cols, frame.image.rows);
-    if (!runtime::usablePixel(det_px, frame.image.cols, frame.image.rows)) {
-      faults_.note("detections_rejected");
-      return std::nullopt;
-    }
+    const auto det = detectCatchBall(cfg_, faults_, detectors_[ci], frame, frame.stamp, predicted);
+    if (!det) return std::nullopt;
     ++sum_.detections;
     ++sum_.cameras[ci].detections;
-    const double sigma_det = cfg_.sigma_px > 0.0
-                                 ? cfg_.sigma_px
-                                 : std::max(cfg_.sigma_px_floor, std::sqrt(0.5 * det->value().pixel_covariance.trace()));
-    const double sigma = std::hypot(sigma_det, cfg_.pixel_noise_px);
-    Eigen::Vector2d px = det_px;
+    const double sigma = det->sigma_px;
+    Eigen::Vector2d px = det->pixel;
     if (cfg_.pixel_noise_px > 0.0)
       px += cfg_.pixel_noise_px * Eigen::Vector2d(core::gaussian(noise_rng_), core::gaussian(noise_rng_));
     // A pause longer than a track can coast (or than the tracker accepts as a step forward) ends

@@ -17,6 +17,7 @@
 #include "viewline/io/log.h"
 #include "viewline/runtime/delay_line.h"
 #include "viewline/runtime/stale_frames.h"
+#include "viewline/scenarios/ball_catching/detection.h"
 #include "viewline/scenarios/ball_catching/planner_input.h"
 #include "viewline/scenarios/ball_catching/recording.h"
 #include "viewline/scenarios/ball_catching/robot_guard.h"
@@ -124,24 +125,12 @@ private:
       const double tp = std::max(frame.stamp, tracker_.state().t());
       if (auto uv = est_cams_[ci].project(tracker_.predictAt(tp).x().head<3>())) predicted = *uv;
     }
-    const auto det = runtime::guardedDetect(faults_, ci, frame.capture_time, [&] {
-      return detectors_[ci].detect(frame.image, frame.stamp, predicted);
-    });
-    if (!det || !det->ok()) return std::nullopt;
-    const Eigen::Vector2d det_px =
-        faults_.detected(ci, frame.capture_time, det->value().pixel, frame.image.cols, frame.image.rows);
-    if (!runtime::usablePixel(det_px, frame.image.cols, frame.image.rows)) {
-      faults_.note("detections_rejected");
-      return std::nullopt;
-    }
+    const auto det = detectCatchBall(cfg_, faults_, detectors_[ci], frame, frame.capture_time, predicted);
+    if (!det) return std::nullopt;
     ++res_.detections;
     if (res_.t_first_detection < 0.0) res_.t_first_detection = frame.capture_time;
-    // The detector's std: as measured against the truth (detector.sigma_px), else the blob's own.
-    const double sigma_det = cfg_.sigma_px > 0.0
-                                 ? cfg_.sigma_px
-                                 : std::max(cfg_.sigma_px_floor, std::sqrt(0.5 * det->value().pixel_covariance.trace()));
-    const double sigma = std::hypot(sigma_det, cfg_.pixel_noise_px);  // the tracker is told the added noise
-    Eigen::Vector2d px = det_px;
+    const double sigma_det = det->sigma_detector_px, sigma = det->sigma_px;
+    Eigen::Vector2d px = det->pixel;
     // The detector's own error as the tracker sees it: against the estimator camera's image of the
     // true ball at the stamp (calibration, registration, blur and stamp errors included).
     if (cfg_.object == "ball" && frame.stamp >= flight_.startTime() && frame.stamp <= flight_.endTime())

@@ -3,6 +3,7 @@
 # live view is in modules/viz (ball_catching_display).
 list(APPEND scenarios_sources
   ball_catching/config.cpp
+  ball_catching/detection.cpp
   ball_catching/flight_fit.cpp
   ball_catching/footage.cpp
   ball_catching/loop.cpp
