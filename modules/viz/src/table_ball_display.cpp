@@ -89,7 +89,9 @@ bool TableBallDisplay::show(const scenarios::TableBallFrameView& view) {
   // --- top view ---
   if (of.ball_found) Impl::push(d.measured, of.measured, d.track_length);
   if (of.estimate_valid) Impl::push(d.filtered, Eigen::Vector2d(of.x[0], of.x[2]), d.track_length);
-  Impl::push(d.truth, view.truth, d.track_length);
+  // On footage there is no truth (NaN): nothing of it is drawn.
+  const bool has_truth = view.truth.allFinite();
+  if (has_truth) Impl::push(d.truth, view.truth, d.track_length);
   vpDisplay::display(d.top_image);
   const double h = 0.5 * d.side;
   const vpImagePoint tl = d.topPixel({-h, h}), br = d.topPixel({h, -h});
@@ -103,7 +105,7 @@ bool TableBallDisplay::show(const scenarios::TableBallFrameView& view) {
   }
   vpDisplay::displayCross(d.top_image, d.topPixel(view.setpoint), 15, vpColor::white, 2);
   const double scale = 0.9 * d.top_px / (d.side + 0.04);
-  vpDisplay::displayCircle(d.top_image, d.topPixel(view.truth), scale * d.radius, vpColor::blue, false, 1);
+  if (has_truth) vpDisplay::displayCircle(d.top_image, d.topPixel(view.truth), scale * d.radius, vpColor::blue, false, 1);
   char text[128];
   std::snprintf(text, sizeof text, "t = %.2f s  tilt (%.1f, %.1f) deg", of.t, core::rad2deg(view.tilt.x()),
                 core::rad2deg(view.tilt.y()));
