@@ -67,6 +67,7 @@
 //     run on the calling thread for a 320x240 image (OpenCV does not split such small images).
 
 #include "viewline/scenarios/table_ball/config.h"
+#include "viewline/scenarios/table_ball/footage.h"
 #include "viewline/scenarios/table_ball/loop.h"
 #include "viewline/scenarios/table_ball/metrics.h"
 #include "viewline/scenarios/table_ball/world.h"
