@@ -104,7 +104,12 @@ io::ConfigReferenceSection tableBallConfigReference() {
   };
   // sim and recording run the closed loop; images, video and v4l2 one session on footage
   // without truth (table_ball/footage.h).
-  for (const io::ConfigKeyDoc& k : runtime::sourceConfigKeys()) s.keys.push_back(k);
+  for (io::ConfigKeyDoc& k : runtime::sourceConfigKeys()) {
+    if (k.key == "source.kind")
+      k.meaning = "sim (the rendered head camera) or recording: the scored closed loop; images, video or v4l2: one "
+                  "session on footage, nothing scored (table_ball/footage.h)";
+    s.keys.push_back(std::move(k));
+  }
   for (io::ConfigKeyDoc& d : runtime::faultConfigKeys()) s.keys.push_back(std::move(d));
   return s;
 }
