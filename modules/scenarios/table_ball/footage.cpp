@@ -213,9 +213,11 @@ TableBallFootageSummary runTableBallFootage(const TableBallConfig& cfg, std::uin
     } else {
       of = &observer.predictOnly(t);
     }
-    if (of->table_found) ++sum.table_found;
-    if (of->ball_found) ++sum.ball_found;
-    if (of->tracked) ++sum.tracked;
+    if (of->image) {  // a prediction-only step keeps the last image's flags
+      if (of->table_found) ++sum.table_found;
+      if (of->ball_found) ++sum.ball_found;
+      if (of->tracked) ++sum.tracked;
+    }
     if (of->ball_found && observer.tracker().initialized() && t - t0 >= cfg.warmup) {
       nis_sum += observer.tracker().lastNis();
       ++sum.nis_count;

@@ -241,6 +241,23 @@ TEST_F(TableBallFootage, VideoPutsTheBallWithinMillimetresOfTheRenderedOne) {
   check(s, cfg, obs, 1.5, 3.0);
 }
 
+TEST_F(TableBallFootage, ASilentWristAndAFrozenCameraAreCountedAndTheCommandsStayWithinLimits) {
+  // Fault windows are on the footage's stamps (here from 0.02 s). The wrist does not answer for
+  // 0.3 s, then resumes from the tilt it held; the camera repeats one image for 0.2 s.
+  const auto cfg = configWith({footage_->images_set, "faults=[{kind: robot_silent, from_s: 0.8, to_s: 1.1}, "
+                                                     "{kind: freeze, from_s: 1.4, to_s: 1.6}]"});
+  const auto s = scenarios::runTableBallFootage(cfg, kSeed);
+  scenarios::printTableBallFootageSummary(stdout, s, cfg);
+  EXPECT_EQ(s.frames, footage_->frames);
+  EXPECT_GT(s.faults.outcomeOf("robot_commands_failed"), 250u);  // ~300 ticks of 1 ms
+  EXPECT_EQ(s.faults.outcomeOf("robot_resumed"), 1u);
+  EXPECT_GE(s.faults.outcomeOf("frames_frozen_dropped"), 5u);
+  EXPECT_EQ(s.skipped, s.faults.outcomeOf("frames_frozen_dropped"));
+  EXPECT_LE(s.tracked, s.frames - s.skipped);  // only processed images count
+  EXPECT_EQ(s.limit_violations, 0u);
+  EXPECT_TRUE(scenarios::toJson(s).contains("faults"));
+}
+
 TEST(TableBallFootageConfig, AMissingFileOrABadPatternIsNamed) {
   const fs::path dir = fs::path(testing::TempDir()) / ("viewline_tb_nofootage_" + std::to_string(::getpid()));
   const auto images = configWith({"source={kind: images, pattern: " + (dir / "image.%04d.png").string() + "}"});
@@ -251,6 +268,10 @@ TEST(TableBallFootageConfig, AMissingFileOrABadPatternIsNamed) {
   const auto video = configWith({"source={kind: video, path: " + (dir / "none.avi").string() + "}"});
   const std::string v = errorOf([&] { scenarios::runTableBallFootage(video, kSeed); });
   EXPECT_NE(v.find((dir / "none.avi").string()), std::string::npos) << v;
+
+  const auto camera = configWith({"source={kind: v4l2, device: " + (dir / "video9").string() + "}"});
+  const std::string d = errorOf([&] { scenarios::runTableBallFootage(camera, kSeed); });
+  EXPECT_NE(d.find((dir / "video9").string()), std::string::npos) << d;
 
   // Two conversions in a pattern: refused when the config is read, naming the pattern.
   const std::string p = errorOf([&] { configWith({"source={kind: images, pattern: /tmp/a%d_%d.png}"}); });
