@@ -179,7 +179,7 @@ TableBallFootageSummary runTableBallFootage(const TableBallConfig& cfg, std::uin
                                " px, the head camera's calibration is " + std::to_string(obs_camera.width) + "x" +
                                std::to_string(obs_camera.height) + " px");
     const double t = frame->stamp;
-    if (sum.frames == 1) sum.t_first = t;
+    if (sum.frames == 1) sum.t_first = sum.t_last = t;
     sum.t_last = std::max(sum.t_last, t);
     if (faults.missesDeadline(*frame)) {  // as in the loop: dropped as a lost frame
       faults.note("frames_late_dropped");

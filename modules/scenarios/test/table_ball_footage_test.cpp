@@ -35,9 +35,9 @@ const std::uint64_t kSeed = [] {
   const char* s = std::getenv("VIEWLINE_FOOTAGE_SEED");
   return s != nullptr ? std::stoull(s) : std::uint64_t{3};
 }();
-// 2 s of the shipped scenario: the ball rolls from its initial position to the first set point
+// 1.6 s of the shipped scenario: the ball rolls from its initial position to the first set point
 // 11 cm away. One render per frame and no side filters or reference timing keep it short.
-const std::vector<std::string> kSim = {"duration=2.0", "camera.blur_samples=1", "metrics.compare_tunings=false",
+const std::vector<std::string> kSim = {"duration=1.6", "camera.blur_samples=1", "metrics.compare_tunings=false",
                                        "metrics.time_reference=false"};
 
 struct Footage {
@@ -244,8 +244,8 @@ TEST_F(TableBallFootage, VideoPutsTheBallWithinMillimetresOfTheRenderedOne) {
 TEST_F(TableBallFootage, ASilentWristAndAFrozenCameraAreCountedAndTheCommandsStayWithinLimits) {
   // Fault windows are on the footage's stamps (here from 0.02 s). The wrist does not answer for
   // 0.3 s, then resumes from the tilt it held; the camera repeats one image for 0.2 s.
-  const auto cfg = configWith({footage_->images_set, "faults=[{kind: robot_silent, from_s: 0.8, to_s: 1.1}, "
-                                                     "{kind: freeze, from_s: 1.4, to_s: 1.6}]"});
+  const auto cfg = configWith({footage_->images_set, "faults=[{kind: robot_silent, from_s: 0.6, to_s: 0.9}, "
+                                                     "{kind: freeze, from_s: 1.1, to_s: 1.3}]"});
   const auto s = scenarios::runTableBallFootage(cfg, kSeed);
   scenarios::printTableBallFootageSummary(stdout, s, cfg);
   EXPECT_EQ(s.frames, footage_->frames);
