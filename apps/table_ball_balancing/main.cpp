@@ -1,7 +1,8 @@
 // table_ball_balancing: [M]'s table-ball observer in the closed loop it was built for.
 // Thin main: the common flags (apps/common), the YAML scenario, scenarios::runTableBall, the
 // summary. --duration S is the common "simulated seconds" flag (as --set duration=S, which also
-// works; the flag keeps the config file's relative paths as written in the summary).
+// works; the flag keeps the config file's relative paths as written in the summary). With footage
+// (source: images, video or v4l2) one session over it instead (scenarios::runTableBallFootage).
 
 #include <algorithm>
 #include <cmath>
@@ -9,6 +10,7 @@
 #include <memory>
 
 #include "app_options.h"
+#include "viewline/core/error.h"
 #include "viewline/io/config_edit.h"
 #include "viewline/io/files.h"
 #include "viewline/io/log.h"
@@ -38,6 +40,27 @@ int main(int argc, char** argv) {
     runtime::CsvSink csv(log);
     scenarios::TableBallHooks hooks;
     if (log.enabled()) hooks.telemetry = &csv;
+    if (cfg.onFootage()) {
+      // One session over the head camera's footage (table_ball/footage.h): it ends with the
+      // footage, is paced by its source, and is recorded already.
+      if (cli.count("--duration") > 0) throw core::InvalidInput("--duration: footage runs until it ends (source.count limits it)");
+      if (cli.count("--realtime") > 0) throw core::InvalidInput("--realtime: footage is paced by its source (source.pace: true)");
+      if (!opt.record_dir.empty()) throw core::InvalidInput("--record: footage is recorded already");
+      if (!opt.replay_dir.empty()) throw core::InvalidInput("--replay: the footage is the input (source:)");
+      std::unique_ptr<viz::TableBallDisplay> view;
+      if (opt.wantDisplay("table_ball_balancing")) {
+        view = std::make_unique<viz::TableBallDisplay>(cfg.table_side, cfg.ball_radius);
+        hooks.on_frame = [&](const scenarios::TableBallFrameView& v) { return view->show(v); };
+      }
+      const scenarios::TableBallFootageSummary s = scenarios::runTableBallFootage(cfg, opt.seed, hooks);
+      nlohmann::json j = scenarios::toJson(s);
+      j["rig"] = cfg.rig ? nlohmann::json(cfg.rig->folder) : nlohmann::json(nullptr);
+      if (!opt.sets.empty()) j["config_set"] = opt.sets;
+      if (!opt.summary_path.empty()) io::writeSummaryFile(opt.summary_path, j);
+      scenarios::printTableBallFootageSummary(stdout, s, cfg);
+      if (view) view->waitForClose();
+      return 0;
+    }
     hooks.pacing = opt.pacing();
     hooks.record_dir = opt.record_dir;
     hooks.replay_dir = opt.replay_dir;

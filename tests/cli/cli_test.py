@@ -52,6 +52,12 @@ SCENARIO_APPS = {
 RECORD_APPS = ["ball_catching", "mobile_capture", "dart_tracking"]
 RECORD_CLASSES = {"record_nonempty": 1, "record_unwritable": 1, "replay_missing": 2}
 
+# Apps that run on footage (source: images|video|v4l2): a pattern whose first image is missing, a
+# video that does not exist and a pattern with two conversions are runtime errors (exit 1) whose
+# message names the file or the pattern, and no summary is written.
+FOOTAGE_APPS = ["table_ball_balancing"]
+FOOTAGE_CLASSES = {"footage_missing_image": 1, "footage_missing_video": 1, "footage_bad_pattern": 1}
+
 
 def table():
     """executable -> dict(file=(flag or None for a positional, rest of the command line), outputs, wrong_type,
@@ -130,6 +136,8 @@ def cases():
     out.append("dart_tracking.full_disk_log")
     for app in RECORD_APPS:
         out += [f"{app}.{cls}" for cls in RECORD_CLASSES]
+    for app in FOOTAGE_APPS:
+        out += [f"{app}.{cls}" for cls in FOOTAGE_CLASSES]
     return out
 
 
@@ -288,6 +296,38 @@ def run_record_case(app, cls, binary, work):
     print("ok")
 
 
+def run_footage_case(app, cls, binary, work):
+    cfg, _, _, _ = SCENARIO_APPS[app]
+    shutil.rmtree(work, ignore_errors=True)
+    os.makedirs(work)
+    summary = os.path.join(work, "summary.json")
+    if cls == "footage_missing_image":
+        source = "{kind: images, pattern: " + os.path.join(work, "no_frames", "image.%04d.png") + "}"
+        named = os.path.join(work, "no_frames", "image.0000.png")
+    elif cls == "footage_missing_video":
+        named = os.path.join(work, "none.avi")
+        source = "{kind: video, path: " + named + "}"
+    else:
+        named = os.path.join(work, "a%d_%d.png")
+        source = "{kind: images, pattern: " + named + "}"
+    cmd = [binary, "--config", cfg, "--quiet", "--summary", summary, "--set", "source=" + source]
+    try:
+        p = subprocess.run(cmd, capture_output=True, text=True, errors="replace", timeout=TIMEOUT_S)
+    except subprocess.TimeoutExpired:
+        fail(f"hang: no exit within {TIMEOUT_S} s: {' '.join(cmd)}")
+    print("$ " + " ".join(cmd))
+    print(f"exit {p.returncode}\n--- stderr\n{p.stderr[-3000:]}\n--- stdout\n{p.stdout[-1000:]}")
+    if p.returncode < 0:
+        fail(f"crash: killed by signal {-p.returncode}")
+    if p.returncode != FOOTAGE_CLASSES[cls]:
+        fail(f"exit status {p.returncode}, expected {FOOTAGE_CLASSES[cls]} ({cls})")
+    if named not in p.stderr:
+        fail(f"the message does not name {named}")
+    if os.path.exists(summary):
+        fail("a summary was written although the run failed")
+    print("ok")
+
+
 SKIP = 77  # ctest's SKIP_RETURN_CODE for these tests
 
 
@@ -359,6 +399,8 @@ def main():
         run_full_disk(exe, cls[len("full_disk_"):], binary, a.work)
     elif cls in RECORD_CLASSES:
         run_record_case(exe, cls, binary, a.work)
+    elif cls in FOOTAGE_CLASSES:
+        run_footage_case(exe, cls, binary, a.work)
     elif cls in ("sigint", "sigterm"):
         run_interrupt(exe, signal.SIGINT if cls == "sigint" else signal.SIGTERM, binary, a.work)
     else:

@@ -9,3 +9,6 @@ list(APPEND scenarios_sources table_ball/config_keys.cpp)
 # The loop on a recording of its head camera (--record / --replay).
 list(APPEND scenarios_tests test/table_ball_sources_test.cpp)
 list(APPEND scenarios_tests test/table_ball_faults_test.cpp)
+# The loop on footage (images, video, v4l2): one session without truth (table_ball/footage.h).
+list(APPEND scenarios_sources table_ball/footage.cpp)
+list(APPEND scenarios_tests test/table_ball_footage_test.cpp)

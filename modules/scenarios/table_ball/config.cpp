@@ -181,10 +181,6 @@ TableBallConfig tableBallConfigFromYaml(const io::ConfigNode& root) {
   // First, so that the config reference's probe of each source kind reaches it.
   c.source = runtime::readSourceConfig(root);
   c.faults = runtime::readFaultPlanConfig(root);
-  if (!c.source.simulated() && c.source.kind != runtime::SourceKind::Recording)
-    throw core::InvalidInput(root.location("source") + ": source.kind " + runtime::toString(c.source.kind) +
-                             " is not supported by table_ball yet (sim or recording: its metrics need the simulated "
-                             "table's truth)");
   c.duration = root.getOr<double>("duration", c.duration);
   {
     const auto n = root.child("table");

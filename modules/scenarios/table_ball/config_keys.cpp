@@ -3,6 +3,7 @@
 // ScenarioConfigKeys fails when a key is read without an entry here or an entry is never read.
 #include "viewline/scenarios/config_keys.h"
 #include "viewline/runtime/faults.h"
+#include "viewline/runtime/source_config.h"
 #include "viewline/scenarios/table_ball/config.h"
 
 namespace viewline::scenarios {
@@ -17,7 +18,8 @@ io::ConfigReferenceSection tableBallConfigReference() {
   s.shipped = {"table_ball.yaml", "table_ball_apriltag.yaml"};
   // No shipped file has the inline camera (both name a rig): the camera given by its geometry.
   s.probes = {"table: {}\nwrist: {}\ncamera: {cx: 320, cy: 240, position: [0.5, 0.0, 1.5], look_at: [0.0, 0.0, 0.9]}\n",
-              "source: {kind: recording, path: rec}\n", runtime::faultConfigProbe()};
+              runtime::faultConfigProbe()};
+  for (const std::string& p : runtime::sourceConfigProbes("")) s.probes.push_back(p);
   s.read = [](const io::ConfigNode& root) { tableBallConfigFromYaml(root); };
   s.keys = {
       {"duration", "s", "simulated time (--duration overrides it)"},
@@ -99,10 +101,15 @@ io::ConfigReferenceSection tableBallConfigReference() {
       {"metrics.push_band", "m", "recovered from a push when back within this distance for good"},
       {"metrics.compare_tunings", "", "run [M]'s two tunings and the stationary gain beside the loop"},
       {"metrics.time_reference", "", "time the plain OpenCV reference of [M]'s steps on every frame"},
-      {"source", "", "where the frames come from (absent: the rendered head camera)"},
-      {"source.kind", "", "sim (the rendered head camera) or recording (a folder written by --record); other kinds are refused"},
-      {"source.path", "", "recording: the folder written by --record"},
   };
+  // sim and recording run the closed loop; images, video and v4l2 one session on footage
+  // without truth (table_ball/footage.h).
+  for (io::ConfigKeyDoc& k : runtime::sourceConfigKeys()) {
+    if (k.key == "source.kind")
+      k.meaning = "sim (the rendered head camera) or recording: the scored closed loop; images, video or v4l2: one "
+                  "session on footage, nothing scored (table_ball/footage.h)";
+    s.keys.push_back(std::move(k));
+  }
   for (io::ConfigKeyDoc& d : runtime::faultConfigKeys()) s.keys.push_back(std::move(d));
   return s;
 }

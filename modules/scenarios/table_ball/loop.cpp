@@ -126,6 +126,9 @@ void reportFrame(runtime::TelemetrySink& sink, double t, double capture_time, co
 }  // namespace
 
 TableBallResult runTableBall(const TableBallConfig& cfg, std::uint64_t seed, const TableBallHooks& hooks) {
+  if (cfg.onFootage() && hooks.replay_dir.empty())
+    throw core::InvalidInput(std::string("source.kind ") + runtime::toString(cfg.source.kind) +
+                             ": footage runs as one session without truth (runTableBallFootage)");
   const auto wall0 = std::chrono::steady_clock::now();
   const double period = cfg.framePeriod();
   TableBallWorld world(cfg, seed);

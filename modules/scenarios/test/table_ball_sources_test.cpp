@@ -1,5 +1,5 @@
 // The table-ball loop on a recording of its head camera: the replay of a recorded run gives the
-// same result bit for bit, lost frames included; sources without the table's truth are refused.
+// same result bit for bit, lost frames included; footage (no table truth) is refused by the scored loop.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -49,12 +49,15 @@ TEST(TableBallSources, ReplayOfARecordingGivesTheSameResultBitForBit) {
   fs::remove_all(dir);
 }
 
-TEST(TableBallSources, SourcesWithoutTheTablesTruthAreRefused) {
+TEST(TableBallSources, TheScoredLoopRefusesFootage) {
+  // Footage has no table truth to score against: it runs as one session (table_ball_footage_test.cpp).
+  const auto cfg = scenarios::tableBallConfigFromYaml(
+      io::loadConfigWithValues("config/table_ball.yaml", {"source.kind=video", "source.path=x.mp4"}));
+  EXPECT_TRUE(cfg.onFootage());
   try {
-    scenarios::tableBallConfigFromYaml(
-        io::loadConfigWithValues("config/table_ball.yaml", {"source.kind=video", "source.path=x.mp4"}));
-    FAIL() << "a video source was accepted";
+    scenarios::runTableBall(cfg, 1);
+    FAIL() << "the scored loop ran on a video source";
   } catch (const core::InvalidInput& e) {
-    EXPECT_NE(std::string(e.what()).find("source.kind video is not supported by table_ball"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("source.kind video: footage runs as one session"), std::string::npos) << e.what();
   }
 }

@@ -4,6 +4,7 @@
 // and a seed, so the app and the tuning tool run exactly the same code. Its parts, each in its
 // own file under modules/scenarios/table_ball/: config (the struct and its YAML reader), world
 // (physics, wrist, head camera as a frame source), loop (the scheduler's events) and metrics.
+// On footage (source: images, video or v4l2) footage.h runs one session without truth instead.
 //
 // World (SI, world z up): a robot arm holds a square table (red, raised black borders) of side
 // L = 0.3 m whose untilted centre is at `table.center`; a green ball (r = 0.025 m) rolls on it
@@ -67,6 +68,7 @@
 //     run on the calling thread for a 320x240 image (OpenCV does not split such small images).
 
 #include "viewline/scenarios/table_ball/config.h"
+#include "viewline/scenarios/table_ball/footage.h"
 #include "viewline/scenarios/table_ball/loop.h"
 #include "viewline/scenarios/table_ball/metrics.h"
 #include "viewline/scenarios/table_ball/world.h"

@@ -88,8 +88,9 @@ struct TableBallConfig {
   double steady_window = 1.0;                                  ///< s
   double push_band = 0.005;                                    ///< m
   bool compare_tunings = true;                                 ///< run the side filters
-  /// Where the frames come from (`source:`): sim (the rendered head camera, the default) or a
-  /// recording of a simulated run (its truth is the simulated world's, which a replay reproduces).
+  /// Where the frames come from (`source:`): sim (the rendered head camera, the default), a
+  /// recording of a simulated run (its truth is the simulated world's, which a replay
+  /// reproduces), or footage (images, video, v4l2: one session without truth, footage.h).
   runtime::SourceConfig source;
   /// Injected camera and detector faults (runtime/faults.h; windows in run time; empty: none).
   runtime::FaultConfig faults;
@@ -99,6 +100,8 @@ struct TableBallConfig {
   /// edits a config afterwards (tests, the tuning tool) calls it again.
   void validate() const;
 
+  /// True when the frames are footage (source.kind images, video or v4l2: runTableBallFootage).
+  bool onFootage() const { return !source.simulated() && source.kind != runtime::SourceKind::Recording; }
   /// The camera frame period, s.
   double framePeriod() const { return 1.0 / rate_hz; }
   /// The set point in force at time t (the last one with t_i <= t).
