@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <opencv2/imgproc.hpp>
 
+#include "viewline/vision/ball_detector.h"
 #include "viewline/vision/color.h"
 
 namespace viewline::vision {
@@ -45,7 +47,74 @@ bool fitLine(std::vector<Eigen::Vector2d>& pts, Eigen::Vector2d& c, Eigen::Vecto
   return true;
 }
 
+/// BORDER_REFLECT_101 index (OpenCV's borderInterpolate) into [0, n).
+int reflect101(int i, int n) {
+  if (n == 1) return 0;
+  while (i < 0 || i >= n) {
+    if (i < 0) i = -i;
+    if (i >= n) i = 2 * n - 2 - i;
+  }
+  return i;
+}
+
 }  // namespace
+
+void gaussianBlurWindow(const cv::Mat& bgr, const cv::Rect& roi, int ksize, cv::Mat& dst) {
+  const bool inside = roi.width > 0 && roi.height > 0 && (roi & cv::Rect(0, 0, bgr.cols, bgr.rows)) == roi;
+  // A submatrix image would be read beyond its edges by OpenCV: that case stays OpenCV's.
+  if (bgr.type() != CV_8UC3 || (ksize != 3 && ksize != 5) || !inside || bgr.isSubmatrix()) {
+    cv::GaussianBlur(bgr(roi), dst, cv::Size(ksize, ksize), 0.0);
+    return;
+  }
+  // What OpenCV 4.6 does for a submatrix that is not isolated (its separable filter engine, not
+  // the bit-exact path of whole images): the binomial taps (1 2 1)/4 and (1 4 6 4 1)/16 in 8.8
+  // fixed point, an exact integer row pass, and a column pass whose float sums are exact too
+  // (at most 17 significant bits), so the only rounding is the last one of the 2-D sum S (weight
+  // 16 or 256): half to even on the elements of a row its SIMD loops cover (the first
+  // 4·floor(n/4) of the n = 3·width channel values, whatever the vector width), half up on the
+  // rest (its scalar tail); a window that is the whole image goes OpenCV's bit-exact way, the
+  // same sums rounded half up. The window reads the image around it and reflects at the image's
+  // edges (BORDER_REFLECT_101). WindowBlurIsOpenCvsGaussianBlur checks it value for value.
+  static constexpr int kTaps3[3] = {1, 2, 1};
+  static constexpr int kTaps5[5] = {1, 4, 6, 4, 1};
+  const int* taps = ksize == 3 ? kTaps3 : kTaps5;
+  const int shift = ksize == 3 ? 4 : 8;
+  const int r = ksize / 2, w = roi.width, h = roi.height;
+  // Scratch kept between calls (per thread), so the steady state does not allocate.
+  thread_local std::vector<std::uint16_t> rows;
+  thread_local std::vector<int> cols;
+  rows.resize(static_cast<std::size_t>(h + 2 * r) * static_cast<std::size_t>(w) * 3);
+  cols.resize(static_cast<std::size_t>(w + 2 * r));
+  for (int i = 0; i < w + 2 * r; ++i) cols[static_cast<std::size_t>(i)] = 3 * reflect101(roi.x - r + i, bgr.cols);
+  for (int yy = 0; yy < h + 2 * r; ++yy) {
+    const std::uint8_t* src = bgr.ptr<std::uint8_t>(reflect101(roi.y - r + yy, bgr.rows));
+    std::uint16_t* out = rows.data() + static_cast<std::size_t>(yy) * static_cast<std::size_t>(w) * 3;
+    for (int x = 0; x < w; ++x) {
+      for (int c = 0; c < 3; ++c) {
+        int sum = 0;
+        for (int j = 0; j < ksize; ++j) sum += taps[j] * src[cols[static_cast<std::size_t>(x + j)] + c];
+        out[3 * x + c] = static_cast<std::uint16_t>(sum);
+      }
+    }
+  }
+  dst.create(h, w, CV_8UC3);
+  const int half = 1 << (shift - 1), frac = (1 << shift) - 1;
+  const std::size_t stride = static_cast<std::size_t>(w) * 3;
+  // A window that is the whole image is no submatrix: OpenCV's bit-exact path, half up throughout.
+  const bool whole = roi.width == bgr.cols && roi.height == bgr.rows;
+  const std::size_t vector_end = whole ? 0 : stride / 4 * 4;
+  for (int y = 0; y < h; ++y) {
+    std::uint8_t* out = dst.ptr<std::uint8_t>(y);
+    const std::uint16_t* in = rows.data() + static_cast<std::size_t>(y) * stride;
+    for (std::size_t q = 0; q < stride; ++q) {
+      int sum = 0;
+      for (int i = 0; i < ksize; ++i) sum += taps[i] * in[static_cast<std::size_t>(i) * stride + q];
+      int v = (sum + half) >> shift;                                   // half up
+      if (q < vector_end && (sum & frac) == half && (v & 1) != 0) --v;  // half to even
+      out[q] = static_cast<std::uint8_t>(v);
+    }
+  }
+}
 
 TableEdgeTracker::TableEdgeTracker(const TableDetectorConfig& detector, const TableEdgeTrackerConfig& config)
     : detector_(detector), config_(config) {
@@ -72,23 +141,31 @@ std::optional<std::array<Eigen::Vector2d, 4>> TableEdgeTracker::trackCorners(
     for (int k = 0; k < config_.samples_per_side; ++k) {
       const double s = 0.15 + 0.7 * (k + 0.5) / config_.samples_per_side;
       const Eigen::Vector2d p0 = a + s * (b - a);
-      bool ok = true;
-      for (int j = 0; j < count && ok; ++j) {
+      // The profile is read lazily: its two ends first (inside the image and contrast), then
+      // from the inside end up to the first crossing only. Each coordinate of the sample points
+      // is monotone in j (a rounded affine function), so both ends inside the image put every
+      // point between them inside; the values are those of the whole profile, read the same way.
+      auto sample = [&](int j) {
         const Eigen::Vector2d p = p0 + (-config_.search_px + j * kStep) * n;
-        prof[static_cast<std::size_t>(j)] = redFeature(bgr, p.x(), p.y());
-        ok = !std::isnan(prof[static_cast<std::size_t>(j)]);
-      }
-      if (!ok) continue;
+        return redFeature(bgr, p.x(), p.y());
+      };
+      prof[0] = sample(0);
+      prof[static_cast<std::size_t>(count - 1)] = sample(count - 1);
+      if (std::isnan(prof[0]) || std::isnan(prof[static_cast<std::size_t>(count - 1)])) continue;
+      prof[1] = sample(1);
+      prof[static_cast<std::size_t>(count - 2)] = sample(count - 2);
       const double in = 0.5 * (prof[0] + prof[1]), out = 0.5 * (prof[static_cast<std::size_t>(count - 1)] + prof[static_cast<std::size_t>(count - 2)]);
       if (in - out < config_.min_contrast) continue;
       const double level = 0.5 * (in + out);
+      double f0 = prof[0];
       for (int j = 0; j + 1 < count; ++j) {
-        const double f0 = prof[static_cast<std::size_t>(j)], f1 = prof[static_cast<std::size_t>(j + 1)];
+        const double f1 = (j + 1 == 1 || j + 1 == count - 2 || j + 1 == count - 1) ? prof[static_cast<std::size_t>(j + 1)] : sample(j + 1);
         if (f0 >= level && f1 < level) {
           const double sj = -config_.search_px + kStep * (j + (f0 - level) / (f0 - f1));
           pts.push_back(p0 + sj * n);
           break;
         }
+        f0 = f1;
       }
     }
     if (!fitLine(pts, line_c[i], line_d[i], config_.min_points)) return std::nullopt;
@@ -114,13 +191,18 @@ std::optional<Circle> TableEdgeTracker::trackBall(const cv::Mat& bgr, const Circ
   if (roi.width < 8 || roi.height < 8) return std::nullopt;
   const int k = detector_.blur_ksize;
   if (k > 1) {
-    cv::GaussianBlur(bgr(roi), blurred_, cv::Size(k, k), 0.0);
+    gaussianBlurWindow(bgr, roi, k, blurred_);
   } else {
     bgr(roi).copyTo(blurred_);
   }
   cv::cvtColor(blurred_, hls_, cv::COLOR_BGR2HLS);
   vision::thresholdColor(hls_, detector_.green_hls, mask_);
-  if (!kernel_.empty()) cv::morphologyEx(mask_, mask_, cv::MORPH_OPEN, kernel_);
+  if (!kernel_.empty()) {
+    // The opening as erosion then dilation into kept buffers: cv::morphologyEx's values (its
+    // default border), without the filter engine it builds on every call.
+    vision::morphologyStep(mask_, eroded_, kernel_, true);
+    vision::morphologyStep(eroded_, mask_, kernel_, false);
+  }
   cv::findContours(mask_, contours_, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_NONE, roi.tl());
   double best = 0.0;
   const std::vector<cv::Point>* ball = nullptr;

@@ -7,6 +7,7 @@
 #include "viewline/core/error.h"
 #include "viewline/core/frames.h"
 #include "viewline/vision/table_detector.h"
+#include "viewline/vision/table_edge_tracker.h"
 
 namespace viewline::vision {
 namespace {
@@ -178,6 +179,37 @@ TEST(TableDetector, RejectsBadInput) {
   cfg = {};
   cfg.red_hls.c1_lo = 300;
   EXPECT_THROW(TableDetector(mCamera(), cfg), core::InvalidInput);
+}
+
+
+TEST(TableEdgeTracker, WindowBlurIsOpenCvsGaussianBlur) {
+  // The fast path's window blur against cv::GaussianBlur on the same submatrix, value for value:
+  // windows inside the image, at each edge and corner, the whole image, one-pixel strips, and
+  // an image one pixel high; random pixels (seeded) so every rounding case occurs.
+  cv::RNG rng(12345);
+  for (const cv::Size size : {cv::Size(320, 240), cv::Size(37, 23), cv::Size(9, 1)}) {
+    cv::Mat bgr(size, CV_8UC3);
+    rng.fill(bgr, cv::RNG::UNIFORM, 0, 256);
+    std::vector<cv::Rect> windows{{0, 0, size.width, size.height}};
+    if (size.height > 1) {
+      windows.insert(windows.end(), {cv::Rect(0, 0, 5, 1), cv::Rect(size.width - 1, size.height - 1, 1, 1),
+                                     cv::Rect(1, 1, size.width - 2, size.height - 2), cv::Rect(0, size.height / 2, size.width, 1)});
+      for (int k = 0; k < 40; ++k) {
+        const int x = rng.uniform(0, size.width), y = rng.uniform(0, size.height);
+        windows.emplace_back(x, y, rng.uniform(1, size.width - x + 1), rng.uniform(1, size.height - y + 1));
+      }
+    }
+    for (const int ksize : {3, 5}) {
+      for (const cv::Rect& roi : windows) {
+        cv::Mat expected, ours;
+        cv::GaussianBlur(bgr(roi), expected, cv::Size(ksize, ksize), 0.0);
+        gaussianBlurWindow(bgr, roi, ksize, ours);
+        ASSERT_EQ(ours.size(), expected.size());
+        EXPECT_EQ(cv::norm(ours, expected, cv::NORM_INF), 0.0)
+            << "ksize " << ksize << ", window " << roi << " of " << size;
+      }
+    }
+  }
 }
 
 }  // namespace
