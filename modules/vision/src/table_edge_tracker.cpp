@@ -1,6 +1,7 @@
 #include "viewline/vision/table_edge_tracker.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <opencv2/imgproc.hpp>
@@ -57,6 +58,72 @@ int reflect101(int i, int n) {
   return i;
 }
 
+/// The body of gaussianBlurWindow for the binomial kernel of size K (3 or 5); see there.
+template <int K>
+void blurWindowBinomial(const cv::Mat& bgr, const cv::Rect& roi, cv::Mat& dst) {
+  static_assert(K == 3 || K == 5, "binomial taps of size 3 or 5");
+  constexpr int kR = K / 2;
+  constexpr std::array<std::uint16_t, K> kTaps = [] {
+    if constexpr (K == 3) {
+      return std::array<std::uint16_t, K>{1, 2, 1};
+    } else {
+      return std::array<std::uint16_t, K>{1, 4, 6, 4, 1};
+    }
+  }();
+  constexpr int kShift = K == 3 ? 4 : 8;  // log2 of the 2-D weight
+  // Every sum fits 16 bits (at most 255 · 256 + half), so the passes run on 16-bit lanes.
+  constexpr std::uint16_t kHalf = 1U << (kShift - 1);
+  const int w = roi.width, h = roi.height;
+  const std::size_t stride = static_cast<std::size_t>(w) * 3;
+  // Scratch kept between calls (per thread), so the steady state does not allocate: the padded
+  // source row and the row sums of the window's rows and the K − 1 around them.
+  thread_local std::vector<std::uint8_t> padded;
+  thread_local std::vector<std::uint16_t> sums;
+  padded.resize(stride + 6 * kR);
+  sums.resize(static_cast<std::size_t>(h + 2 * kR) * stride);
+  const bool inside_x = roi.x >= kR && roi.x + w + kR <= bgr.cols;
+  for (int yy = 0; yy < h + 2 * kR; ++yy) {
+    const std::uint8_t* row = bgr.ptr<std::uint8_t>(reflect101(roi.y - kR + yy, bgr.rows));
+    const std::uint8_t* src = row + 3 * (roi.x - kR);
+    if (!inside_x) {
+      for (int i = 0; i < w + 2 * kR; ++i) {
+        const std::uint8_t* p = row + 3 * reflect101(roi.x - kR + i, bgr.cols);
+        std::copy(p, p + 3, padded.data() + 3 * i);
+      }
+      src = padded.data();
+    }
+    std::uint16_t* out = sums.data() + static_cast<std::size_t>(yy) * stride;
+    for (std::size_t q = 0; q < stride; ++q) {
+      std::uint16_t sum = 0;
+      for (int j = 0; j < K; ++j)
+        sum = static_cast<std::uint16_t>(sum + kTaps[static_cast<std::size_t>(j)] * src[q + 3 * static_cast<std::size_t>(j)]);
+      out[q] = sum;
+    }
+  }
+  dst.create(h, w, CV_8UC3);
+  // A window that is the whole image is no submatrix: OpenCV's bit-exact path, half up throughout.
+  const bool whole = roi.width == bgr.cols && roi.height == bgr.rows;
+  const std::size_t vector_end = whole ? 0 : stride / 4 * 4;
+  for (int y = 0; y < h; ++y) {
+    std::uint8_t* out = dst.ptr<std::uint8_t>(y);
+    const std::uint16_t* in = sums.data() + static_cast<std::size_t>(y) * stride;
+    auto sumAt = [&](std::size_t q) {
+      std::uint16_t sum = 0;
+      for (int i = 0; i < K; ++i)
+        sum = static_cast<std::uint16_t>(sum + kTaps[static_cast<std::size_t>(i)] * in[static_cast<std::size_t>(i) * stride + q]);
+      return sum;
+    };
+    // Half to even: adding half − 1 plus the truncated result's lowest bit rounds a tie up only
+    // from an odd value.
+    for (std::size_t q = 0; q < vector_end; ++q) {
+      const std::uint16_t sum = sumAt(q);
+      out[q] = static_cast<std::uint8_t>(static_cast<std::uint16_t>(sum + kHalf - 1 + ((sum >> kShift) & 1U)) >> kShift);
+    }
+    for (std::size_t q = vector_end; q < stride; ++q)
+      out[q] = static_cast<std::uint8_t>(static_cast<std::uint16_t>(sumAt(q) + kHalf) >> kShift);
+  }
+}
+
 }  // namespace
 
 void gaussianBlurWindow(const cv::Mat& bgr, const cv::Rect& roi, int ksize, cv::Mat& dst) {
@@ -75,44 +142,10 @@ void gaussianBlurWindow(const cv::Mat& bgr, const cv::Rect& roi, int ksize, cv::
   // rest (its scalar tail); a window that is the whole image goes OpenCV's bit-exact way, the
   // same sums rounded half up. The window reads the image around it and reflects at the image's
   // edges (BORDER_REFLECT_101). WindowBlurIsOpenCvsGaussianBlur checks it value for value.
-  static constexpr int kTaps3[3] = {1, 2, 1};
-  static constexpr int kTaps5[5] = {1, 4, 6, 4, 1};
-  const int* taps = ksize == 3 ? kTaps3 : kTaps5;
-  const int shift = ksize == 3 ? 4 : 8;
-  const int r = ksize / 2, w = roi.width, h = roi.height;
-  // Scratch kept between calls (per thread), so the steady state does not allocate.
-  thread_local std::vector<std::uint16_t> rows;
-  thread_local std::vector<int> cols;
-  rows.resize(static_cast<std::size_t>(h + 2 * r) * static_cast<std::size_t>(w) * 3);
-  cols.resize(static_cast<std::size_t>(w + 2 * r));
-  for (int i = 0; i < w + 2 * r; ++i) cols[static_cast<std::size_t>(i)] = 3 * reflect101(roi.x - r + i, bgr.cols);
-  for (int yy = 0; yy < h + 2 * r; ++yy) {
-    const std::uint8_t* src = bgr.ptr<std::uint8_t>(reflect101(roi.y - r + yy, bgr.rows));
-    std::uint16_t* out = rows.data() + static_cast<std::size_t>(yy) * static_cast<std::size_t>(w) * 3;
-    for (int x = 0; x < w; ++x) {
-      for (int c = 0; c < 3; ++c) {
-        int sum = 0;
-        for (int j = 0; j < ksize; ++j) sum += taps[j] * src[cols[static_cast<std::size_t>(x + j)] + c];
-        out[3 * x + c] = static_cast<std::uint16_t>(sum);
-      }
-    }
-  }
-  dst.create(h, w, CV_8UC3);
-  const int half = 1 << (shift - 1), frac = (1 << shift) - 1;
-  const std::size_t stride = static_cast<std::size_t>(w) * 3;
-  // A window that is the whole image is no submatrix: OpenCV's bit-exact path, half up throughout.
-  const bool whole = roi.width == bgr.cols && roi.height == bgr.rows;
-  const std::size_t vector_end = whole ? 0 : stride / 4 * 4;
-  for (int y = 0; y < h; ++y) {
-    std::uint8_t* out = dst.ptr<std::uint8_t>(y);
-    const std::uint16_t* in = rows.data() + static_cast<std::size_t>(y) * stride;
-    for (std::size_t q = 0; q < stride; ++q) {
-      int sum = 0;
-      for (int i = 0; i < ksize; ++i) sum += taps[i] * in[static_cast<std::size_t>(i) * stride + q];
-      int v = (sum + half) >> shift;                                   // half up
-      if (q < vector_end && (sum & frac) == half && (v & 1) != 0) --v;  // half to even
-      out[q] = static_cast<std::uint8_t>(v);
-    }
+  if (ksize == 3) {
+    blurWindowBinomial<3>(bgr, roi, dst);
+  } else {
+    blurWindowBinomial<5>(bgr, roi, dst);
   }
 }
 
