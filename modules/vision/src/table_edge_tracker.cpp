@@ -228,15 +228,63 @@ std::optional<Circle> TableEdgeTracker::trackBall(const cv::Mat& bgr, const Circ
   } else {
     bgr(roi).copyTo(blurred_);
   }
-  cv::cvtColor(blurred_, hls_, cv::COLOR_BGR2HLS);
-  vision::thresholdColor(hls_, detector_.green_hls, mask_);
+  // HLS and the range test on the rows that can hold a green pixel only. OpenCV's hue of a pixel
+  // whose red is its largest channel (ties included: its R branch comes first) is 60° off red at
+  // most, 8-bit H in [0, 30] ∪ [150, 180]; a range inside (30, 150) can only hold pixels with
+  // R < max(G, B). The conversion is per pixel and each converted row is whole (its SIMD and
+  // scalar parts are those of the full conversion), so the band's values are the full ones and
+  // the rows outside it are all zero in the full mask too.
+  const ColorRange& green = detector_.green_hls;
+  int band0 = 0, band1 = blurred_.rows;  // [band0, band1)
+  if (!green.wraps() && green.hue_lo > 30 && green.hue_hi < 150) {
+    band0 = blurred_.rows;
+    band1 = 0;
+    for (int y = 0; y < blurred_.rows; ++y) {
+      const std::uint8_t* p = blurred_.ptr<std::uint8_t>(y);
+      bool any = false;
+      for (int x = 0; x < 3 * blurred_.cols; x += 3) any |= p[x + 2] < std::max(p[x], p[x + 1]);
+      if (any) {
+        band0 = std::min(band0, y);
+        band1 = y + 1;
+      }
+    }
+  }
+  mask_.create(blurred_.size(), CV_8UC1);
+  mask_.setTo(0);
+  if (band0 < band1) {
+    cv::cvtColor(blurred_.rowRange(band0, band1), hls_, cv::COLOR_BGR2HLS);
+    cv::Mat band = mask_.rowRange(band0, band1);
+    vision::thresholdColor(hls_, green, band);
+    if (band.data != mask_.ptr(band0)) band.copyTo(mask_.rowRange(band0, band1));  // a reallocated header
+  }
   if (!kernel_.empty()) {
     // The opening as erosion then dilation into kept buffers: cv::morphologyEx's values (its
     // default border), without the filter engine it builds on every call.
     vision::morphologyStep(mask_, eroded_, kernel_, true);
     vision::morphologyStep(eroded_, mask_, kernel_, false);
   }
-  cv::findContours(mask_, contours_, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_NONE, roi.tl());
+  // Contours of the mask's non-zero bounding box only: findContours pads its input with a zero
+  // frame, so the crop (zeros cut off around it) gives the same contours, point for point and in
+  // the same (raster) order, from fewer pixels.
+  int x0 = mask_.cols, x1 = -1, y0 = mask_.rows, y1 = -1;
+  for (int y = 0; y < mask_.rows; ++y) {
+    const std::uint8_t* m = mask_.ptr<std::uint8_t>(y);
+    int first = -1, last = -1;
+    for (int x = 0; x < mask_.cols; ++x) {
+      if (m[x] != 0) {
+        if (first < 0) first = x;
+        last = x;
+      }
+    }
+    if (first < 0) continue;
+    x0 = std::min(x0, first);
+    x1 = std::max(x1, last);
+    y0 = std::min(y0, y);
+    y1 = y;
+  }
+  if (x1 < 0) return std::nullopt;  // an empty mask has no contour
+  const cv::Rect nonzero(x0, y0, x1 - x0 + 1, y1 - y0 + 1);
+  cv::findContours(mask_(nonzero), contours_, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_NONE, roi.tl() + nonzero.tl());
   double best = 0.0;
   const std::vector<cv::Point>* ball = nullptr;
   for (const auto& c : contours_) {
@@ -258,37 +306,47 @@ std::optional<Circle> TableEdgeTracker::trackBall(const cv::Mat& bgr, const Circ
   Circle c{Eigen::Vector2d(static_cast<double>(centre.x), static_cast<double>(centre.y)), static_cast<double>(r)};
   std::vector<cv::Point2f> edge;
   constexpr double kStep = 0.25;
-  const double reach = 3.0;
-  const int count = static_cast<int>(2.0 * reach / kStep) + 1;
-  std::vector<double> prof(static_cast<std::size_t>(count));
+  constexpr double reach = 3.0;
+  constexpr int count = static_cast<int>(2.0 * reach / kStep) + 1;
+  std::array<double, count> prof{};
+  std::array<bool, count> have{};
   for (int ray = 0; ray < 32; ++ray) {
     const double ang = 2.0 * 3.14159265358979323846 * ray / 32.0;
     const Eigen::Vector2d dir(std::cos(ang), std::sin(ang));
-    bool ok = true;
-    for (int j = 0; j < count && ok; ++j) {
+    // The profile is read lazily (its ends, then up to the crossings): each coordinate of the
+    // sample points is monotone in j, so both ends inside the image put every point inside, and
+    // each value read is the one the whole profile would hold.
+    have.fill(false);
+    auto value = [&](int j) {
+      const auto jj = static_cast<std::size_t>(j);
+      if (!have[jj]) {
+        const Eigen::Vector2d p = c.center + (c.radius - reach + j * kStep) * dir;
+        const double u = p.x(), v = p.y();
+        const int x = static_cast<int>(u), y = static_cast<int>(v);
+        const double fx = u - x, fy = v - y;
+        const cv::Vec3b* r0 = bgr.ptr<cv::Vec3b>(y) + x;
+        const cv::Vec3b* r1 = bgr.ptr<cv::Vec3b>(y + 1) + x;
+        double f[3];
+        for (int q = 0; q < 3; ++q) f[q] = (1 - fy) * ((1 - fx) * r0[0][q] + fx * r0[1][q]) + fy * ((1 - fx) * r1[0][q] + fx * r1[1][q]);
+        prof[jj] = f[1] - std::max(f[0], f[2]);
+        have[jj] = true;
+      }
+      return prof[jj];
+    };
+    auto inside = [&](int j) {
       const Eigen::Vector2d p = c.center + (c.radius - reach + j * kStep) * dir;
       const double u = p.x(), v = p.y();
-      if (!(u >= 0.0 && v >= 0.0 && u < bgr.cols - 1.0 && v < bgr.rows - 1.0)) {
-        ok = false;
-        break;
-      }
-      const int x = static_cast<int>(u), y = static_cast<int>(v);
-      const double fx = u - x, fy = v - y;
-      const cv::Vec3b* r0 = bgr.ptr<cv::Vec3b>(y) + x;
-      const cv::Vec3b* r1 = bgr.ptr<cv::Vec3b>(y + 1) + x;
-      double f[3];
-      for (int q = 0; q < 3; ++q) f[q] = (1 - fy) * ((1 - fx) * r0[0][q] + fx * r0[1][q]) + fy * ((1 - fx) * r1[0][q] + fx * r1[1][q]);
-      prof[static_cast<std::size_t>(j)] = f[1] - std::max(f[0], f[2]);
-    }
-    if (!ok) continue;
-    const double in = 0.5 * (prof[0] + prof[1]);
-    const double out = 0.5 * (prof[static_cast<std::size_t>(count - 1)] + prof[static_cast<std::size_t>(count - 2)]);
+      return u >= 0.0 && v >= 0.0 && u < bgr.cols - 1.0 && v < bgr.rows - 1.0;
+    };
+    if (!inside(0) || !inside(count - 1)) continue;
+    const double in = 0.5 * (value(0) + value(1));
+    const double out = 0.5 * (value(count - 1) + value(count - 2));
     if (in - out < 0.5 * config_.min_contrast) continue;
     // Crossing of the mid level; then once more with the levels 1.25 px either side of it (the
     // shaded sphere darkens towards its limb, so the far inside plateau would bias the edge).
     auto crossing = [&](double level, int from, int to, double& s_out) {
       for (int j = std::max(from, 0); j + 1 < count && j < to; ++j) {
-        const double f0 = prof[static_cast<std::size_t>(j)], f1 = prof[static_cast<std::size_t>(j + 1)];
+        const double f0 = value(j), f1 = value(j + 1);
         if (f0 >= level && f1 < level) {
           s_out = kStep * (j + (f0 - level) / (f0 - f1));
           return true;
@@ -301,7 +359,7 @@ std::optional<Circle> TableEdgeTracker::trackBall(const cv::Mat& bgr, const Circ
     const int ie = static_cast<int>(std::lround(s_edge / kStep));
     constexpr int kGap = 5;
     if (ie - kGap >= 0 && ie + kGap < count) {
-      const double in2 = prof[static_cast<std::size_t>(ie - kGap)], out2 = prof[static_cast<std::size_t>(ie + kGap)];
+      const double in2 = value(ie - kGap), out2 = value(ie + kGap);
       double s2 = 0.0;
       if (in2 - out2 >= 0.5 * config_.min_contrast && crossing(0.5 * (in2 + out2), ie - kGap, ie + kGap, s2)) s_edge = s2;
     }
