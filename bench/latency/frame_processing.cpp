@@ -23,7 +23,11 @@
 //
 //   nice -n 10 build/bench/latency_frames [--frames 10000] [--scaling-seconds 2] [--throws 2]
 //       [--record-seconds 6] [--config config/ball_catching.yaml] [--check] [--pan-tilt-only]
+//       [--table-ball-only] [--stages]
 // --pan-tilt-only: the pan-tilt rows alone (for profiling that pipeline; no budget check).
+// --table-ball-only: the table-ball rows alone (no budget check); --stages adds the table ball's
+// fast-path breakdown by stage (its clock reads add a little to the totals: the budget check
+// runs without it).
 
 #include <Eigen/Geometry>
 #include <opencv2/core/utility.hpp>
@@ -127,9 +131,15 @@ struct TableBallFigures {
   latency::Stats total;     ///< every frame
   latency::Stats tracked;   ///< frames of the fast path (edge tracking)
   latency::Stats detected;  ///< frames of the full detection (first frame of a pass, fast path lost)
+  /// Fast-path frames by stage: edge tracking, ball window, PnP refine, pose filter + tilt + ball
+  /// on the table, rolling-ball filter, controller.
+  latency::Stats fast_edges, fast_ball, fast_pose, fast_geometry, fast_filter, fast_control;
 };
 
-TableBallFigures tableBall(const std::string& config, double seconds, std::size_t frames_wanted, std::size_t& recorded) {
+// With `stages`, the fast-path frames are also timed stage by stage (the clock reads add a little
+// to the totals; the budget check runs without them).
+TableBallFigures tableBall(const std::string& config, double seconds, std::size_t frames_wanted, std::size_t& recorded,
+                           bool stages) {
   scenarios::TableBallConfig cfg = scenarios::tableBallConfigFromYaml(io::loadConfigWithValues(config, {}));
   cfg.duration = seconds;
   cfg.time_reference = false;
@@ -145,6 +155,7 @@ TableBallFigures tableBall(const std::string& config, double seconds, std::size_
   recorded = frames.size();
   scenarios::TableBallWorld world(cfg, 1);  // kinematics (table pose), observer config, wrist
   std::vector<double> times, tracked, detected;
+  std::vector<double> s_edges, s_ball, s_pose, s_geometry, s_filter, s_control;
   std::size_t timed = 0;
   bool warm = false;
   while (timed < frames_wanted) {
@@ -154,24 +165,48 @@ TableBallFigures tableBall(const std::string& config, double seconds, std::size_
     for (const auto& f : frames) {
       const Eigen::Matrix3d c_R_w = f.camera.c_M_w.rotation();
       const Eigen::Isometry3d c_M_t_nominal = f.camera.c_M_w * world.tablePose(f.tilt);
+      scenarios::ObserverStageTimes st;
       const double t0 = latency::threadCpuNow();
-      const scenarios::ObserverFrame& of = observer.process(f.image, f.t, c_R_w, c_M_t_nominal);
+      const scenarios::ObserverFrame& of =
+          observer.process(f.image, f.t, c_R_w, c_M_t_nominal, stages ? &latency::threadCpuNow : nullptr, &st);
+      const double t1 = stages ? latency::threadCpuNow() : 0.0;
       if (of.estimate_valid) {
         const control::TiltRamp r = controller.update(f.t, Eigen::Vector2d(of.x[0], of.x[2]),
                                                       Eigen::Vector2d(of.x[1], of.x[3]), f.setpoint);
         sink += r.rate.x();
       }
-      const double dt = latency::threadCpuNow() - t0;
+      const double t2 = latency::threadCpuNow();
+      const double dt = t2 - t0;
       if (warm) {
         times.push_back(dt);
         (of.tracked ? tracked : detected).push_back(dt);
+        if (stages && of.tracked) {
+          s_edges.push_back(st.table);
+          s_ball.push_back(st.ball);
+          s_pose.push_back(st.pose);
+          s_geometry.push_back(st.geometry);
+          s_filter.push_back(st.filter);
+          s_control.push_back(t2 - t1);
+        }
         ++timed;
       }
     }
     warm = true;  // the first pass warms buffers and caches
     if (!std::isfinite(sink)) throw core::Error("table ball: non-finite controller output");
   }
-  return {latency::summarise(times), latency::summarise(tracked), latency::summarise(detected)};
+  TableBallFigures out;
+  out.total = latency::summarise(times);
+  out.tracked = latency::summarise(tracked);
+  out.detected = latency::summarise(detected);
+  if (stages) {
+    out.fast_edges = latency::summarise(s_edges);
+    out.fast_ball = latency::summarise(s_ball);
+    out.fast_pose = latency::summarise(s_pose);
+    out.fast_geometry = latency::summarise(s_geometry);
+    out.fast_filter = latency::summarise(s_filter);
+    out.fast_control = latency::summarise(s_control);
+  }
+  return out;
 }
 
 // ---- pan-tilt ---------------------------------------------------------------------------------
@@ -352,6 +387,28 @@ PanTiltFigures panTiltRows(double record_seconds, std::size_t frames) {
   return f;
 }
 
+// The table-ball rows of the report (with `stages`, the fast path's stage breakdown too).
+TableBallFigures tableBallRows(double record_seconds, std::size_t frames, bool stages) {
+  std::size_t recorded = 0;
+  const TableBallFigures f =
+      tableBall(std::string(VIEWLINE_SOURCE_DIR) + "/config/table_ball.yaml", record_seconds, frames, recorded, stages);
+  std::printf("\n## Table ball, 320x240, observer (table + ball detection, filter) + controller (%zu recorded frames replayed)\n\n",
+              recorded);
+  std::printf("| sample | frames | median (us) | p99 (us) | mean (us) |\n|---|---|---|---|---|\n");
+  printStats("every frame", f.total);
+  printStats("  fast path (sides and ball tracked locally)", f.tracked);
+  if (stages) {
+    printStats("    of which edge tracking (four sides)", f.fast_edges);
+    printStats("    of which ball window", f.fast_ball);
+    printStats("    of which PnP refine (border-aware)", f.fast_pose);
+    printStats("    of which pose filter, tilt, ball on the table", f.fast_geometry);
+    printStats("    of which rolling-ball filter", f.fast_filter);
+    printStats("    of which controller", f.fast_control);
+  }
+  printStats("  full detection ([M]'s pipeline)", f.detected);
+  return f;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -359,7 +416,7 @@ int main(int argc, char** argv) {
   std::size_t frames = 10000;
   double scaling_seconds = 2.0, record_seconds = 6.0;
   int throws = 2;
-  bool check = false, pan_tilt_only = false;
+  bool check = false, pan_tilt_only = false, table_ball_only = false, stages = false;
   std::string config = std::string(VIEWLINE_SOURCE_DIR) + "/config/ball_catching.yaml";
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -370,10 +427,12 @@ int main(int argc, char** argv) {
     else if (i + 1 < argc && a == "--record-seconds") record_seconds = std::atof(argv[++i]);
     else if (a == "--check") check = true;
     else if (a == "--pan-tilt-only") pan_tilt_only = true;
+    else if (a == "--table-ball-only") table_ball_only = true;
+    else if (a == "--stages") stages = true;
     else {
       std::fprintf(stderr,
                    "usage: %s [--frames N>=1] [--scaling-seconds S>0] [--throws N>=1] [--record-seconds S>=1] "
-                   "[--config FILE] [--check] [--pan-tilt-only]\n",
+                   "[--config FILE] [--check] [--pan-tilt-only] [--table-ball-only] [--stages]\n",
                    argv[0]);
       return 2;
     }
@@ -388,6 +447,10 @@ int main(int argc, char** argv) {
       panTiltRows(record_seconds, frames);
       return 0;
     }
+    if (table_ball_only) {
+      tableBallRows(record_seconds, frames, stages);
+      return 0;
+    }
     const CatchFigures bc = ballCatching(config, throws, frames);
     std::printf("## Ball catching, 656x480, detect + track + plan (%zu recorded frames replayed)\n\n", bc.recorded);
     std::printf("| sample | frames | median (us) | p99 (us) | mean (us) |\n|---|---|---|---|---|\n");
@@ -398,16 +461,7 @@ int main(int argc, char** argv) {
     printStats("tracking: full-frame searches", bc.full_in_tracking);
     printStats("acquisition: every frame searched whole", bc.acquisition);
 
-    std::size_t table_recorded = 0;
-    const TableBallFigures tb_frames =
-        tableBall(std::string(VIEWLINE_SOURCE_DIR) + "/config/table_ball.yaml", record_seconds, frames, table_recorded);
-    const latency::Stats& tb = tb_frames.total;
-    std::printf("\n## Table ball, 320x240, observer (table + ball detection, filter) + controller (%zu recorded frames replayed)\n\n",
-                table_recorded);
-    std::printf("| sample | frames | median (us) | p99 (us) | mean (us) |\n|---|---|---|---|---|\n");
-    printStats("every frame", tb);
-    printStats("  fast path (sides and ball tracked locally)", tb_frames.tracked);
-    printStats("  full detection ([M]'s pipeline)", tb_frames.detected);
+    const latency::Stats tb = tableBallRows(record_seconds, frames, stages).total;
 
     const PanTiltFigures pt_frames = panTiltRows(record_seconds, frames);
 

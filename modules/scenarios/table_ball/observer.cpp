@@ -123,8 +123,19 @@ void TableBallObserver::filterStep(double t, const std::optional<Eigen::Vector2d
 }
 
 const ObserverFrame& TableBallObserver::process(const cv::Mat& bgr, double t, const Eigen::Matrix3d& c_R_w,
-                                                const Eigen::Isometry3d& c_M_t_nominal) {
+                                                const Eigen::Isometry3d& c_M_t_nominal, double (*clock)(),
+                                                ObserverStageTimes* times) {
   const auto t0 = std::chrono::steady_clock::now();
+  // Stage timing for the latency bench: lap(slot) adds the time since the previous lap to slot.
+  if (clock == nullptr) times = nullptr;
+  if (times != nullptr) *times = {};
+  double last_lap = times != nullptr ? clock() : 0.0;
+  auto lap = [&](double ObserverStageTimes::*slot) {
+    if (times == nullptr) return;
+    const double now = clock();
+    times->*slot += now - last_lap;
+    last_lap = now;
+  };
   const auto& model = config_.tracker.model;
   frame_.t = t;
   frame_.image = true;
@@ -138,10 +149,13 @@ const ObserverFrame& TableBallObserver::process(const cv::Mat& bgr, double t, co
   if (config_.edge_tracking && config_.table_pose == TablePoseSource::Corners && frame_.table_found &&
       frame_.ball_circle_prev) {
     const auto corners = edges_.trackCorners(bgr, frame_.corners);
+    lap(&ObserverStageTimes::table);
     const auto ball = corners ? edges_.trackBall(bgr, *frame_.ball_circle_prev) : std::nullopt;
+    lap(&ObserverStageTimes::ball);
     if (corners && ball) {
       const Eigen::Isometry3d p = borderAwareTablePose(camera_, *corners, c_M_t_, model.table_side,
                                                        std::max(config_.border_height, 1e-9), 1);
+      lap(&ObserverStageTimes::pose);
       if (core::rotationAngle(p.linear(), c_M_t_.linear()) < 0.2) {
         pose = p;
         circle = ball;
@@ -153,17 +167,20 @@ const ObserverFrame& TableBallObserver::process(const cv::Mat& bgr, double t, co
   if (!frame_.tracked) {
     detector_.setPrior(c_M_t_nominal);  // quarter turns from the arm's kinematics
     const vision::TableScene scene = detector_.detect(bgr, t);
+    lap(&ObserverStageTimes::table);
     circle = scene.ball_circle;
     if (config_.table_pose == TablePoseSource::Corners) {
       if (scene.table) {
         frame_.corners = scene.table->corners;
         pose = borderAwareTablePose(camera_, frame_.corners, scene.table->c_M_t, model.table_side, config_.border_height);
+        lap(&ObserverStageTimes::pose);
       } else {
         frame_.failure = std::string("table: ") + vision::toString(scene.table.failure().reason) + " " +
                          scene.table.failure().message;
       }
     } else {
       const auto tag_table = tags_->detect(bgr, t);
+      lap(&ObserverStageTimes::table);
       if (tag_table) {
         pose = tag_table->c_M_t;
         frame_.corners = tag_table->corners;
@@ -206,7 +223,9 @@ const ObserverFrame& TableBallObserver::process(const cv::Mat& bgr, double t, co
     // off the table keeps NaN: not measured).
     if (y_raw) frame_.measured_own_pose = *y_raw;
   }
+  lap(&ObserverStageTimes::geometry);
   filterStep(t, y);
+  lap(&ObserverStageTimes::filter);
   frame_.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return frame_;
 }

@@ -35,6 +35,12 @@ struct TableEdgeTrackerConfig {
   double ball_margin_px = 6.0;  ///< px, the motion margin of the ball window
 };
 
+/// cv::GaussianBlur(bgr(roi), dst, Size(ksize, ksize), 0) value for value (its default border:
+/// the pixels around the window from the image, reflected at the image's edges), for a BGR 8-bit
+/// image; ksize 3 and 5 by exact integer sums and OpenCV 4.6's rounding, without its per-call
+/// set-up; other sizes, other types and submatrix images by OpenCV. `roi` must lie inside the image.
+void gaussianBlurWindow(const cv::Mat& bgr, const cv::Rect& roi, int ksize, cv::Mat& dst);
+
 /// The observer's fast path: the table's sides and the ball followed from the previous frame.
 class TableEdgeTracker {
 public:
@@ -50,7 +56,7 @@ public:
 private:
   TableDetectorConfig detector_;
   TableEdgeTrackerConfig config_;
-  cv::Mat kernel_, blurred_, hls_, mask_;
+  cv::Mat kernel_, blurred_, hls_, mask_, eroded_;
   std::vector<std::vector<cv::Point>> contours_;
 };
 

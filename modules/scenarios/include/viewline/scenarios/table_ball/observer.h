@@ -173,6 +173,16 @@ struct ObserverFrame {
   double seconds = 0.0;                  ///< wall-clock cost of detection + filter
 };
 
+/// CPU time spent in each stage of one TableBallObserver::process call (s, by the clock passed
+/// in), for the latency bench; a stage that did not run this frame keeps 0.
+struct ObserverStageTimes {
+  double table = 0.0;   ///< table: edge tracking of the four sides (fast path) or the full detection (table and ball)
+  double ball = 0.0;    ///< ball: the windowed ball tracker (fast path; the full detection counts under table)
+  double pose = 0.0;    ///< border-aware PnP refinement of the table pose
+  double geometry = 0.0;  ///< table pose filter, tilt and the ball on the table
+  double filter = 0.0;  ///< the rolling-ball filter step and predictions
+};
+
 /// [M]'s observer: one camera image in, table pose, ball on the table and the filtered and
 /// predicted ball out (the steps at the top of this file).
 class TableBallObserver {
@@ -187,8 +197,10 @@ public:
   /// One frame: BGR image captured at t, camera-to-ground rotation c_R_w at that instant, and
   /// the table pose expected from the arm's kinematics at t (resolves the square's quarter turns;
   /// the kinematic pose of the table pose filter, step 2b).
+  /// With `clock` (seconds, e.g. thread CPU time) and `times`, also the time of each stage.
   const ObserverFrame& process(const cv::Mat& bgr, double t, const Eigen::Matrix3d& c_R_w,
-                               const Eigen::Isometry3d& c_M_t_nominal);
+                               const Eigen::Isometry3d& c_M_t_nominal, double (*clock)() = nullptr,
+                               ObserverStageTimes* times = nullptr);
   /// A step without an image (dropped frame): prediction only.
   const ObserverFrame& predictOnly(double t);
 
