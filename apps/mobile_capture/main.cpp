@@ -1,7 +1,8 @@
 // mobile_capture: [K]'s mobile robot with a pan/tilt camera chasing and grasping a red object that
 // moves on the floor. Thin main: the common flags, the YAML scenario, one displayed/logged run when
 // asked, then scenarios::runMobileCaptureBatch and its summary; --record DIR / --replay DIR
-// (mobile_capture/recording.h). The scenario is documented in
+// (mobile_capture/recording.h); with footage as `source:` (images, video, v4l2) one session over it
+// instead (scenarios::runMobileCaptureFootage, mobile_capture/footage.h). The scenario is documented in
 // modules/scenarios/include/viewline/scenarios/mobile_capture.h.
 
 #include <cstdio>
@@ -9,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app_options.h"
+#include "viewline/core/error.h"
 #include "viewline/core/random.h"
 #include "viewline/io/config_edit.h"
 #include "viewline/io/files.h"
@@ -16,6 +18,7 @@
 #include "viewline/runtime/progress.h"
 #include "viewline/runtime/telemetry.h"
 #include "viewline/scenarios/mobile_capture.h"
+#include "viewline/scenarios/mobile_capture/footage.h"
 #include "viewline/viz/mobile_capture_display.h"
 
 using namespace viewline;
@@ -38,6 +41,25 @@ int main(int argc, char** argv) {
     auto cfg = scenarios::loadMobileCaptureConfig(root);
     if (jobs > 0) cfg.threads = jobs;
     cfg.validate();
+    if (scenarios::mobileCaptureOnFootage(cfg)) {
+      // One session over the head camera's footage, the robot held at its start pose
+      // (mobile_capture/footage.h): no runs to count, nothing to record or replay.
+      if (cli.count("--runs") > 0) throw core::InvalidInput("--runs: footage runs as one session");
+      if (!opt.record_dir.empty()) throw core::InvalidInput("--record: footage is recorded already");
+      if (!opt.replay_dir.empty()) throw core::InvalidInput("--replay: the footage is the input (source:)");
+      if (cli.count("--realtime") > 0)
+        throw core::InvalidInput("--realtime: footage is paced by its source (source.pace: true)");
+      if (opt.wantDisplay("mobile_capture"))
+        throw core::InvalidInput("--display: the footage session has no view (run it --headless)");
+      const auto s = scenarios::runMobileCaptureFootage(cfg, opt.seed);
+      io::LogDirectory log(opt.log_dir);
+      scenarios::logFootage(s, log);
+      nlohmann::json j = scenarios::footageSummaryJson(s, cfg);
+      if (!opt.sets.empty()) j["config_set"] = opt.sets;
+      if (!opt.summary_path.empty()) io::writeSummaryFile(opt.summary_path, j);
+      std::fputs(scenarios::footageSummaryText(s, cfg).c_str(), stdout);
+      return 0;
+    }
     // --record / --replay: the batch's runs in a session recording (mobile_capture/recording.h).
     scenarios::MobileCaptureSessionIo files;
     files.record_dir = opt.record_dir;
