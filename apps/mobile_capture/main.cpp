@@ -45,19 +45,25 @@ int main(int argc, char** argv) {
       // One session over the head camera's footage, the robot held at its start pose
       // (mobile_capture/footage.h): no runs to count, nothing to record or replay.
       if (cli.count("--runs") > 0) throw core::InvalidInput("--runs: footage runs as one session");
-      if (!opt.record_dir.empty()) throw core::InvalidInput("--record: footage is recorded already");
-      if (!opt.replay_dir.empty()) throw core::InvalidInput("--replay: the footage is the input (source:)");
       if (cli.count("--realtime") > 0)
         throw core::InvalidInput("--realtime: footage is paced by its source (source.pace: true)");
-      if (opt.wantDisplay("mobile_capture"))
-        throw core::InvalidInput("--display: the footage session has no view (run it --headless)");
-      const auto s = scenarios::runMobileCaptureFootage(cfg, opt.seed);
+      scenarios::MobileCaptureHooks hooks;
+      hooks.record_dir = opt.record_dir;  // refused by the session, naming the flag
+      hooks.replay_dir = opt.replay_dir;
+      std::unique_ptr<viz::MobileCaptureDisplay> view;
+      if (opt.wantDisplay("mobile_capture")) {
+        view = std::make_unique<viz::MobileCaptureDisplay>(cfg);
+        hooks.on_frame = [&](const scenarios::MobileCaptureFrame& f) { view->show(f); };
+        hooks.quit_requested = [&] { return view->quitRequested(); };
+      }
+      const auto s = scenarios::runMobileCaptureFootage(cfg, opt.seed, nullptr, &hooks);
       io::LogDirectory log(opt.log_dir);
       scenarios::logFootage(s, log);
       nlohmann::json j = scenarios::footageSummaryJson(s, cfg);
       if (!opt.sets.empty()) j["config_set"] = opt.sets;
       if (!opt.summary_path.empty()) io::writeSummaryFile(opt.summary_path, j);
       std::fputs(scenarios::footageSummaryText(s, cfg).c_str(), stdout);
+      if (view) view->waitForClose();
       return 0;
     }
     // --record / --replay: the batch's runs in a session recording (mobile_capture/recording.h).

@@ -47,11 +47,17 @@ bool mobileCaptureOnFootage(const MobileCaptureConfig& cfg) {
 }
 
 MobileFootageSummary runMobileCaptureFootage(const MobileCaptureConfig& cfg, std::uint64_t seed,
-                                             runtime::WallClock* clock) {
+                                             runtime::WallClock* clock, const MobileCaptureHooks* hooks) {
   cfg.validate();
   if (!mobileCaptureOnFootage(cfg))
     throw core::InvalidInput(std::string("source.kind: expected footage (images, video or v4l2), got ") +
                              runtime::toString(cfg.source.kind));
+  if (hooks && !hooks->record_dir.empty()) throw core::InvalidInput("--record: footage is recorded already");
+  if (hooks && !hooks->replay_dir.empty()) throw core::InvalidInput("--replay: the footage is the input (source:)");
+  if (hooks && hooks->pacing.paced())
+    throw core::InvalidInput("--realtime: footage is paced by its source (source.pace: true)");
+  if (hooks && hooks->telemetry)
+    throw core::InvalidInput("telemetry: the footage session logs footage.csv (logFootage), not the loop's channels");
   const auto wall0 = std::chrono::steady_clock::now();
   MobileFootageSummary sum;
   sum.seed = seed;
@@ -90,6 +96,7 @@ MobileFootageSummary runMobileCaptureFootage(const MobileCaptureConfig& cfg, std
   if (live) timer.emplace(cfg.vision_period, clock);
 
   planning::CapturePlan plan;
+  std::vector<Vector2d> prediction;  // the track's path over the planner's horizon (predictPath)
   double last_seen = -1.0, sweep_start = -1.0, centre_bearing = 0.0;
   bool have_bearing = false;
   control::SearchMode mode = control::SearchMode::Sweeping;
@@ -137,7 +144,8 @@ MobileFootageSummary runMobileCaptureFootage(const MobileCaptureConfig& cfg, std
       row.heading = x[2];
       row.speed = x[3];
       row.turn_rate = x[4];
-      plan = planning::planCapture(predictPath(track, cfg), {{pose.x, pose.y}, pose.theta}, cfg.plannerParams());
+      prediction = predictPath(track, cfg);
+      plan = planning::planCapture(prediction, {{pose.x, pose.y}, pose.theta}, cfg.plannerParams());
       row.reachable = plan.reachable;
       row.intercept = plan.point;
       row.intercept_time = t + plan.time;
@@ -146,6 +154,24 @@ MobileFootageSummary runMobileCaptureFootage(const MobileCaptureConfig& cfg, std
       have_bearing = true;
     }
     sum.samples.push_back(row);
+    if (hooks && hooks->on_frame) {
+      MobileCaptureFrame f;
+      f.t = t;
+      f.image = &frame.image;
+      f.detected = row.detected;
+      if (det_px) f.pixel = *det_px;
+      f.robot = pose;
+      f.joints = robot.q;
+      // No truth on footage: the view centres on (and marks) the tracked position instead.
+      f.object_true = row.track_valid ? row.position : row.detected ? row.measured : Vector2d(pose.x, pose.y);
+      f.fused = row.fused;
+      f.estimate_valid = track.valid();
+      if (track.valid()) f.estimate = track.state().x();
+      f.prediction = prediction;
+      f.plan = plan;
+      f.mode = mode;
+      hooks->on_frame(f);
+    }
   };
 
   // Control period: the laws' commands from the held pose, checked and counted, never executed.
@@ -215,6 +241,7 @@ MobileFootageSummary runMobileCaptureFootage(const MobileCaptureConfig& cfg, std
         }
         if (timer) timer->finish(id);
       }
+      if (hooks && hooks->quit_requested && hooks->quit_requested()) sched.requestStop();
       next_capture();
     });
   };
@@ -304,6 +331,7 @@ nlohmann::json footageSummaryJson(const MobileFootageSummary& s, const MobileCap
       {"truth", "not scored (the frame source has no truth)"},
       {"rig", cfg.rig ? nlohmann::json(cfg.rig->folder) : nlohmann::json(nullptr)},
       {"wall_time_s", s.wall_s}};
+  if (s.interrupted) j["interrupted"] = true;  // ended before the footage's end (a signal, or the view's quit)
   if (s.live) j["live"] = runtime::toJson(*s.live);
   if (!s.faults.empty()) j["faults"] = runtime::toJson(s.faults);
   return j;

@@ -210,6 +210,35 @@ TEST_F(MobileCaptureFootage, PacedFootageReportsItsProcessingTimes) {
   EXPECT_TRUE(scenarios::footageSummaryJson(s, cfg).contains("live"));
 }
 
+TEST_F(MobileCaptureFootage, AViewSeesEveryFrameAndItsQuitEndsTheSession) {
+  const auto cfg = configWith(imageSets());
+  scenarios::MobileCaptureHooks hooks;
+  int shown = 0, tracked = 0;
+  hooks.on_frame = [&](const scenarios::MobileCaptureFrame& f) {
+    ++shown;
+    ASSERT_NE(f.image, nullptr);
+    EXPECT_EQ(f.image->cols, 320);
+    EXPECT_NEAR(f.robot.x, cfg.robot_start.x(), 1e-12);  // held
+    if (f.estimate_valid) {
+      ++tracked;
+      EXPECT_FALSE(f.prediction.empty());
+      EXPECT_TRUE((f.object_true - f.estimate.head<2>()).norm() < 1e-9);  // no truth: the track stands in
+    }
+  };
+  hooks.quit_requested = [&] { return shown >= 10; };
+  const auto s = scenarios::runMobileCaptureFootage(cfg, kSeed, nullptr, &hooks);
+  EXPECT_TRUE(s.interrupted);
+  EXPECT_EQ(shown, 10);
+  EXPECT_EQ(s.frames, 10u);
+  EXPECT_GT(tracked, 5);
+  EXPECT_NE(scenarios::footageSummaryText(s, cfg).find("(interrupted)"), std::string::npos);
+  // What the footage session cannot do is refused by name.
+  scenarios::MobileCaptureHooks record;
+  record.record_dir = "rec";
+  EXPECT_NE(errorOf([&] { scenarios::runMobileCaptureFootage(cfg, kSeed, nullptr, &record); }).find("--record"),
+            std::string::npos);
+}
+
 TEST(MobileCaptureFootageInput, MissingFilesAndBadPatternsAreNamed) {
   const std::string dir = (fs::path(testing::TempDir()) / "viewline_mc_no_such_folder").string();
   const auto missing = configWith({"source={kind: images, pattern: " + dir + "/image.%04d.png}"});

@@ -38,6 +38,7 @@
 #include "viewline/runtime/faults.h"
 #include "viewline/runtime/live.h"
 #include "viewline/scenarios/mobile_capture/config.h"
+#include "viewline/scenarios/mobile_capture/loop.h"
 #include "viewline/tracking/track_gate.h"
 
 namespace viewline::scenarios {
@@ -88,10 +89,15 @@ struct MobileFootageSummary {
 
 /// Runs the session over cfg.source's footage (images, video or v4l2; the header comment).
 /// `clock`: the wall clock of paced footage and of the processing timer (null: the steady clock).
+/// `hooks`: on_frame (a live view: MobileCaptureFrame with the held robot and joints; there is no
+/// truth, so object_true is the tracked position, or the last measured one before a track) and
+/// quit_requested (polled after each frame: true ends the session, `interrupted`) are used;
+/// telemetry, pacing, record_dir and replay_dir are refused (core::InvalidInput).
 /// Throws core::InvalidInput naming the file or device a source cannot open or read, or a frame
 /// that is not a colour image of the camera's size.
 MobileFootageSummary runMobileCaptureFootage(const MobileCaptureConfig& cfg, std::uint64_t seed,
-                                             runtime::WallClock* clock = nullptr);
+                                             runtime::WallClock* clock = nullptr,
+                                             const MobileCaptureHooks* hooks = nullptr);
 
 /// True when cfg.source is footage (images, video or v4l2), which runMobileCaptureFootage() runs.
 bool mobileCaptureOnFootage(const MobileCaptureConfig& cfg);
