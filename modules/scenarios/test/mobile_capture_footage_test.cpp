@@ -170,7 +170,7 @@ Footage* MobileCaptureFootage::footage_ = nullptr;
 
 }  // namespace
 
-TEST_F(MobileCaptureFootage, ImageSequenceTracksTheRenderedObjectWithinAFewCentimetres) {
+TEST_F(MobileCaptureFootage, ImageSequenceTracksTheRenderedObjectWithinAFewCentimetresPacedOrViewed) {
   const auto cfg = configWith(imageSets());
   ASSERT_TRUE(scenarios::mobileCaptureOnFootage(cfg));
   const auto s = scenarios::runMobileCaptureFootage(cfg, kSeed);
@@ -184,16 +184,9 @@ TEST_F(MobileCaptureFootage, ImageSequenceTracksTheRenderedObjectWithinAFewCenti
   EXPECT_EQ(j.at("robot").at("limit_violations"), 0);
   EXPECT_FALSE(j.at("object_last").is_null());
   EXPECT_NE(scenarios::footageSummaryText(s, cfg).find("not scored: no truth"), std::string::npos);
-}
 
-TEST_F(MobileCaptureFootage, MotionJpegVideoTracksTheRenderedObjectWithinAFewCentimetres) {
-  const auto cfg = configWith(videoSets());
-  const auto s = scenarios::runMobileCaptureFootage(cfg, kSeed);
-  checkSession(s, cfg, 0.04, 0.10);
-}
-
-TEST_F(MobileCaptureFootage, PacedFootageReportsItsProcessingTimes) {
-  // Played as a live camera on a clock the test advances itself: nothing is dropped, every frame timed.
+  // The same footage (one render per test process: making the footage is the slow part) played as
+  // a live camera on a clock the test advances itself: nothing is dropped, every frame is timed.
   struct InstantClock : runtime::WallClock {
     double t = 0.0;
     double now() const override { return t; }
@@ -201,17 +194,15 @@ TEST_F(MobileCaptureFootage, PacedFootageReportsItsProcessingTimes) {
   } clock;
   auto sets = imageSets();
   sets.push_back("source.pace=true");
-  const auto cfg = configWith(sets);
-  const auto s = scenarios::runMobileCaptureFootage(cfg, kSeed, &clock);
-  ASSERT_TRUE(s.live.has_value());
-  EXPECT_EQ(s.live->dropped, 0u);
-  EXPECT_EQ(s.live->processed, footage_->frames);
-  EXPECT_EQ(s.frames, footage_->frames);
-  EXPECT_TRUE(scenarios::footageSummaryJson(s, cfg).contains("live"));
-}
+  const auto paced_cfg = configWith(sets);
+  const auto paced = scenarios::runMobileCaptureFootage(paced_cfg, kSeed, &clock);
+  ASSERT_TRUE(paced.live.has_value());
+  EXPECT_EQ(paced.live->dropped, 0u);
+  EXPECT_EQ(paced.live->processed, footage_->frames);
+  EXPECT_EQ(paced.frames, footage_->frames);
+  EXPECT_TRUE(scenarios::footageSummaryJson(paced, paced_cfg).contains("live"));
 
-TEST_F(MobileCaptureFootage, AViewSeesEveryFrameAndItsQuitEndsTheSession) {
-  const auto cfg = configWith(imageSets());
+  // A view sees every frame with the held robot, and its quit after 10 frames ends the session.
   scenarios::MobileCaptureHooks hooks;
   int shown = 0, tracked = 0;
   hooks.on_frame = [&](const scenarios::MobileCaptureFrame& f) {
@@ -226,17 +217,23 @@ TEST_F(MobileCaptureFootage, AViewSeesEveryFrameAndItsQuitEndsTheSession) {
     }
   };
   hooks.quit_requested = [&] { return shown >= 10; };
-  const auto s = scenarios::runMobileCaptureFootage(cfg, kSeed, nullptr, &hooks);
-  EXPECT_TRUE(s.interrupted);
+  const auto viewed = scenarios::runMobileCaptureFootage(cfg, kSeed, nullptr, &hooks);
+  EXPECT_TRUE(viewed.interrupted);
   EXPECT_EQ(shown, 10);
-  EXPECT_EQ(s.frames, 10u);
+  EXPECT_EQ(viewed.frames, 10u);
   EXPECT_GT(tracked, 5);
-  EXPECT_NE(scenarios::footageSummaryText(s, cfg).find("(interrupted)"), std::string::npos);
+  EXPECT_NE(scenarios::footageSummaryText(viewed, cfg).find("(interrupted)"), std::string::npos);
   // What the footage session cannot do is refused by name.
   scenarios::MobileCaptureHooks record;
   record.record_dir = "rec";
   EXPECT_NE(errorOf([&] { scenarios::runMobileCaptureFootage(cfg, kSeed, nullptr, &record); }).find("--record"),
             std::string::npos);
+}
+
+TEST_F(MobileCaptureFootage, MotionJpegVideoTracksTheRenderedObjectWithinAFewCentimetres) {
+  const auto cfg = configWith(videoSets());
+  const auto s = scenarios::runMobileCaptureFootage(cfg, kSeed);
+  checkSession(s, cfg, 0.04, 0.10);
 }
 
 TEST(MobileCaptureFootageInput, MissingFilesAndBadPatternsAreNamed) {
