@@ -25,7 +25,8 @@ using namespace viewline;
 
 int main(int argc, char** argv) {
   CLI::App cli{"Mobile capture: differential-drive robot with a pan/tilt camera, curvilinear-target EKF, "
-               "least-squares path prediction and [K]'s shortest-time capture planner, on rendered images"};
+               "least-squares path prediction and [K]'s shortest-time capture planner, on rendered images (or footage: "
+               "source: images, video, v4l2)"};
   apps::CommonOptions opt;
   opt.config_path = "config/mobile_capture.yaml";
   int runs = 1, jobs = 0;

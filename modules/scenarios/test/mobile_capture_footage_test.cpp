@@ -246,6 +246,9 @@ TEST(MobileCaptureFootageInput, MissingFilesAndBadPatternsAreNamed) {
   const auto no_video = configWith({"source={kind: video, path: " + dir + "/head.avi}"});
   e = errorOf([&] { scenarios::runMobileCaptureFootage(no_video, 1); });
   EXPECT_NE(e.find(dir + "/head.avi"), std::string::npos) << e;
+  const auto no_camera = configWith({"source={kind: v4l2, device: " + dir + "/video9}"});
+  e = errorOf([&] { scenarios::runMobileCaptureFootage(no_camera, 1); });
+  EXPECT_NE(e.find(dir + "/video9"), std::string::npos) << e;
   // The simulated batch's sources are not footage.
   EXPECT_FALSE(scenarios::mobileCaptureOnFootage(configWith({})));
   EXPECT_NE(errorOf([] { scenarios::runMobileCaptureFootage(configWith({}), 1); }).find("expected footage"),
