@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -29,7 +30,10 @@ using namespace viewline;
 
 namespace {
 
-constexpr std::uint64_t kSeed = 3;
+// The object's path and the sensor noise; VIEWLINE_MC_FOOTAGE_SEED=S runs the suite on another seed
+// (docs/results.md gives the figures over seeds 1-5).
+const std::uint64_t kSeed =
+    std::getenv("VIEWLINE_MC_FOOTAGE_SEED") ? std::strtoull(std::getenv("VIEWLINE_MC_FOOTAGE_SEED"), nullptr, 10) : 3;
 // The object starts 3.5 m ahead of the robot (at (-0.5, -0.5), heading +y), comes towards it on
 // [K]'s capture profile (0.6 m/s) and turns left: it stays within 7 degrees of the held head
 // camera's axis and 1.2-3.6 m from it for the footage's 4 s (41 frames).
@@ -114,8 +118,11 @@ protected:
     return {"source={kind: images, pattern: " + (footage_->dir / "seq" / "image.%04d.png").string() +
             ", stamps: " + (footage_->dir / "seq" / "stamps.csv").string() + "}"};
   }
+  // The video is motion JPEG: its blob centres are noisier than the rendered frames' the shipped
+  // detector.pixel_sigma (0.12 px) was fitted to, and with it the gate rejected up to 9 of 39
+  // detections and restarted the track on 3 of seeds 1-5; 0.3 px is what this footage needs.
   static std::vector<std::string> videoSets() {
-    return {"source={kind: video, path: " + (footage_->dir / "head.avi").string() +
+    return {"detector.pixel_sigma=0.3", "source={kind: video, path: " + (footage_->dir / "head.avi").string() +
             ", stamps: " + (footage_->dir / "head_stamps.csv").string() + "}"};
   }
   // The checks every session must pass: every frame counted, the track within max_mean_m (mean)
@@ -133,6 +140,8 @@ protected:
     EXPECT_DOUBLE_EQ(s.t_first, f.stamps.front());
     EXPECT_DOUBLE_EQ(s.t_last, f.stamps.back());
     EXPECT_GT(s.detections, f.frames * 3 / 4);
+    EXPECT_EQ(s.gate.starts, 1u);  // one track over the footage, never restarted
+    EXPECT_EQ(s.gate.restarts, 0u);
     double sum = 0.0, worst = 0.0, sse_measured = 0.0;
     int n = 0, tracked = 0, measured = 0;
     for (std::size_t k = 0; k < s.samples.size(); ++k) {
