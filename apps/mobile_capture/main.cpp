@@ -1,7 +1,8 @@
 // mobile_capture: [K]'s mobile robot with a pan/tilt camera chasing and grasping a red object that
 // moves on the floor. Thin main: the common flags, the YAML scenario, one displayed/logged run when
 // asked, then scenarios::runMobileCaptureBatch and its summary; --record DIR / --replay DIR
-// (mobile_capture/recording.h). The scenario is documented in
+// (mobile_capture/recording.h); with footage as `source:` (images, video, v4l2) one session over it
+// instead (scenarios::runMobileCaptureFootage, mobile_capture/footage.h). The scenario is documented in
 // modules/scenarios/include/viewline/scenarios/mobile_capture.h.
 
 #include <cstdio>
@@ -9,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app_options.h"
+#include "viewline/core/error.h"
 #include "viewline/core/random.h"
 #include "viewline/io/config_edit.h"
 #include "viewline/io/files.h"
@@ -16,13 +18,15 @@
 #include "viewline/runtime/progress.h"
 #include "viewline/runtime/telemetry.h"
 #include "viewline/scenarios/mobile_capture.h"
+#include "viewline/scenarios/mobile_capture/footage.h"
 #include "viewline/viz/mobile_capture_display.h"
 
 using namespace viewline;
 
 int main(int argc, char** argv) {
   CLI::App cli{"Mobile capture: differential-drive robot with a pan/tilt camera, curvilinear-target EKF, "
-               "least-squares path prediction and [K]'s shortest-time capture planner, on rendered images"};
+               "least-squares path prediction and [K]'s shortest-time capture planner, on rendered images (or footage: "
+               "source: images, video, v4l2)"};
   apps::CommonOptions opt;
   opt.config_path = "config/mobile_capture.yaml";
   int runs = 1, jobs = 0;
@@ -38,6 +42,31 @@ int main(int argc, char** argv) {
     auto cfg = scenarios::loadMobileCaptureConfig(root);
     if (jobs > 0) cfg.threads = jobs;
     cfg.validate();
+    if (scenarios::mobileCaptureOnFootage(cfg)) {
+      // One session over the head camera's footage, the robot held at its start pose
+      // (mobile_capture/footage.h): no runs to count, nothing to record or replay.
+      if (cli.count("--runs") > 0) throw core::InvalidInput("--runs: footage runs as one session");
+      if (cli.count("--realtime") > 0)
+        throw core::InvalidInput("--realtime: footage is paced by its source (source.pace: true)");
+      scenarios::MobileCaptureHooks hooks;
+      hooks.record_dir = opt.record_dir;  // refused by the session, naming the flag
+      hooks.replay_dir = opt.replay_dir;
+      std::unique_ptr<viz::MobileCaptureDisplay> view;
+      if (opt.wantDisplay("mobile_capture")) {
+        view = std::make_unique<viz::MobileCaptureDisplay>(cfg);
+        hooks.on_frame = [&](const scenarios::MobileCaptureFrame& f) { view->show(f); };
+        hooks.quit_requested = [&] { return view->quitRequested(); };
+      }
+      const auto s = scenarios::runMobileCaptureFootage(cfg, opt.seed, nullptr, &hooks);
+      io::LogDirectory log(opt.log_dir);
+      scenarios::logFootage(s, log);
+      nlohmann::json j = scenarios::footageSummaryJson(s, cfg);
+      if (!opt.sets.empty()) j["config_set"] = opt.sets;
+      if (!opt.summary_path.empty()) io::writeSummaryFile(opt.summary_path, j);
+      std::fputs(scenarios::footageSummaryText(s, cfg).c_str(), stdout);
+      if (view) view->waitForClose();
+      return 0;
+    }
     // --record / --replay: the batch's runs in a session recording (mobile_capture/recording.h).
     scenarios::MobileCaptureSessionIo files;
     files.record_dir = opt.record_dir;

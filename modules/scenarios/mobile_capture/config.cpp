@@ -110,7 +110,7 @@ void positive(const io::ConfigNode& n, const std::string& key, double v) {
 MobileCaptureConfig loadMobileCaptureConfig(const io::ConfigNode& root) {
   MobileCaptureConfig c = MobileCaptureConfig::defaults();
   c.faults = runtime::readFaultPlanConfig(root);  // first: the config reference's probe reaches it
-  c.source = readMobileCaptureSource(root);  // sim or a recording (mobile_capture/recording.h)
+  c.source = readMobileCaptureSource(root);  // sim, a recording (recording.h) or footage (footage.h)
   if (root.has("world")) {
     const auto w = root.child("world");
     readOpt(w, "robot_start", c.robot_start);

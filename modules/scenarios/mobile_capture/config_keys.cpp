@@ -3,6 +3,7 @@
 // ScenarioConfigKeys fails when a key is read without an entry here or an entry is never read.
 #include "viewline/scenarios/config_keys.h"
 #include "viewline/runtime/faults.h"
+#include "viewline/runtime/source_config.h"
 #include "viewline/scenarios/mobile_capture/config.h"
 
 namespace viewline::scenarios {
@@ -17,8 +18,8 @@ io::ConfigReferenceSection mobileCaptureConfigReference() {
       "`MobileCaptureConfig::defaults()`).";
   s.shipped = {"mobile_capture.yaml"};
   // The shipped file names a rig: the inline camera's field of view too.
-  s.probes = {"camera: {width: 640, height: 480, hfov_deg: 50, vfov_deg: 40}\n", "source: {kind: recording, path: rec}\n",
-              runtime::faultConfigProbe()};
+  s.probes = {"camera: {width: 640, height: 480, hfov_deg: 50, vfov_deg: 40}\n", runtime::faultConfigProbe()};
+  for (const std::string& p : runtime::sourceConfigProbes("")) s.probes.push_back(p);
   s.read = [](const io::ConfigNode& root) { loadMobileCaptureConfig(root); };
   s.keys = {
       {"world", "", "the floor, the robot and the object"},
@@ -115,10 +116,9 @@ io::ConfigReferenceSection mobileCaptureConfigReference() {
       {"fov_sweep.points", "", "floor points per pose"},
       {"fov_sweep.pixel_sigma", "px", "noise added to the projected pixels"},
       {"threads", "", "parallel runs"},
-      {"source", "", "where the frames come from (absent: the rendered head camera)"},
-      {"source.kind", "", "sim (the rendered head camera) or recording (a folder written by --record); other kinds are refused"},
-      {"source.path", "", "recording: the folder written by --record (as --replay)"},
   };
+  // sim and recording run the batch; images, video and v4l2 one footage session (mobile_capture/footage.h).
+  for (const io::ConfigKeyDoc& k : runtime::sourceConfigKeys()) s.keys.push_back(k);
   for (io::ConfigKeyDoc& d : runtime::faultConfigKeys()) s.keys.push_back(std::move(d));
   return s;
 }

@@ -176,16 +176,7 @@ MobileCaptureRun runMobileCapture(const MobileCaptureConfig& cfg, std::uint64_t 
       const Vector2d p = track.positionAt(t);
       predicted_px = camera.project(Vector3d(p.x(), p.y(), plane_z));
     }
-    const auto det = runtime::guardedDetect(faults, frame.camera, frame.capture_time,
-                                            [&] { return detector.detect(frame.image, t, predicted_px); });
-    std::optional<Vector2d> det_px;
-    if (det && det->ok())
-      det_px = faults.detected(frame.camera, frame.capture_time, det->value().blob_center, frame.image.cols,
-                               frame.image.rows);
-    if (det_px && !runtime::usablePixel(*det_px, frame.image.cols, frame.image.rows)) {
-      faults.note("detections_rejected");
-      det_px.reset();
-    }
+    const std::optional<Vector2d> det_px = detectScreened(detector, faults, frame, t, predicted_px);
     bool detected = false, fused = false;
     std::optional<FloorMeasurement> measurement;
     double nis = std::numeric_limits<double>::quiet_NaN();

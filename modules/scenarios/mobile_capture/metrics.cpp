@@ -11,6 +11,7 @@
 #include <thread>
 
 #include "viewline/core/error.h"
+#include "viewline/core/interrupt.h"
 #include "viewline/core/random.h"
 #include "viewline/core/statistics.h"
 #include "viewline/estimation/models/unicycle.h"
@@ -96,6 +97,7 @@ FovSweepResult compareGroundLocalization(const MobileCaptureConfig& cfg, std::ui
   const double plane_z = 0.5 * cfg.object_height;
   FovSweepResult r;
   for (int pose = 0; pose < cfg.fov_sweep_poses; ++pose) {
+    if (core::interruptRequested()) break;  // the batch then reports no sweep (runMobileCaptureBatch)
     // A head looking at a floor point 0.5-4 m ahead within ±45° (what the chase produces).
     const double range = core::uniform(rng, 0.5, 4.0), bearing = core::uniform(rng, -0.8, 0.8);
     const auto q = head.pointAtBest(Vector3d(range * std::cos(bearing), range * std::sin(bearing), plane_z));
@@ -219,11 +221,18 @@ MobileCaptureSummary runMobileCaptureBatch(const MobileCaptureConfig& cfg, int r
   }
   if (!oracle_times.empty()) s.oracle_time_median = core::percentile(oracle_times, 0.5);
 
-  if (stopped) {  // the filter test and the field-of-view sweep are long: not after a stop request
+  // The filter test and the field-of-view sweep are long: not after a stop request, and a request
+  // that comes while they run ends them (their figures are then not reported, summaryJson).
+  const auto stop = [&] {
+    if (core::interruptRequested()) stopped = true;
+    if (!stopped) return false;
+    s.interrupted = true;
     s.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    return s;
-  }
+    return true;
+  };
+  if (stop()) return s;
   for (int k = 0; k < cfg.filter_test_runs; ++k) {
+    if (stop()) return s;
     FilterTestResult f = runFilterTest(cfg, core::deriveSeed(seed, 100000 + static_cast<std::uint64_t>(k)));
     s.filter_rmse_theta += f.rmse_theta / cfg.filter_test_runs;
     s.filter_rmse_theta_moving += f.rmse_theta_moving / cfg.filter_test_runs;
@@ -235,7 +244,9 @@ MobileCaptureSummary runMobileCaptureBatch(const MobileCaptureConfig& cfg, int r
     s.filter_rmse_measurement += f.rmse_measurement / cfg.filter_test_runs;
     if (k == 0) s.filter_first = std::move(f);
   }
+  if (stop()) return s;
   s.fov = compareGroundLocalization(cfg, seed);
+  if (stop()) return s;
   s.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return s;
 }

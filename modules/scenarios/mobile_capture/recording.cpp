@@ -20,13 +20,8 @@ std::vector<double> truthOf(const sim::GroundState& s) { return {s.x, s.y, s.the
 }  // namespace
 
 runtime::SourceConfig readMobileCaptureSource(const io::ConfigNode& root) {
-  runtime::SourceConfig s = runtime::readSourceConfig(root);
-  if (!s.simulated() && s.kind != runtime::SourceKind::Recording)
-    throw core::InvalidInput(root.location("source") + ": source.kind " + runtime::toString(s.kind) +
-                             " is not supported by mobile_capture (sim or recording: the grasp, the oracle and the "
-                             "robot need the simulated object and base, which footage from " +
-                             runtime::toString(s.kind) + " does not have)");
-  return s;
+  // Every kind: sim and recording run the batch (recording.h), footage one session (footage.h).
+  return runtime::readSourceConfig(root);
 }
 
 std::string mobileCaptureReplayRoot(const MobileCaptureConfig& cfg, const MobileCaptureSessionIo& io) {

@@ -61,6 +61,21 @@ double targetDuration(const MobileCaptureConfig& cfg) {
   return cfg.max_time + (cfg.horizon_steps + 2) * cfg.vision_period + 1.0;
 }
 
+std::optional<Vector2d> detectScreened(vision::BallDetector& detector, runtime::FaultPlan& faults,
+                                       const runtime::Frame& frame, double t,
+                                       const std::optional<Vector2d>& predicted_px) {
+  const auto det = runtime::guardedDetect(faults, frame.camera, frame.capture_time,
+                                          [&] { return detector.detect(frame.image, t, predicted_px); });
+  std::optional<Vector2d> px;
+  if (det && det->ok())
+    px = faults.detected(frame.camera, frame.capture_time, det->value().blob_center, frame.image.cols, frame.image.rows);
+  if (px && !runtime::usablePixel(*px, frame.image.cols, frame.image.rows)) {
+    faults.note("detections_rejected");
+    px.reset();
+  }
+  return px;
+}
+
 Vector2d toRobot(const robots::BasePose& pose, const Vector2d& p_w) {
   const Vector2d d = p_w - Vector2d(pose.x, pose.y);
   const double c = std::cos(pose.theta), s = std::sin(pose.theta);

@@ -10,3 +10,6 @@ list(APPEND scenarios_sources mobile_capture/config_keys.cpp)
 list(APPEND scenarios_tests test/mobile_capture_faults_test.cpp)
 # The robot's side of the faults: commands through the fault plan, the base's command watchdog.
 list(APPEND scenarios_sources mobile_capture/robot_link.cpp)
+# Footage (images, video, v4l2): one session with the robot held at its start pose (a fixed camera).
+list(APPEND scenarios_sources mobile_capture/footage.cpp)
+list(APPEND scenarios_tests test/mobile_capture_footage_test.cpp)

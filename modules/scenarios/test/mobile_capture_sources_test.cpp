@@ -1,7 +1,7 @@
 // Mobile capture on a recording of its runs (mobile_capture/recording.h): a recorded batch replayed
 // with the same config and seed gives the same summary bit for bit (the wall-clock time aside); a
-// replay whose simulated object is not the recorded one is refused; so are sources without the
-// simulated world.
+// replay whose simulated object is not the recorded one is refused; footage kinds are read for the
+// footage session (mobile_capture/footage.h).
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -13,6 +13,7 @@
 #include "viewline/core/error.h"
 #include "viewline/io/config_edit.h"
 #include "viewline/scenarios/mobile_capture.h"
+#include "viewline/scenarios/mobile_capture/footage.h"
 
 namespace fs = std::filesystem;
 using namespace viewline;
@@ -71,10 +72,15 @@ TEST(MobileCaptureSources, ReplayOfARecordingGivesTheSameSummaryBitForBit) {
   fs::remove_all(dir);
 }
 
-TEST(MobileCaptureSources, SourcesWithoutTheSimulatedWorldAreRefused) {
-  const std::string e = errorOf([] {
-    scenarios::loadMobileCaptureConfig(
-        io::loadConfigWithValues("config/mobile_capture.yaml", {"source.kind=images", "source.pattern=x%04d.png"}));
-  });
-  EXPECT_NE(e.find("source.kind images is not supported by mobile_capture"), std::string::npos) << e;
+TEST(MobileCaptureSources, FootageSourcesAreReadForTheFootageSession) {
+  // images, video and v4l2 run one session on footage (mobile_capture/footage.h), not the batch.
+  const auto cfg = scenarios::loadMobileCaptureConfig(
+      io::loadConfigWithValues("config/mobile_capture.yaml", {"source.kind=images", "source.pattern=x%04d.png"}));
+  EXPECT_EQ(cfg.source.kind, runtime::SourceKind::Images);
+  EXPECT_TRUE(scenarios::mobileCaptureOnFootage(cfg));
+  EXPECT_NE(errorOf([] {
+              scenarios::loadMobileCaptureConfig(
+                  io::loadConfigWithValues("config/mobile_capture.yaml", {"source.kind=film"}));
+            }).find("source.kind"),
+            std::string::npos);
 }

@@ -18,8 +18,8 @@
 // seed or object settings is refused (core::InvalidInput naming the frame), never scored against
 // the wrong path.
 //
-// Other sources (images, video, v4l2) are refused by the config reader: the run's grasp, its oracle
-// and its robot need the simulated object and base, which footage does not have.
+// Footage (images, video, v4l2) has no simulated object to grasp or to chase with the oracle: it
+// runs as one session with the robot held at its start pose (mobile_capture/footage.h).
 
 #include <memory>
 #include <optional>
@@ -35,8 +35,8 @@
 
 namespace viewline::scenarios {
 
-/// Reads the config's `source:` (runtime::readSourceConfig): sim or recording; other kinds are
-/// refused with core::InvalidInput naming file:line (see the file comment).
+/// Reads the config's `source:` (runtime::readSourceConfig): sim or recording (the batch), images,
+/// video or v4l2 (one footage session, footage.h); throws core::InvalidInput naming file:line.
 runtime::SourceConfig readMobileCaptureSource(const io::ConfigNode& root);
 
 /// Record and replay folders of a batch (runMobileCaptureBatch); empty: none.

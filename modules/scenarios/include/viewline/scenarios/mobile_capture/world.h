@@ -12,10 +12,12 @@
 
 #include "viewline/core/camera.h"
 #include "viewline/core/random.h"
+#include "viewline/runtime/faults.h"
 #include "viewline/runtime/frame_source.h"
 #include "viewline/scenarios/mobile_capture/config.h"
 #include "viewline/sim/physics.h"
 #include "viewline/tracking/unicycle_tracker.h"
+#include "viewline/vision/ball_detector.h"
 
 namespace viewline::scenarios::mobile_capture {
 
@@ -63,6 +65,15 @@ struct FloorMeasurement {
 /// back-projection. Empty when the ray (or a perturbed one) misses the plane.
 std::optional<FloorMeasurement> floorMeasurement(const MobileCaptureConfig& cfg, const core::Camera& camera,
                                                  const Eigen::Vector2d& uv, double plane_z);
+
+/// The object's pixel in one frame, detected and screened as every loop of the scenario does (the
+/// simulated chase and the footage session): the detector in its window around `predicted_px`
+/// (runtime::guardedDetect: a detector exception is counted, not thrown), the fault plan's detector
+/// faults, and runtime::usablePixel (a non-finite or outside pixel is counted and dropped).
+/// `t`: the frame's stamp, s. Empty when no detection survives.
+std::optional<Eigen::Vector2d> detectScreened(vision::BallDetector& detector, runtime::FaultPlan& faults,
+                                              const runtime::Frame& frame, double t,
+                                              const std::optional<Eigen::Vector2d>& predicted_px);
 
 /// A floor point in the robot frame (x forward, y left).
 Eigen::Vector2d toRobot(const robots::BasePose& pose, const Eigen::Vector2d& p_w);
