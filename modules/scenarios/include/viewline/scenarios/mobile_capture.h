@@ -57,7 +57,9 @@
 // tool also gets every frame (MobileCaptureHooks::on_frame).
 //
 // Files: mobile_capture/config (parameters, reader), world (object, floor, robot, head camera
-// source), loop (the chase and the oracle), metrics (filter test, sweep, batch, summary).
+// source), loop (the chase and the oracle), metrics (filter test, sweep, batch, summary),
+// recording (record and replay), robot_link (the base's command link and its faults), footage
+// (one session over a camera's footage with the robot held at its start pose, no truth).
 
 #include "viewline/scenarios/mobile_capture/config.h"
 #include "viewline/scenarios/mobile_capture/loop.h"
