@@ -15,7 +15,10 @@ io::ConfigReferenceSection dartConfigReference() {
       "simulated cameras, the viewline tracker's consistency, gates, asynchronous and late data and "
       "single-camera start. Every key is optional (defaults: `scenarios::defaultDartScenario()`).";
   s.shipped = {"dart_tracking.yaml"};
-  s.probes = {"source: {kind: recording, path: rec}\n"};
+  // The detector block of footage (not in the shipped file, which runs the experiments).
+  s.probes = {"source: {kind: recording, path: rec}\n",
+              "detector: {hsv: [35, 85, 80, 255, 30, 255], min_area_px: 6, noise_area_px: 2, min_roundness: 0.45,\n"
+              "           roi_half_size_px: 48, open_kernel_px: 3, close_kernel_px: 3, sigma_px_floor: 0.3, sigma_px: 0}\n"};
   // A camera's footage: one probe per kind (a recording is refused per camera, so not probed).
   for (const std::string& p : runtime::sourceConfigProbes("    ")) {
     if (p.find("kind: recording") != std::string::npos) continue;
@@ -53,12 +56,12 @@ io::ConfigReferenceSection dartConfigReference() {
       {"detector", "", "footage only: the dart's coloured marker detector (vision::BallDetector; a dart seen by a "
                        "camera is a small blob: smaller area floors than the ball's)"},
       {"detector.hsv", "", "HSV range of the marker [hue_lo, hue_hi, s_lo, s_hi, v_lo, v_hi] (absent: the detector's green)"},
-      {"detector.min_area_px", "px", "blobs with fewer pixels are too small (absent: 6, a few-pixel marker)"},
-      {"detector.noise_area_px", "px", "blobs below this are ignored altogether (absent: 2)"},
+      {"detector.min_area_px", "px", "blobs with fewer pixels are too small (a dart's marker is a few pixels across)"},
+      {"detector.noise_area_px", "px", "blobs below this are ignored altogether"},
       {"detector.min_roundness", "", "area / (π ρ²) below which a blob is no marker"},
       {"detector.roi_half_size_px", "px", "half side of the search window around the tracker's predicted pixel"},
       {"detector.open_kernel_px", "px", "elliptic opening kernel size (odd; 0 or 1: none)"},
-      {"detector.close_kernel_px", "px", "elliptic closing kernel size (odd; 0 or 1: none; absent: 3)"},
+      {"detector.close_kernel_px", "px", "elliptic closing kernel size (odd; 0 or 1: none)"},
       {"detector.sigma_px_floor", "px", "floor of the blob's own std handed to the tracker"},
       {"detector.sigma_px", "px", "measured std of the detection per axis, told to the tracker (0: the blob's own, floored)"},
       {"tracker", "", "the viewline tracker (tracking::TrackerConfig)"},
