@@ -28,7 +28,7 @@ std::string describeSource(const SourceConfig& source);
 
 /// One camera of a merged source: its name in the rig, its footage and its calibrated image size.
 struct MergedCamera {
-  std::string name;     ///< the rig's camera name (messages say cameras[<name>].source)
+  std::string name;     ///< the rig's camera name (messages name it as cameras[name].source)
   SourceConfig source;  ///< images, video or v4l2
   unsigned width = 0,   ///< calibrated image width, px
            height = 0;  ///< calibrated image height, px
