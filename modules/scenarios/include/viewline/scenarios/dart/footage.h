@@ -23,6 +23,10 @@
 // std, from its last confirmed estimate before the predicted hit time: later images show the
 // dart at rest in the board) and the mean NIS of the fused images tested against their track
 // before that time. The experiments' RMSE, NEES and gate figures are "not scored: no truth".
+//
+// Limits: footage with pace: true (or a V4L2 camera) is taken at its own pace, but the session
+// times no frame and reports no deadline misses (ball catching's footage session does); there
+// is no fault injection on footage; v4l2 is untested on hardware.
 
 #include <cstdint>
 #include <nlohmann/json.hpp>
