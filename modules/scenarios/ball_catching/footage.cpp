@@ -14,7 +14,6 @@
 #include "viewline/runtime/delay_line.h"
 #include "viewline/runtime/scheduler.h"
 #include "viewline/runtime/stale_frames.h"
-#include "viewline/runtime/v4l2_source.h"
 #include "viewline/scenarios/ball_catching/detection.h"
 #include "viewline/scenarios/ball_catching/planner_input.h"
 #include "viewline/scenarios/ball_catching/robot_guard.h"
@@ -23,126 +22,25 @@
 
 namespace viewline::scenarios {
 
-std::string describeSource(const runtime::SourceConfig& s) {
-  switch (s.kind) {
-    case runtime::SourceKind::Images: return "images " + s.images.pattern;
-    case runtime::SourceKind::Video: return "video " + s.video.path;
-    case runtime::SourceKind::V4l2: return "v4l2 " + s.v4l2.device;
-    case runtime::SourceKind::Recording: return "recording " + s.recording;
-    case runtime::SourceKind::Sim: break;
-  }
-  return "sim";
-}
+std::string describeSource(const runtime::SourceConfig& s) { return runtime::describeSource(s); }
 
-CatchFootageFrames::CatchFootageFrames(const BallCatchingConfig& cfg, runtime::WallClock* clock) {
+namespace {
+
+// The rig's active cameras with their footage and calibrated image size.
+std::vector<runtime::MergedCamera> footageCameras(const BallCatchingConfig& cfg) {
+  std::vector<runtime::MergedCamera> cams;
   for (std::size_t i = 0; i < cfg.activeCameras(); ++i) {
     const CatchCameraConfig& c = cfg.cameras[i];
-    if (c.source.simulated() || c.source.kind == runtime::SourceKind::Recording)
-      throw core::InvalidInput("cameras[" + c.name + "].source: expected footage (images, video or v4l2), got " +
-                               runtime::toString(c.source.kind));
-    Camera k;
-    k.name = c.name;
-    k.what = describeSource(c.source);
     const core::Camera est = c.estimatorCamera();
-    k.width = est.width;
-    k.height = est.height;
-    try {
-      k.source = runtime::makeFrameSource(c.source, clock);
-    } catch (const core::InvalidInput& e) {
-      throw core::InvalidInput("cameras[" + c.name + "].source: " + e.what());
-    }
-    if (k.source->cameraCount() != 1)
-      throw core::InvalidInput("cameras[" + c.name + "].source: " + k.what + " holds " +
-                               std::to_string(k.source->cameraCount()) + " cameras, expected one");
-    cameras_.push_back(std::move(k));
+    cams.push_back({c.name, c.source, est.width, est.height});
   }
+  return cams;
 }
 
-std::optional<core::Timestamp> CatchFootageFrames::nextReadyTime() const {
-  std::optional<core::Timestamp> t;
-  for (const Camera& c : cameras_)
-    if (const auto r = c.source->nextReadyTime(); r && (!t || *r < *t)) t = r;
-  return t;
-}
+}  // namespace
 
-std::optional<runtime::Frame> CatchFootageFrames::grab() {
-  std::size_t best = cameras_.size();
-  core::Timestamp t = std::numeric_limits<double>::infinity();
-  // A V4L2 camera is always ready "now" (its grab waits for the driver's next frame), so the
-  // earliest ready time would always be the first camera's: V4L2 cameras are taken in turn,
-  // starting after the one grabbed last; footage goes by its stamps.
-  for (std::size_t k = 0; k < cameras_.size(); ++k) {
-    const std::size_t i = (last_ + 1 + k) % cameras_.size();
-    const auto r = cameras_[i].source->nextReadyTime();
-    if (!r) continue;
-    if (dynamic_cast<const runtime::V4l2Source*>(cameras_[i].source.get())) {
-      best = i;
-      break;
-    }
-    if (*r < t || (*r == t && i < best)) {
-      t = *r;
-      best = i;
-    }
-  }
-  if (best == cameras_.size()) return std::nullopt;
-  last_ = best;
-  Camera& c = cameras_[best];
-  std::optional<runtime::Frame> f = c.source->grab();
-  if (!f) {
-    ++c.lost;
-    return f;
-  }
-  if (f->image.type() != CV_8UC3)
-    throw core::InvalidInput("cameras[" + c.name + "].source: " + c.what + ": frame " + std::to_string(f->sequence) +
-                             " is not a colour (8-bit BGR) image: the ball detector segments colour");
-  if (static_cast<unsigned>(f->image.cols) != c.width || static_cast<unsigned>(f->image.rows) != c.height)
-    throw core::InvalidInput("cameras[" + c.name + "].source: " + c.what + ": frame " + std::to_string(f->sequence) +
-                             " is " + std::to_string(f->image.cols) + "x" + std::to_string(f->image.rows) +
-                             " px, the camera's calibration is " + std::to_string(c.width) + "x" +
-                             std::to_string(c.height) + " px");
-  f->camera = best;
-  ++c.frames;
-  return f;
-}
-
-bool CatchFootageFrames::live() const {
-  for (const Camera& c : cameras_)
-    if (dynamic_cast<const runtime::LiveFrameSource*>(c.source.get())) return true;
-  return false;
-}
-
-std::uint64_t CatchFootageFrames::delivered() const {
-  std::uint64_t n = 0;
-  for (const Camera& c : cameras_) {
-    const auto* l = dynamic_cast<const runtime::LiveFrameSource*>(c.source.get());
-    n += l ? l->delivered() : c.frames + c.lost;
-  }
-  return n;
-}
-
-std::uint64_t CatchFootageFrames::dropped() const {
-  std::uint64_t n = 0;
-  for (const Camera& c : cameras_)
-    if (const auto* l = dynamic_cast<const runtime::LiveFrameSource*>(c.source.get())) n += l->dropped();
-  return n;
-}
-
-std::uint64_t CatchFootageFrames::queuedLate() const {
-  std::uint64_t n = 0;
-  for (const Camera& c : cameras_)
-    if (const auto* l = dynamic_cast<const runtime::LiveFrameSource*>(c.source.get())) n += l->queuedLate();
-  return n;
-}
-
-std::string CatchFootageFrames::describe() const {
-  std::string s;
-  for (const Camera& c : cameras_) {
-    if (!s.empty()) s += "; ";
-    const auto* l = dynamic_cast<const runtime::LiveFrameSource*>(c.source.get());
-    s += c.name + ": " + (l ? l->describe() : c.what);
-  }
-  return s;
-}
+CatchFootageFrames::CatchFootageFrames(const BallCatchingConfig& cfg, runtime::WallClock* clock)
+    : runtime::MergedFrameSource(footageCameras(cfg), clock) {}
 
 namespace {
 

@@ -1,5 +1,7 @@
 #include "viewline/scenarios/dart/config.h"
 
+#include <cmath>
+
 #include "viewline/core/checks.h"
 #include "viewline/core/error.h"
 #include "viewline/core/frames.h"
@@ -7,6 +9,23 @@
 #include "viewline/io/config_edit.h"
 
 namespace viewline::scenarios {
+
+vision::BallDetectorConfig defaultDartDetector() {
+  vision::BallDetectorConfig d;
+  // A 2 cm marker 2.5 m away covers about 50 px on the default rig (radius about 4 px): the
+  // ball's floors (12 px, 3 px) would pass it only when close, and a 5 px closing would merge it
+  // with its neighbours; a 3 px opening keeps it.
+  d.min_area_px = 6.0;
+  d.noise_area_px = 2.0;
+  d.close_kernel_px = 3;
+  return d;
+}
+
+bool DartScenarioConfig::onFootage() const {
+  for (const DartCameraConfig& c : cameras)
+    if (!c.source.simulated()) return true;
+  return false;
+}
 
 tracking::TrackerConfig DartScenarioConfig::trackerConfig() const {
   tracking::TrackerConfig t = tracker;
@@ -30,6 +49,20 @@ void DartScenarioConfig::validate() const {
     if (!(c.jitter_std_s >= 0.0 && c.jitter_std_s < 0.25 / c.rate_hz))
       throw core::InvalidInput(p + "jitter_std_s: expected >= 0 and below a quarter frame period");
   }
+  if (onFootage()) {
+    // One clock for the session: footage cannot be fused with generated detections.
+    for (const DartCameraConfig& c : cameras)
+      if (c.source.simulated())
+        throw core::InvalidInput("dart scenario: cameras[" + c.name +
+                                 "].source: every camera needs footage when one has it (one session on the "
+                                 "footage's clock)");
+    if (!source.simulated())
+      throw core::InvalidInput("dart scenario: source: kind recording and cameras[].source footage are exclusive");
+  }
+  detector.validate();
+  if (!(detector_sigma_px >= 0.0 && std::isfinite(detector_sigma_px)))
+    throw core::InvalidInput("dart scenario: detector.sigma_px: expected a finite value >= 0");
+  core::requirePositive(detector_sigma_px_floor, "dart scenario: detector.sigma_px_floor");
   core::requireFinite(gravity_w, "dart scenario: gravity");
   core::requireFinite(release_mean, "dart scenario: throw.release_mean");
   core::requireFinite(release_std, "dart scenario: throw.release_std");
@@ -88,6 +121,10 @@ DartCameraConfig readCamera(const io::ConfigNode& c) {
   cam.clock_drift_std = c.getOr<double>("clock_drift_std", cam.clock_drift_std);
   cam.jitter_std_s = c.getOr<double>("jitter_std_s", cam.jitter_std_s);
   if (!(cam.rate_hz > 0)) c.fail("rate_hz", "a positive number");
+  cam.source = runtime::readSourceConfig(c);  // absent: sim (generated detections)
+  if (cam.source.kind == runtime::SourceKind::Recording)
+    throw core::InvalidInput(c.location("source") + ": cameras[].source.kind recording is not a camera's source (a "
+                             "recording holds every camera's detections: the top-level source: {kind: recording})");
   return cam;
 }
 
@@ -124,6 +161,26 @@ void readTracker(const io::ConfigNode& t, DartScenarioConfig& cfg) {
   }
 }
 
+vision::ColorRange readHsv(const io::ConfigNode& n, const char* key) {
+  const auto v = n.get<std::vector<int>>(key);
+  if (v.size() != 6) n.fail(key, "[hue_lo, hue_hi, s_lo, s_hi, v_lo, v_hi]");
+  return {v[0], v[1], v[2], v[3], v[4], v[5]};
+}
+
+// The marker detector on footage: the ball detector's keys (ball_catching's detector block).
+void readDetector(const io::ConfigNode& d, DartScenarioConfig& cfg) {
+  vision::BallDetectorConfig& k = cfg.detector;
+  if (d.has("hsv")) k.hsv = readHsv(d, "hsv");
+  k.min_area_px = d.getOr<double>("min_area_px", k.min_area_px);
+  k.noise_area_px = d.getOr<double>("noise_area_px", k.noise_area_px);
+  k.min_roundness = d.getOr<double>("min_roundness", k.min_roundness);
+  k.roi_half_size_px = d.getOr<double>("roi_half_size_px", k.roi_half_size_px);
+  k.open_kernel_px = d.getOr<int>("open_kernel_px", k.open_kernel_px);
+  k.close_kernel_px = d.getOr<int>("close_kernel_px", k.close_kernel_px);
+  cfg.detector_sigma_px_floor = d.getOr<double>("sigma_px_floor", cfg.detector_sigma_px_floor);
+  cfg.detector_sigma_px = d.getOr<double>("sigma_px", cfg.detector_sigma_px);
+}
+
 void readExperiments(const io::ConfigNode& e, DartScenarioConfig& cfg) {
   cfg.alternate_step = e.getOr<double>("alternate_step_s", cfg.alternate_step);
   cfg.late_max_delay = e.getOr<double>("late_max_delay_s", cfg.late_max_delay);
@@ -147,7 +204,7 @@ DartScenarioConfig dartScenarioFromNode(const io::ConfigNode& root) {
   if (!cfg.source.simulated() && cfg.source.kind != runtime::SourceKind::Recording)
     throw core::InvalidInput(root.location("source") + ": source.kind " + runtime::toString(cfg.source.kind) +
                              " is not supported by dart_tracking (sim or recording: the experiments run on "
-                             "detections with their truth, and render or read no images)");
+                             "detections with their truth; footage goes per camera, cameras[].source)");
   if (root.has("cameras")) {
     cfg.cameras.clear();
     for (const io::ConfigNode& c : root.childList("cameras")) cfg.cameras.push_back(readCamera(c));
@@ -167,6 +224,7 @@ DartScenarioConfig dartScenarioFromNode(const io::ConfigNode& root) {
   cfg.pixel_noise_px = root.getOr<double>("pixel_noise_px", cfg.pixel_noise_px);
   cfg.outlier_rate = root.getOr<double>("outlier_rate", cfg.outlier_rate);
   if (root.has("tracker")) readTracker(root.child("tracker"), cfg);
+  if (root.has("detector")) readDetector(root.child("detector"), cfg);
   if (root.has("experiments")) readExperiments(root.child("experiments"), cfg);
   io::finishAndValidate(root, cfg);
   return cfg;

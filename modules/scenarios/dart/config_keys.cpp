@@ -15,7 +15,16 @@ io::ConfigReferenceSection dartConfigReference() {
       "simulated cameras, the viewline tracker's consistency, gates, asynchronous and late data and "
       "single-camera start. Every key is optional (defaults: `scenarios::defaultDartScenario()`).";
   s.shipped = {"dart_tracking.yaml"};
-  s.probes = {"source: {kind: recording, path: rec}\n"};
+  // The detector block of footage (not in the shipped file, which runs the experiments).
+  s.probes = {"source: {kind: recording, path: rec}\n",
+              "detector: {hsv: [35, 85, 80, 255, 30, 255], min_area_px: 6, noise_area_px: 2, min_roundness: 0.45,\n"
+              "           roi_half_size_px: 48, open_kernel_px: 3, close_kernel_px: 3, sigma_px_floor: 0.3, sigma_px: 0}\n"};
+  // A camera's footage: one probe per kind (a recording is refused per camera, so not probed).
+  for (const std::string& p : runtime::sourceConfigProbes("    ")) {
+    if (p.find("kind: recording") != std::string::npos) continue;
+    s.probes.push_back("cameras:\n  - name: a\n    eye: [1.2, -2.6, 1.6]\n    target: [1.2, 0.0, 1.75]\n    hfov_deg: 62\n" +
+                       p);
+  }
   s.read = [](const io::ConfigNode& root) { dartScenarioFromNode(root); };
   s.keys = {
       {"cameras", "", "the simulated cameras (absent: two cameras, side and rear, 2-3 m from the thrower)"},
@@ -41,8 +50,20 @@ io::ConfigReferenceSection dartConfigReference() {
       {"pixel_noise_px", "px", "detection noise (std per axis)"},
       {"outlier_rate", "", "fraction of detections that are gross outliers anywhere in the image, in [0, 1)"},
       {"source", "", "where the detections come from (absent: generated from the simulated flights)"},
-      {"source.kind", "", "sim (generated) or recording (a folder written by --record); other kinds are refused"},
+      {"source.kind", "", "sim (generated) or recording (a folder written by --record); footage goes per camera "
+                          "(cameras[].source)"},
       {"source.path", "", "recording: the folder written by --record (as --replay)"},
+      {"detector", "", "footage only: the dart's coloured marker detector (vision::BallDetector; a dart seen by a "
+                       "camera is a small blob: smaller area floors than the ball's)"},
+      {"detector.hsv", "", "HSV range of the marker [hue_lo, hue_hi, s_lo, s_hi, v_lo, v_hi] (absent: the detector's green)"},
+      {"detector.min_area_px", "px", "blobs with fewer pixels are too small (a dart's marker is a few pixels across)"},
+      {"detector.noise_area_px", "px", "blobs below this are ignored altogether"},
+      {"detector.min_roundness", "", "area / (π ρ²) below which a blob is no marker"},
+      {"detector.roi_half_size_px", "px", "half side of the search window around the tracker's predicted pixel"},
+      {"detector.open_kernel_px", "px", "elliptic opening kernel size (odd; 0 or 1: none)"},
+      {"detector.close_kernel_px", "px", "elliptic closing kernel size (odd; 0 or 1: none)"},
+      {"detector.sigma_px_floor", "px", "floor of the blob's own std handed to the tracker"},
+      {"detector.sigma_px", "px", "measured std of the detection per axis, told to the tracker (0: the blob's own, floored)"},
       {"tracker", "", "the viewline tracker (tracking::TrackerConfig)"},
       {"tracker.prior_position", "m", "prior position of a new track (absent: [1, 0, 1.75], mid-flight)"},
       {"tracker.prior_velocity", "m/s", "prior velocity of a new track (absent: [12, 0, 0], towards the board)"},
@@ -76,6 +97,19 @@ io::ConfigReferenceSection dartConfigReference() {
       {"experiments.settled_index", "", "RMSE and PCRLB pooled over measurements with this index and later"},
       {"experiments.confidence", "", "confidence of the consistency intervals, in (0, 1)"},
   };
+  // Footage per camera (dart/footage.h): the runtime's `source:` keys under each camera.
+  for (io::ConfigKeyDoc d : runtime::sourceConfigKeys()) {
+    if (d.key == "source") {
+      d.meaning = "this camera's footage (absent: generated detections); every camera has footage or none: one "
+                  "session over it, no truth (dart/footage.h)";
+    } else if (d.key == "source.kind") {
+      d.meaning = "sim (generated), images, video or v4l2 (recording is the top-level source's)";
+    } else if (d.key == "source.path") {
+      d.meaning = "video: the file";
+    }
+    d.key = "cameras[]." + d.key;
+    s.keys.push_back(std::move(d));
+  }
   return s;
 }
 

@@ -357,6 +357,9 @@ void finish(DartSummary& sum, const Pools& p, const DartScenarioConfig& cfg, int
 
 DartSummary runDartExperiments(const DartScenarioConfig& cfg, std::uint64_t seed, int runs, const DartRunCallbacks& cb) {
   if (runs < 1) throw core::InvalidInput("dart scenario: runs: expected >= 1");
+  if (cfg.onFootage())
+    throw core::InvalidInput("dart scenario: cameras[].source: footage runs as one session without truth "
+                             "(runDartFootage), not as the experiments");
   const auto t_start = std::chrono::steady_clock::now();
   const std::vector<core::Camera> cams = makeDartCameras(cfg);
 

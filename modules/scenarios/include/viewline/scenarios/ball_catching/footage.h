@@ -49,6 +49,7 @@
 #include "viewline/planning/crossing.h"
 #include "viewline/runtime/faults.h"
 #include "viewline/runtime/live.h"
+#include "viewline/runtime/merged_source.h"
 #include "viewline/scenarios/ball_catching/config.h"
 #include "viewline/scenarios/ball_catching/loop.h"
 
@@ -58,47 +59,12 @@ namespace viewline::scenarios {
 std::string describeSource(const runtime::SourceConfig& source);
 
 /// The footage of the rig's active cameras (cameras[i].source), merged into one multi-camera
-/// source in stamp order: the next frame is the camera's whose next frame is ready first (ties:
-/// the lower index; V4L2 cameras, always ready, in turn), handed out with `camera` set to its
-/// index in the rig.
-class CatchFootageFrames : public runtime::LiveFrameSource {
+/// source in stamp order (runtime::MergedFrameSource), `camera` set to the camera's index in the rig.
+class CatchFootageFrames : public runtime::MergedFrameSource {
 public:
   /// Opens every active camera's source (runtime::makeFrameSource; throws core::InvalidInput
   /// naming the file or device) with `clock` for paced footage (null: the steady clock).
   explicit CatchFootageFrames(const BallCatchingConfig& cfg, runtime::WallClock* clock = nullptr);
-  std::size_t cameraCount() const override { return cameras_.size(); }
-  /// The earliest next ready time over the cameras, s; nullopt once every camera has ended.
-  std::optional<core::Timestamp> nextReadyTime() const override;
-  /// The next frame of the camera ready first (nullopt: that camera lost it). Throws
-  /// core::InvalidInput naming the camera and its source when a frame is not a colour image of
-  /// the camera's calibrated size (the detector segments colour in the calibrated image).
-  std::optional<runtime::Frame> grab() override;
-  /// Frames delivered over the cameras (a live camera's own count; a file's frames grabbed).
-  std::uint64_t delivered() const override;
-  /// Frames a live camera delivered but the loop never took (0 for unpaced files).
-  std::uint64_t dropped() const override;
-  /// Frames handed out more than a frame period after capture (live cameras).
-  std::uint64_t queuedLate() const override;
-  /// Each camera's source and pacing, "; "-separated.
-  std::string describe() const override;
-  /// True when a camera runs at its own pace (V4L2, or footage with pace: true).
-  bool live() const;
-  /// Frames camera i handed out.
-  std::uint64_t frames(std::size_t i) const { return cameras_[i].frames; }
-  /// Grabs of camera i that lost their frame.
-  std::uint64_t lost(std::size_t i) const { return cameras_[i].lost; }
-  /// Camera i's source, as describeSource() names it.
-  const std::string& sourceName(std::size_t i) const { return cameras_[i].what; }
-
-private:
-  struct Camera {
-    std::unique_ptr<runtime::FrameSource> source;
-    std::string name, what;  // the rig's camera name, describeSource()
-    unsigned width = 0, height = 0;  // the calibrated image size, px
-    std::uint64_t frames = 0, lost = 0;
-  };
-  std::vector<Camera> cameras_;
-  std::size_t last_ = 0;  // the camera grabbed last (V4L2 cameras are taken in turn)
 };
 
 /// One track of a footage session (one attempt of the planner) and what the planner made of it.

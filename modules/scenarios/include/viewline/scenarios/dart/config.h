@@ -17,8 +17,13 @@
 #include "viewline/io/config.h"
 #include "viewline/runtime/source_config.h"
 #include "viewline/tracking/tracker.h"
+#include "viewline/vision/ball_detector.h"
 
 namespace viewline::scenarios {
+
+/// The marker detector's defaults for a dart: the ball detector's, with area floors for a blob
+/// of a few pixels across (a 2 cm marker at 2.5 m is about 4 px in radius on the default rig).
+vision::BallDetectorConfig defaultDartDetector();
 
 /// One camera of the dart rig: pose (eye/target, world frame), intrinsics and free-running clock.
 struct DartCameraConfig {
@@ -32,6 +37,8 @@ struct DartCameraConfig {
   double rate_hz = 50.0;       ///< nominal frame rate of the free-running clock, Hz
   double clock_drift_std = 1e-4;  ///< relative frequency error of the free-running clock (std)
   double jitter_std_s = 0.5e-3;   ///< capture-time jitter (std), s
+  /// The camera's footage (images, video or v4l2; dart/footage.h); sim (absent): generated detections.
+  runtime::SourceConfig source;
 };
 
 /// The dart experiments' whole configuration: rig, throws, detection noise, tracker, experiments.
@@ -65,6 +72,16 @@ struct DartScenarioConfig {
   std::size_t settled_index = 4;    ///< RMSE / PCRLB pooled over measurements with index >= this
   double confidence = 0.99;  ///< two-sided probability of the NEES consistency bounds
   runtime::SourceConfig source;  ///< `source:` sim (generated detections) or recording (dart/recording.h)
+  /// The dart's coloured marker detector on footage (a dart seen by a camera is a small blob:
+  /// smaller area floors than the ball's); unused on generated detections.
+  vision::BallDetectorConfig detector = defaultDartDetector();
+  /// Footage: the detection's std per axis told to the tracker, px (0: the blob's own, floored).
+  double detector_sigma_px = 0.0;
+  /// Footage: floor of the blob's own std, px (a few-pixel blob's edge noise model is optimistic).
+  double detector_sigma_px_floor = 0.3;
+
+  /// True when the cameras give footage (cameras[].source), not generated detections.
+  bool onFootage() const;
 
   /// The tracker's configuration with the scenario's gravity in its model.
   tracking::TrackerConfig trackerConfig() const;

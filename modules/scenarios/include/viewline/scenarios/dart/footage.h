@@ -1,0 +1,95 @@
+#pragma once
+// Dart tracking on footage: the dart rig's cameras give real frames (an image sequence, a video
+// file or a live V4L2 camera per camera) and the viewline tracker runs on the dart's marker as
+// it would on a real rig.
+//
+//   cameras:
+//     - {name: side, eye: [...], target: [...], hfov_deg: 62, source: {kind: video, path: side.mkv, stamps: side.csv}}
+//     - {name: rear, eye: [...], target: [...], hfov_deg: 62, source: {kind: images, pattern: rear/%04d.png, stamps: rear.csv}}
+//   detector: {hsv: [35, 85, 80, 255, 30, 255], min_area_px: 6}
+//
+// One `source:` per camera (every camera or none), merged in stamp order
+// (runtime::MergedFrameSource: the stamps must share one clock). Each frame's marker is detected
+// by vision::BallDetector (the `detector:` block; a dart seen by a camera is a small blob, so its
+// defaults have smaller area floors than the ball's, defaultDartDetector()), in a window around
+// the tracker's predicted pixel, and fed to the viewline tracker with the scenario's tracker
+// config (tracker.gate: the shipped Mahalanobis gate; the experiments' gate comparison needs
+// truth). Tracks start and restart as the tracker does; a pause in the detections longer than
+// max_coast_s (or max_forward_gap_s) ends the dart: the tracker starts afresh, as for a new throw.
+//
+// There is no truth: the run is ONE session to the end of the footage. What is reported is what
+// can be known without it: frames, lost frames and detections per camera, tracks started, each
+// track's predicted board hit (the crossing of the plane x = board_center.x, with the time and
+// std, from its last confirmed estimate before the predicted hit time: later images show the
+// dart at rest in the board) and the mean NIS of the fused images tested against their track
+// before that time. The experiments' RMSE, NEES and gate figures are "not scored: no truth".
+//
+// Limits: footage with pace: true (or a V4L2 camera) is taken at its own pace, but the session
+// times no frame and reports no deadline misses (ball catching's footage session does); there
+// is no fault injection on footage; v4l2 is untested on hardware.
+
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "viewline/planning/crossing.h"
+#include "viewline/runtime/telemetry.h"
+#include "viewline/scenarios/dart/config.h"
+
+namespace viewline::scenarios {
+
+/// What one camera of a dart footage session gave.
+struct DartFootageCamera {
+  std::string name;              ///< the rig's camera name
+  std::string source;            ///< runtime::describeSource()
+  std::uint64_t frames = 0,      ///< frames handed out
+                lost = 0,        ///< grabs that lost their frame
+                detections = 0;  ///< frames the marker was detected in
+};
+
+/// One track of a dart footage session and its predicted board hit.
+struct DartFootageTrack {
+  int track = 0;         ///< the session's track number, from 1 (a restart after rejections keeps it)
+  double t_first = 0.0,  ///< s, footage stamp of the track's first fused image
+         t_last = 0.0;   ///< s, stamp of its last fused image
+  int fused = 0;         ///< images fused into the track
+  /// The crossing of the board plane x = board_center.x predicted from the track's last confirmed
+  /// estimate before the predicted hit time: point (m, world), time (s, footage clock),
+  /// covariance; empty when none was predicted.
+  std::optional<planning::Crossing> board_hit;
+};
+
+/// The summary of a dart footage session (footage.h): what is known without truth.
+struct DartFootageSummary {
+  std::vector<DartFootageCamera> cameras;  ///< per camera, in the rig's order
+  double t_first = 0.0,  ///< s, first frame's stamp
+         t_last = 0.0;   ///< s, last frame's stamp
+  std::uint64_t frames = 0,      ///< frames over the cameras
+                detections = 0,  ///< detections over the cameras
+                fused = 0,       ///< detections the tracker fused
+                gated = 0,       ///< detections its gate rejected
+                refused = 0;     ///< detections the tracker refused (tracking::Refusal)
+  int tracks_started = 0;  ///< tracks the tracker started (a restart after rejections is the same track)
+  std::vector<DartFootageTrack> tracks;  ///< the tracks with a fused image, in order
+  double nis_mean = 0.0;        ///< mean NIS of the fused images tested against their track before its hit (2 dof)
+  std::uint64_t nis_samples = 0;  ///< images in nis_mean
+  double wall_s = 0.0;  ///< wall-clock time of the session, s
+};
+
+/// The board plane of the scenario: x = board_center.x, normal towards the thrower (-x).
+planning::CrossingPlane dartBoardPlane(const DartScenarioConfig& cfg);
+
+/// Runs the session over the footage of cfg's cameras (cfg.onFootage(); the header comment).
+/// `telemetry` (optional): the detections, the tracker's updates (channel "dart") and estimates.
+/// Throws core::InvalidInput naming the file or device a source cannot open or read.
+DartFootageSummary runDartFootage(const DartScenarioConfig& cfg, runtime::TelemetrySink* telemetry = nullptr);
+
+/// The summary as JSON (RMSE and experiments null: "truth": not scored).
+nlohmann::json dartFootageSummaryJson(const DartFootageSummary& s, const DartScenarioConfig& cfg);
+
+/// The console summary (says "not scored: no truth" where the experiments give their figures).
+std::string dartFootageSummaryText(const DartFootageSummary& s, const DartScenarioConfig& cfg);
+
+}  // namespace viewline::scenarios
