@@ -18,6 +18,24 @@ std::string describeSource(const SourceConfig& s) {
   return "sim";
 }
 
+SingleCameraFootage openSingleCameraFootage(const SourceConfig& config, WallClock* clock, const std::string& role) {
+  const std::string name = describeSource(config);
+  SingleCameraFootage f;
+  try {
+    f.source = makeFrameSource(config, clock);
+  } catch (const core::InvalidInput& e) {
+    throw core::InvalidInput(std::string("source: ") + e.what());
+  }
+  if (f.source->cameraCount() != 1)
+    throw core::InvalidInput("source: " + name + " holds " + std::to_string(f.source->cameraCount()) +
+                             " cameras, expected one (" + role + ")");
+  const std::optional<core::Timestamp> first = f.source->nextReadyTime();
+  if (!first) throw core::InvalidInput("source: " + name + ": the footage holds no frame");
+  f.t0 = *first;
+  f.live = dynamic_cast<LiveFrameSource*>(f.source.get());
+  return f;
+}
+
 MergedFrameSource::MergedFrameSource(const std::vector<MergedCamera>& cameras, WallClock* clock) {
   for (const MergedCamera& c : cameras) {
     if (c.source.simulated() || c.source.kind == SourceKind::Recording)

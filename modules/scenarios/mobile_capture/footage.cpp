@@ -11,6 +11,7 @@
 #include "viewline/core/error.h"
 #include "viewline/core/interrupt.h"
 #include "viewline/core/random.h"
+#include "viewline/runtime/merged_source.h"
 #include "viewline/runtime/scheduler.h"
 #include "viewline/runtime/source_config.h"
 #include "viewline/runtime/stale_frames.h"
@@ -25,17 +26,6 @@ using Eigen::Vector3d;
 using namespace mobile_capture;
 
 namespace {
-
-std::string describe(const runtime::SourceConfig& s) {
-  switch (s.kind) {
-    case runtime::SourceKind::Images: return "images " + s.images.pattern;
-    case runtime::SourceKind::Video: return "video " + s.video.path;
-    case runtime::SourceKind::V4l2: return "v4l2 " + s.v4l2.device;
-    case runtime::SourceKind::Recording: return "recording " + s.recording;
-    case runtime::SourceKind::Sim: break;
-  }
-  return "sim";
-}
 
 // A command within a limit, with a relative tolerance for the clamps' own rounding.
 bool within(double value, double limit) { return std::abs(value) <= limit * (1.0 + 1e-9); }
@@ -61,20 +51,11 @@ MobileFootageSummary runMobileCaptureFootage(const MobileCaptureConfig& cfg, std
   const auto wall0 = std::chrono::steady_clock::now();
   MobileFootageSummary sum;
   sum.seed = seed;
-  sum.source = describe(cfg.source);
-  std::unique_ptr<runtime::FrameSource> source;
-  try {
-    source = runtime::makeFrameSource(cfg.source, clock);
-  } catch (const core::InvalidInput& e) {
-    throw core::InvalidInput(std::string("source: ") + e.what());
-  }
-  if (source->cameraCount() != 1)
-    throw core::InvalidInput("source: " + sum.source + " holds " + std::to_string(source->cameraCount()) +
-                             " cameras; the head camera is one");
-  const std::optional<double> first = source->nextReadyTime();
-  if (!first) throw core::InvalidInput("source: " + sum.source + " holds no frame");
-  const double t0 = *first;
-  auto* live = dynamic_cast<runtime::LiveFrameSource*>(source.get());
+  sum.source = runtime::describeSource(cfg.source);
+  runtime::SingleCameraFootage opened = runtime::openSingleCameraFootage(cfg.source, clock, "the head camera");
+  const std::unique_ptr<runtime::FrameSource>& source = opened.source;
+  const double t0 = opened.t0;
+  runtime::LiveFrameSource* const live = opened.live;
 
   // The fixed camera: the robot and its head held at their start pose (header comment).
   RobotSim robot(cfg);

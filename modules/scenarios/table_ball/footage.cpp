@@ -12,6 +12,7 @@
 #include "viewline/core/frames.h"
 #include "viewline/robots/table_tilt.h"
 #include "viewline/runtime/delay_line.h"
+#include "viewline/runtime/merged_source.h"
 #include "viewline/runtime/scheduler.h"
 #include "viewline/runtime/source_config.h"
 #include "viewline/runtime/stale_frames.h"
@@ -31,16 +32,7 @@ constexpr double kTimeTolerance = 1e-9;
 
 }  // namespace
 
-std::string tableBallFootageName(const runtime::SourceConfig& s) {
-  switch (s.kind) {
-    case runtime::SourceKind::Images: return "images " + s.images.pattern;
-    case runtime::SourceKind::Video: return "video " + s.video.path;
-    case runtime::SourceKind::V4l2: return "v4l2 " + s.v4l2.device;
-    case runtime::SourceKind::Recording: return "recording " + s.recording;
-    case runtime::SourceKind::Sim: break;
-  }
-  return "sim";
-}
+std::string tableBallFootageName(const runtime::SourceConfig& s) { return runtime::describeSource(s); }
 
 TableBallFootageSummary runTableBallFootage(const TableBallConfig& cfg, std::uint64_t seed, const TableBallHooks& hooks,
                                             runtime::WallClock* clock) {
@@ -56,19 +48,10 @@ TableBallFootageSummary runTableBallFootage(const TableBallConfig& cfg, std::uin
   TableBallFootageSummary sum;
   sum.seed = seed;
   sum.source = tableBallFootageName(cfg.source);
-  std::unique_ptr<runtime::FrameSource> footage;
-  try {
-    footage = runtime::makeFrameSource(cfg.source, clock);
-  } catch (const core::InvalidInput& e) {
-    throw core::InvalidInput(std::string("source: ") + e.what());
-  }
-  if (footage->cameraCount() != 1)
-    throw core::InvalidInput("source: " + sum.source + " holds " + std::to_string(footage->cameraCount()) +
-                             " cameras, expected one (the head camera)");
-  const std::optional<double> first = footage->nextReadyTime();
-  if (!first) throw core::InvalidInput("source: " + sum.source + ": the footage holds no frame");
-  const double t0 = *first;
-  auto* live = dynamic_cast<runtime::LiveFrameSource*>(footage.get());
+  runtime::SingleCameraFootage opened = runtime::openSingleCameraFootage(cfg.source, clock, "the head camera");
+  const std::unique_ptr<runtime::FrameSource>& footage = opened.source;
+  const double t0 = opened.t0;
+  runtime::LiveFrameSource* const live = opened.live;
 
   // The world gives what the design fixes: the observer's camera (the rig's calibration or the
   // inline camera) and configuration, and the arm's kinematics. Nothing in it is rendered.

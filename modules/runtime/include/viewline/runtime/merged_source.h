@@ -26,6 +26,18 @@ namespace viewline::runtime {
 /// "images <pattern>", "video <path>", "v4l2 <device>" or "recording <folder>": a source named for messages.
 std::string describeSource(const SourceConfig& source);
 
+/// One camera's footage opened for a session (openSingleCameraFootage).
+struct SingleCameraFootage {
+  std::unique_ptr<FrameSource> source;  ///< the footage
+  core::Timestamp t0 = 0.0;             ///< s, the ready time of its first frame
+  LiveFrameSource* live = nullptr;      ///< `source` when it runs at its own pace (V4L2, pace: true), else null
+};
+
+/// Opens `config` (makeFrameSource with `clock`; null: the steady clock) as the footage of one
+/// camera. Throws core::InvalidInput starting "source: " when it cannot be opened, holds more than
+/// one camera (`role` names the one it should be, e.g. "the head camera") or holds no frame.
+SingleCameraFootage openSingleCameraFootage(const SourceConfig& config, WallClock* clock, const std::string& role);
+
 /// One camera of a merged source: its name in the rig, its footage and its calibrated image size.
 struct MergedCamera {
   std::string name;     ///< the rig's camera name (messages name it as cameras[name].source)
