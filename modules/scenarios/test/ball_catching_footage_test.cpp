@@ -25,9 +25,12 @@
 #include "viewline/runtime/stamps.h"
 #include "viewline/scenarios/ball_catching.h"
 #include "viewline/scenarios/ball_catching/recording.h"
+#include "scenario_test_util.h"
 
 namespace fs = std::filesystem;
 using namespace viewline;
+
+using viewline::scenarios::test::errorOf;
 
 namespace {
 
@@ -46,15 +49,6 @@ struct Footage {
   std::vector<std::size_t> frames;        // per camera: frames written
   std::vector<std::string> image_sets, video_sets;  // --set values naming the footage of each camera
 };
-
-std::string errorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const core::InvalidInput& e) {
-    return e.what();
-  }
-  return "";
-}
 
 void writeText(const fs::path& file, const std::string& text) {
   std::ofstream out(file);

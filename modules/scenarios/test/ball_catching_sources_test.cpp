@@ -13,9 +13,12 @@
 #include "viewline/io/config_edit.h"
 #include "viewline/scenarios/ball_catching.h"
 #include "viewline/scenarios/ball_catching/recording.h"
+#include "scenario_test_util.h"
 
 namespace fs = std::filesystem;
 using namespace viewline;
+
+using viewline::scenarios::test::errorOf;
 
 namespace {
 
@@ -30,16 +33,6 @@ fs::path tempDir(const std::string& name) {
   const fs::path dir = fs::path(testing::TempDir()) / (name + "_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   return dir;
-}
-
-template <class F>
-std::string errorOf(F&& f) {
-  try {
-    f();
-  } catch (const core::InvalidInput& e) {
-    return e.what();
-  }
-  return "";
 }
 
 }  // namespace

@@ -26,9 +26,12 @@
 #include "viewline/scenarios/dart/loop.h"
 #include "viewline/scenarios/dart/world.h"
 #include "viewline/sim/renderer.h"
+#include "scenario_test_util.h"
 
 namespace fs = std::filesystem;
 using namespace viewline;
+
+using viewline::scenarios::test::errorOf;
 
 namespace {
 
@@ -53,15 +56,6 @@ struct Footage {
   std::vector<std::string> image_sets, video_sets;
   bool video_lossless = true;  // FFV1 written (else motion JPEG)
 };
-
-std::string errorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const core::InvalidInput& e) {
-    return e.what();
-  }
-  return "";
-}
 
 void writeText(const fs::path& file, const std::string& text) {
   std::ofstream out(file);

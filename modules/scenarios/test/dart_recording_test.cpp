@@ -9,9 +9,12 @@
 
 #include "viewline/core/error.h"
 #include "viewline/scenarios/dart/loop.h"
+#include "scenario_test_util.h"
 
 namespace fs = std::filesystem;
 using namespace viewline;
+
+using viewline::scenarios::test::errorOf;
 
 namespace {
 
@@ -20,16 +23,6 @@ nlohmann::json withoutWallClock(nlohmann::json j) {
   j.erase("runtime_s");
   j["async"].erase("update_time_us");
   return j;
-}
-
-template <class F>
-std::string errorOf(F&& f) {
-  try {
-    f();
-  } catch (const core::InvalidInput& e) {
-    return e.what();
-  }
-  return "";
 }
 
 }  // namespace

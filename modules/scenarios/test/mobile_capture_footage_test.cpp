@@ -24,9 +24,12 @@
 #include "viewline/scenarios/mobile_capture.h"
 #include "viewline/scenarios/mobile_capture/footage.h"
 #include "viewline/scenarios/mobile_capture/world.h"
+#include "scenario_test_util.h"
 
 namespace fs = std::filesystem;
 using namespace viewline;
+
+using viewline::scenarios::test::errorOf;
 
 namespace {
 
@@ -47,15 +50,6 @@ struct Footage {
   std::vector<double> stamps;
   std::vector<Eigen::Vector2d> truth;  // the rendered object's centre at each frame's stamp, m
 };
-
-std::string errorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const core::InvalidInput& e) {
-    return e.what();
-  }
-  return "";
-}
 
 scenarios::MobileCaptureConfig configWith(const std::vector<std::string>& sets) {
   std::vector<std::string> all = kScene;

@@ -14,9 +14,12 @@
 #include "viewline/io/config_edit.h"
 #include "viewline/scenarios/mobile_capture.h"
 #include "viewline/scenarios/mobile_capture/footage.h"
+#include "scenario_test_util.h"
 
 namespace fs = std::filesystem;
 using namespace viewline;
+
+using viewline::scenarios::test::errorOf;
 
 namespace {
 
@@ -25,16 +28,6 @@ nlohmann::json withoutWallClock(const std::string& text) {
   nlohmann::json j = nlohmann::json::parse(text);
   j.erase("wall_time_s");
   return j;
-}
-
-template <class F>
-std::string errorOf(F&& f) {
-  try {
-    f();
-  } catch (const core::InvalidInput& e) {
-    return e.what();
-  }
-  return "";
 }
 
 // A short batch: a few simulated seconds per run, and the summary's filter test and sweep small.

@@ -23,9 +23,12 @@
 #include "viewline/core/frames.h"
 #include "viewline/io/config_edit.h"
 #include "viewline/scenarios/table_ball.h"
+#include "scenario_test_util.h"
 
 namespace fs = std::filesystem;
 using namespace viewline;
+
+using viewline::scenarios::test::errorOf;
 
 namespace {
 
@@ -46,15 +49,6 @@ struct Footage {
   std::size_t frames = 0;              // frames written (the lost ones are not in the footage)
   std::string images_set, video_set;   // --set values naming the footage
 };
-
-std::string errorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const core::InvalidInput& e) {
-    return e.what();
-  }
-  return "";
-}
 
 scenarios::TableBallConfig configWith(const std::vector<std::string>& sets) {
   std::vector<std::string> all = kSim;
