@@ -4,7 +4,12 @@
 #include <unistd.h>
 
 #include <filesystem>
+#include <fstream>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/videoio.hpp>
+#include <sstream>
 #include <string>
+#include <vector>
 
 #include "viewline/io/config_edit.h"
 #include "viewline/scenarios/pan_tilt/loop.h"
@@ -70,4 +75,52 @@ TEST(PanTiltSources, FootageWithoutTruthIsNotScored) {
   const nlohmann::json j = r.toJson(cfg);
   EXPECT_EQ(j["truth"], "not scored (the frame source has no truth)");
   EXPECT_TRUE(j["ours"]["rmse_measured_cm"]["x"].is_null());
+}
+
+// A recorded run's frames written as footage, an image sequence and an FFV1 (lossless) video with
+// one stamps file: the loop gives the same unscored result on both, frame for frame.
+TEST(PanTiltSources, FootageAsAVideoGivesWhatItsImagesGive) {
+  const fs::path dir = scratch("video");
+  scenarios::PanTiltRunIo record;
+  record.record_dir = (dir / "rec").string();
+  const auto live = scenarios::runPanTiltComparison(shortRun(), 7, record);
+  std::ifstream index(dir / "rec" / "predictive" / "recording.csv");
+  std::string line;
+  ASSERT_TRUE(std::getline(index, line)) << "recording.csv";  // ready_time,camera,sequence,capture_time,stamp,file
+  const fs::path mkv = dir / "footage.mkv";
+  std::ofstream stamps(dir / "stamps.csv");
+  cv::VideoWriter video;
+  std::size_t frames = 0;
+  while (std::getline(index, line)) {
+    std::vector<std::string> f;
+    std::stringstream row(line);
+    for (std::string cell; std::getline(row, cell, ',');) f.push_back(cell);
+    ASSERT_EQ(f.size(), 6u) << line;
+    const cv::Mat bgr = cv::imread((dir / "rec" / "predictive" / f[5]).string(), cv::IMREAD_COLOR);
+    ASSERT_FALSE(bgr.empty()) << f[5];
+    if (!video.isOpened())
+      video.open(mkv.string(), cv::CAP_FFMPEG, cv::VideoWriter::fourcc('F', 'F', 'V', '1'), 30.0, bgr.size(), true);
+    ASSERT_TRUE(video.isOpened()) << "OpenCV's FFmpeg back end cannot write FFV1";
+    video.write(bgr);
+    stamps << frames << ',' << f[4] << '\n';  // the recorded stamp, printed to the last bit
+    ++frames;
+  }
+  video.release();
+  stamps.close();
+  ASSERT_EQ(frames, live.ours.frames);
+  const std::string stamps_file = (dir / "stamps.csv").string();
+  const auto on_images = scenarios::runPanTiltComparison(
+      shortRun({"source.kind=images", "source.pattern=" + (dir / "rec" / "predictive" / "cam0" / "%06d.png").string(),
+                "source.stamps=" + stamps_file}),
+      7);
+  const auto on_video =
+      scenarios::runPanTiltComparison(shortRun({"source.kind=video", "source.path=" + mkv.string(), "source.stamps=" + stamps_file}), 7);
+  EXPECT_FALSE(on_video.ours.scored);
+  EXPECT_EQ(on_video.ours.frames, frames);
+  EXPECT_EQ(on_images.ours.frames, frames);
+  EXPECT_GT(on_images.ours.detections, 15u);
+  EXPECT_EQ(on_video.ours.detections, on_images.ours.detections);
+  EXPECT_EQ(on_video.ours.detections, live.ours.detections);
+  EXPECT_EQ(on_video.ours.filter_jumps, on_images.ours.filter_jumps);
+  fs::remove_all(dir);
 }
