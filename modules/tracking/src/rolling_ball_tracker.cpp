@@ -134,7 +134,7 @@ void RollingBallTracker::step(double t, const Eigen::Vector2d& a_xy, const std::
   missed_ = fused ? 0 : missed_ + 1;
   t_ = t;
   last_dt_ = dt;
-  predictions_ = model.predictPositions(x_, dt, a_xy);
+  predictions_ = model.predictPositions(x_, tr, 0);  // tr is transition(dt, a_xy)
 }
 
 Eigen::Index RollingBallTracker::stateDim() const { return config_.coloured_sigma > 0.0 ? 8 : 6; }

@@ -122,10 +122,15 @@ void RollingBallModel::predictClamped(StateEstimate& s, double dt, const Eigen::
 
 std::vector<Eigen::Vector2d> RollingBallModel::predictPositions(const Eigen::VectorXd& x0, double dt,
                                                                 const Eigen::Vector2d& a_xy, int steps) const {
+  return predictPositions(x0, transition(dt, a_xy), steps);
+}
+
+std::vector<Eigen::Vector2d> RollingBallModel::predictPositions(const Eigen::VectorXd& x0, const LinearTransition& tr,
+                                                                int steps) const {
   core::requireSize(x0, 6, 1, "RollingBallModel::predictPositions: state");
   core::requireFinite(x0, "RollingBallModel::predictPositions: state");
+  core::requireSize(tr.Phi, 6, 6, "RollingBallModel::predictPositions: Phi");
   const int n = steps < 1 ? prediction_steps : steps;
-  const LinearTransition tr = transition(dt, a_xy);
   const Eigen::VectorXd gu = tr.Gamma * tr.u;
   Eigen::VectorXd x = x0;
   std::vector<Eigen::Vector2d> out;

@@ -80,6 +80,9 @@ struct RollingBallModel {
   /// clamping at every step; N = `steps` (< 1 means prediction_steps).
   std::vector<Eigen::Vector2d> predictPositions(const Eigen::VectorXd& x, double dt, const Eigen::Vector2d& a_xy,
                                                 int steps = 0) const;
+  /// The same with the step's transition `tr` already at hand (transition(dt, a_xy)), so a filter
+  /// that has just predicted with it does not discretise the model again.
+  std::vector<Eigen::Vector2d> predictPositions(const Eigen::VectorXd& x, const LinearTransition& tr, int steps = 0) const;
   /// Stationary filter (DARE) for a fixed frame interval dt.
   StationaryFilter stationaryFilter(double dt) const;
   /// One stationary-gain step: x⁻ = Φ x + Γ u, x⁺ = x⁻ + Kf (y − C x⁻); returns x⁺ (clamped).
