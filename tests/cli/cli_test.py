@@ -158,6 +158,22 @@ def leftovers(out):
     return found
 
 
+def run_failing(cmd, expected, what):
+    """Runs cmd (no hang within TIMEOUT_S), prints it and its output, and fails unless it exited with
+    `expected` (not a signal). Returns the completed process for the case's own checks."""
+    try:
+        p = subprocess.run(cmd, capture_output=True, text=True, errors="replace", timeout=TIMEOUT_S)
+    except subprocess.TimeoutExpired:
+        fail(f"hang: no exit within {TIMEOUT_S} s: {' '.join(cmd)}")
+    print("$ " + " ".join(cmd))
+    print(f"exit {p.returncode}\n--- stderr\n{p.stderr[-3000:]}\n--- stdout\n{p.stdout[-1000:]}")
+    if p.returncode < 0:
+        fail(f"crash: killed by signal {-p.returncode}")
+    if p.returncode != expected:
+        fail(f"exit status {p.returncode}, expected {expected} ({what})")
+    return p
+
+
 def run_case(exe, cls, binary, work):
     spec = table()[exe]
     out = os.path.join(work, "out")
@@ -192,16 +208,7 @@ def run_case(exe, cls, binary, work):
     if exe == "load_rig" and cls == "unknown_flag":
         args = ["--no-such-flag", "calib/rigs/dart/rig.yaml"]
     cmd = [binary] + args
-    try:
-        p = subprocess.run(cmd, capture_output=True, text=True, errors="replace", timeout=TIMEOUT_S)
-    except subprocess.TimeoutExpired:
-        fail(f"hang: no exit within {TIMEOUT_S} s: {' '.join(cmd)}")
-    print("$ " + " ".join(cmd))
-    print(f"exit {p.returncode}\n--- stderr\n{p.stderr[-3000:]}\n--- stdout\n{p.stdout[-1000:]}")
-    if p.returncode < 0:
-        fail(f"crash: killed by signal {-p.returncode}")
-    if p.returncode != expected:
-        fail(f"exit status {p.returncode}, expected {expected} ({cls})")
+    p = run_failing(cmd, expected, cls)
     text = p.stderr + p.stdout
     if not any(n in text for n in named):
         fail(f"the message names none of {named}")
@@ -277,16 +284,7 @@ def run_record_case(app, cls, binary, work):
         folder = os.path.join(work, "no_such_recording")
         flag = ["--replay", folder]
     cmd = [binary, "--config", cfg, "--quiet", "--summary", summary] + short + flag
-    try:
-        p = subprocess.run(cmd, capture_output=True, text=True, errors="replace", timeout=TIMEOUT_S)
-    except subprocess.TimeoutExpired:
-        fail(f"hang: no exit within {TIMEOUT_S} s: {' '.join(cmd)}")
-    print("$ " + " ".join(cmd))
-    print(f"exit {p.returncode}\n--- stderr\n{p.stderr[-3000:]}\n--- stdout\n{p.stdout[-1000:]}")
-    if p.returncode < 0:
-        fail(f"crash: killed by signal {-p.returncode}")
-    if p.returncode != RECORD_CLASSES[cls]:
-        fail(f"exit status {p.returncode}, expected {RECORD_CLASSES[cls]} ({cls})")
+    p = run_failing(cmd, RECORD_CLASSES[cls], cls)
     if folder not in p.stderr:
         fail(f"the message does not name {folder}")
     if os.path.exists(summary):
@@ -311,16 +309,7 @@ def run_footage_case(app, cls, binary, work):
         named = os.path.join(work, "a%d_%d.png")
         source = "{kind: images, pattern: " + named + "}"
     cmd = [binary, "--config", cfg, "--quiet", "--summary", summary, "--set", "source=" + source]
-    try:
-        p = subprocess.run(cmd, capture_output=True, text=True, errors="replace", timeout=TIMEOUT_S)
-    except subprocess.TimeoutExpired:
-        fail(f"hang: no exit within {TIMEOUT_S} s: {' '.join(cmd)}")
-    print("$ " + " ".join(cmd))
-    print(f"exit {p.returncode}\n--- stderr\n{p.stderr[-3000:]}\n--- stdout\n{p.stdout[-1000:]}")
-    if p.returncode < 0:
-        fail(f"crash: killed by signal {-p.returncode}")
-    if p.returncode != FOOTAGE_CLASSES[cls]:
-        fail(f"exit status {p.returncode}, expected {FOOTAGE_CLASSES[cls]} ({cls})")
+    p = run_failing(cmd, FOOTAGE_CLASSES[cls], cls)
     if named not in p.stderr:
         fail(f"the message does not name {named}")
     if os.path.exists(summary):
