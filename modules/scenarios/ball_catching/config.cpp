@@ -305,6 +305,11 @@ BallCatchingConfig loadBallCatchingConfig(const io::ConfigNode& root) {
     c.rig = rig->folder;
   }
   for (const auto& n : root.childList("cameras")) c.cameras.push_back(readCamera(n, rig));
+  c.true_cameras = root.getOr<bool>("true_cameras", false);
+  if (c.true_cameras) {
+    if (!rig) root.fail("true_cameras", "a rig: (inline cameras are already the simulator's own)");
+    for (auto& k : c.cameras) k.calibrated_camera = k.true_camera;
+  }
   // Sensor noise of every camera at once (the noise table): < 0 keeps each camera's noise_sigma.
   const double noise = root.getOr<double>("noise_sigma_override", -1.0);
   if (noise >= 0.0)
@@ -331,6 +336,8 @@ BallCatchingConfig loadBallCatchingConfig(const io::ConfigNode& root) {
   c.tracker.model.gravity_w = sim::gravityWorld();
   if (root.has("planner")) readPlanner(root.child("planner"), c.planner);
   if (root.has("registration")) readRegistration(root.child("registration"), c.registration);
+  if (c.true_cameras && c.registration.enabled)
+    root.fail("true_cameras", "registration.enabled: false as well (the registration would move the true cameras)");
   if (root.has("flight_fit")) {
     const auto f = root.child("flight_fit");
     c.flight_fit.enabled = f.getOr<bool>("enabled", c.flight_fit.enabled);

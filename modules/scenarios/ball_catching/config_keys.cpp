@@ -34,6 +34,8 @@ io::ConfigReferenceSection ballCatchingConfigReference() {
       {"camera_count", "", "use the first N cameras (0: all)"},
       {"rate_override_hz", "Hz", "> 0: every camera at this rate during the throws (0: each camera's rate_hz)"},
       {"rig", "", "calibrated rig folder (truth renders, calibration estimates); absent: inline camera geometry"},
+      {"true_cameras", "", "diagnosis: the estimators use the rig's true cameras instead of its calibration (the "
+                           "detector's own error; with registration.enabled: false)", "false"},
       {"cameras", "", "the cameras, by name (with rig: cameras of the rig)"},
       {"cameras[].name", "", "camera name (with rig: a camera of the rig)"},
       {"cameras[].width", "px", "image width (inline camera, no rig)"},

@@ -106,3 +106,24 @@ TEST(BallCatchingSources, FootageAtTheTopLevelIsRefusedAndPointsToTheCameras) {
   EXPECT_NE(e.find("source.kind video is not supported by ball_catching at the top level"), std::string::npos) << e;
   EXPECT_NE(e.find("cameras: [{name: right, source: {kind: video"), std::string::npos) << e;  // where footage goes
 }
+
+// The diagnosis switch: the estimators take the rig's true cameras, and only without the
+// registration (which would move them).
+TEST(BallCatchingConfig, TrueCamerasGiveTheEstimatorsTheRenderersCamerasAndRefuseTheRegistration) {
+  const auto shipped = scenarios::loadBallCatchingConfig(io::loadConfigWithValues("config/ball_catching.yaml", {}));
+  ASSERT_FALSE(shipped.true_cameras);
+  // Calibrated: the estimator's pose differs from the renderer's (a calibration is never exact).
+  EXPECT_GT((shipped.cameras[0].estimatorCamera().c_M_w.translation() -
+             shipped.cameras[0].renderCamera().c_M_w.translation()).norm(), 1e-6);
+
+  const auto truth = scenarios::loadBallCatchingConfig(
+      io::loadConfigWithValues("config/ball_catching.yaml", {"true_cameras=true", "registration.enabled=false"}));
+  for (const auto& k : truth.cameras) {
+    EXPECT_TRUE(k.estimatorCamera().c_M_w.matrix() == k.renderCamera().c_M_w.matrix()) << k.name;
+    EXPECT_EQ(k.estimatorCamera().intrinsics.get_px(), k.renderCamera().intrinsics.get_px()) << k.name;
+  }
+  const std::string e = errorOf([] {
+    scenarios::loadBallCatchingConfig(io::loadConfigWithValues("config/ball_catching.yaml", {"true_cameras=true"}));
+  });
+  EXPECT_NE(e.find("registration.enabled: false as well"), std::string::npos) << e;
+}

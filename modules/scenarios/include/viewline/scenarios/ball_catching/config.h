@@ -111,6 +111,9 @@ struct BallCatchingConfig {
   std::string rig;                   ///< rig folder as resolved ("" : inline cameras)
   std::vector<CatchCameraConfig> cameras;  ///< every configured camera (registration uses all)
   std::size_t camera_count = 0;      ///< use the first N cameras (0: all)
+  /// Diagnosis: the estimators use the rig's true cameras (what the simulator renders with)
+  /// instead of its calibration, so the detection error is the detector's own (needs a rig).
+  bool true_cameras = false;
   double rate_override_hz = 0.0;     ///< > 0: every camera at this rate (throws; registration keeps rate_hz)
   ThrowDistribution throws;          ///< where, how fast and what is thrown
   Eigen::Vector3d ball_albedo_bgr = Eigen::Vector3d(0.08, 0.45, 0.95);  ///< orange (dart: flight colour)
