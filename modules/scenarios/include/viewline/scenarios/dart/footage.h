@@ -30,8 +30,9 @@
 // update and the board-hit prediction; wall and thread CPU, runtime::ProcessingTimer) against one
 // frame period of the fastest camera (cameras[].rate_hz): the summary's `live` object and lines,
 // as ball catching's footage session gives them (runtime::LiveReport). Each camera's PacedSource
-// sets its wall-clock origin at its own first grab, so the cameras' pacing can be offset by up to
-// one frame; the stamps the tracker sees are the footage's own.
+// sets its wall-clock origin at its own first grab, so the frames of a camera whose first stamp
+// is later (alternating cameras: the second, 10 ms) arrive that much earlier, relative to the
+// other camera's, than their stamps say; the stamps the tracker sees are the footage's own.
 //
 // Faults: the `faults:` list (runtime/faults.h, windows on the footage's stamps) is injected into
 // the footage and the detector as in ball catching's footage session, and the same defences run
