@@ -347,11 +347,41 @@ nlohmann::json crossingJson(const std::optional<planning::Crossing>& c) {
 
 }  // namespace
 
-nlohmann::json footageSummaryJson(const CatchFootageSummary& s, const BallCatchingConfig& cfg) {
+std::string footageSessionText(const FootageSessionCounts& n, const std::vector<FootageCamera>& cameras) {
+  std::string out;
+  char line[512];
+  std::snprintf(line, sizeof line, "%s on footage: one session, stamps %.3f to %.3f s, %llu frames, %llu detections\n",
+                n.scenario.c_str(), n.t_first, n.t_last, static_cast<unsigned long long>(n.frames),
+                static_cast<unsigned long long>(n.detections));
+  out += line;
+  for (const auto& c : cameras) {
+    std::snprintf(line, sizeof line, "  camera %-8s %s: %llu frames, %llu lost, %llu detections\n", c.name.c_str(),
+                  c.source.c_str(), static_cast<unsigned long long>(c.frames), static_cast<unsigned long long>(c.lost),
+                  static_cast<unsigned long long>(c.detections));
+    out += line;
+  }
+  std::snprintf(line, sizeof line, "  tracker: %d tracks started, %llu images fused, %llu gated, %llu refused\n",
+                n.tracks_started, static_cast<unsigned long long>(n.fused), static_cast<unsigned long long>(n.gated),
+                static_cast<unsigned long long>(n.refused));
+  out += line;
+  return out;
+}
+
+nlohmann::json footageCamerasJson(const std::vector<FootageCamera>& cameras) {
   nlohmann::json cams = nlohmann::json::array();
-  for (const auto& c : s.cameras)
+  for (const auto& c : cameras)
     cams.push_back({{"name", c.name}, {"source", c.source}, {"frames", c.frames}, {"lost", c.lost},
                     {"detections", c.detections}});
+  return cams;
+}
+
+std::string footageLiveText(const std::optional<runtime::LiveReport>& live) {
+  if (!live) return {};
+  return "  " + runtime::summaryLine(*live) + "\n  " + runtime::processingLine(*live) + "\n";
+}
+
+nlohmann::json footageSummaryJson(const CatchFootageSummary& s, const BallCatchingConfig& cfg) {
+  const nlohmann::json cams = footageCamerasJson(s.cameras);
   nlohmann::json tracks = nlohmann::json::array();
   for (const auto& t : s.tracks) {
     nlohmann::json j = {{"track", t.track},
@@ -401,22 +431,10 @@ nlohmann::json footageSummaryJson(const CatchFootageSummary& s, const BallCatchi
 }
 
 std::string footageSummaryText(const CatchFootageSummary& s, const BallCatchingConfig& cfg) {
-  std::string out;
+  std::string out = footageSessionText(
+      {cfg.name, s.t_first, s.t_last, s.frames, s.detections, s.fused, s.gated, s.refused, s.tracks_started},
+      s.cameras);
   char line[512];
-  std::snprintf(line, sizeof line, "%s on footage: one session, stamps %.3f to %.3f s, %llu frames, %llu detections\n",
-                cfg.name.c_str(), s.t_first, s.t_last, static_cast<unsigned long long>(s.frames),
-                static_cast<unsigned long long>(s.detections));
-  out += line;
-  for (const auto& c : s.cameras) {
-    std::snprintf(line, sizeof line, "  camera %-8s %s: %llu frames, %llu lost, %llu detections\n", c.name.c_str(),
-                  c.source.c_str(), static_cast<unsigned long long>(c.frames), static_cast<unsigned long long>(c.lost),
-                  static_cast<unsigned long long>(c.detections));
-    out += line;
-  }
-  std::snprintf(line, sizeof line, "  tracker: %d tracks started, %llu images fused, %llu gated, %llu refused\n",
-                s.tracks_started, static_cast<unsigned long long>(s.fused), static_cast<unsigned long long>(s.gated),
-                static_cast<unsigned long long>(s.refused));
-  out += line;
   for (const auto& t : s.tracks) {
     if (t.target) {
       std::snprintf(line, sizeof line,
@@ -443,10 +461,7 @@ std::string footageSummaryText(const CatchFootageSummary& s, const BallCatchingC
   out += line;
   out += "  catch rate: not scored: no truth (footage has no flight to score the catch against)\n";
   out += "  registration: off on footage (the rig's calibration is used as registered)\n";
-  if (s.live) {
-    out += "  " + runtime::summaryLine(*s.live) + "\n";
-    out += "  " + runtime::processingLine(*s.live) + "\n";
-  }
+  out += footageLiveText(s.live);
   return out;
 }
 

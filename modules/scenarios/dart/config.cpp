@@ -58,6 +58,9 @@ void DartScenarioConfig::validate() const {
                                  "footage's clock)");
     if (!source.simulated())
       throw core::InvalidInput("dart scenario: source: kind recording and cameras[].source footage are exclusive");
+  } else if (!faults.faults.empty()) {
+    throw core::InvalidInput("dart scenario: faults: injected on footage only (cameras[].source); the experiments' "
+                             "generated detections have no frames to fault");
   }
   detector.validate();
   if (!(detector_sigma_px >= 0.0 && std::isfinite(detector_sigma_px)))
@@ -198,6 +201,7 @@ void readExperiments(const io::ConfigNode& e, DartScenarioConfig& cfg) {
 
 DartScenarioConfig dartScenarioFromNode(const io::ConfigNode& root) {
   DartScenarioConfig cfg = defaultDartScenario();
+  cfg.faults = runtime::readFaultPlanConfig(root);  // first: the config reference's probe reaches it
   cfg.source = runtime::readSourceConfig(root);
   // The experiments consume detections, not images: a recording of them (dart/recording.h) can
   // replace the generator, footage cannot.

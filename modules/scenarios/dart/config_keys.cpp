@@ -2,6 +2,7 @@
 // docs/config_reference.md is generated from this table and the recorded reads; the unit test
 // ScenarioConfigKeys fails when a key is read without an entry here or an entry is never read.
 #include "viewline/scenarios/config_keys.h"
+#include "viewline/runtime/faults.h"
 #include "viewline/scenarios/dart/config.h"
 
 namespace viewline::scenarios {
@@ -16,7 +17,7 @@ io::ConfigReferenceSection dartConfigReference() {
       "single-camera start. Every key is optional (defaults: `scenarios::defaultDartScenario()`).";
   s.shipped = {"dart_tracking.yaml"};
   // The detector block of footage (not in the shipped file, which runs the experiments).
-  s.probes = {"source: {kind: recording, path: rec}\n",
+  s.probes = {"source: {kind: recording, path: rec}\n", runtime::faultConfigProbe(),
               "detector: {hsv: [35, 85, 80, 255, 30, 255], min_area_px: 6, noise_area_px: 2, min_roundness: 0.45,\n"
               "           roi_half_size_px: 48, open_kernel_px: 3, close_kernel_px: 3, sigma_px_floor: 0.3, sigma_px: 0}\n"};
   // A camera's footage: one probe per kind (a recording is refused per camera, so not probed).
@@ -97,6 +98,13 @@ io::ConfigReferenceSection dartConfigReference() {
       {"experiments.settled_index", "", "RMSE and PCRLB pooled over measurements with this index and later"},
       {"experiments.confidence", "", "confidence of the consistency intervals, in (0, 1)"},
   };
+  // Injected faults, on footage only (dart/footage.h).
+  for (io::ConfigKeyDoc d : runtime::faultConfigKeys()) {
+    if (d.key == "faults")
+      d.meaning = "injected camera and detector faults on footage (absent: none; refused on generated detections; "
+                  "the robot kinds have no robot to hit); runtime/faults.h";
+    s.keys.push_back(std::move(d));
+  }
   // Footage per camera (dart/footage.h): the runtime's `source:` keys under each camera.
   for (io::ConfigKeyDoc d : runtime::sourceConfigKeys()) {
     if (d.key == "source") {

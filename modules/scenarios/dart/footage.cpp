@@ -6,8 +6,10 @@
 #include <cstdio>
 
 #include "viewline/core/error.h"
+#include "viewline/core/random.h"
 #include "viewline/runtime/faults.h"
 #include "viewline/runtime/merged_source.h"
+#include "viewline/runtime/stale_frames.h"
 #include "viewline/scenarios/dart/loop.h"
 #include "viewline/scenarios/dart/world.h"
 #include "viewline/tracking/tracker.h"
@@ -28,9 +30,9 @@ namespace {
 class DartFootageSession {
 public:
   DartFootageSession(const DartScenarioConfig& cfg, std::vector<core::Camera> cams, DartFootageSummary& sum,
-                     runtime::TelemetrySink* tel)
+                     runtime::TelemetrySink* tel, runtime::FaultPlan& faults)
       : cfg_(cfg), cams_(std::move(cams)), tracker_(cams_, cfg.trackerConfig()), sum_(sum), tel_(tel),
-        plane_(dartBoardPlane(cfg)) {
+        faults_(faults), plane_(dartBoardPlane(cfg)) {
     for (const core::Camera& c : cams_) detectors_.emplace_back(cfg.detector, c);
     // The board hit is predicted with the tracker's own model: ballistic, its gravity and
     // process noise (no drag: the tracker has none).
@@ -48,15 +50,25 @@ public:
       const double tp = std::max(f.stamp, tracker_.state().t());
       if (auto uv = cams_[ci].project(tracker_.predictAt(tp).x().head<3>())) predicted = *uv;
     }
-    std::optional<vision::BallMeasurement> det;
-    if (auto r = detectors_[ci].detect(f.image, f.stamp, predicted); r.ok()) det = r.value();
-    if (!det || !runtime::usablePixel(det->pixel, f.image.cols, f.image.rows)) return;
+    // The detector behind the fault plan's injection point and the loops' defences (as ball
+    // catching's detectCatchBall): an exception is counted (detector_errors), not thrown; the
+    // detect_* faults act on the centre; a non-finite or outside centre is counted and dropped.
+    const auto r = runtime::guardedDetect(faults_, ci, f.stamp, [&] {
+      return detectors_[ci].detect(f.image, f.stamp, predicted);
+    });
+    if (!r || !r->ok()) return;
+    vision::BallMeasurement det = r->value();
+    det.pixel = faults_.detected(ci, f.stamp, det.pixel, f.image.cols, f.image.rows);
+    if (!runtime::usablePixel(det.pixel, f.image.cols, f.image.rows)) {
+      faults_.note("detections_rejected");
+      return;
+    }
     ++sum_.detections;
     ++sum_.cameras[ci].detections;
     // The std told to the tracker: as measured (detector.sigma_px), else the blob's own, floored.
     const double sigma = cfg_.detector_sigma_px > 0.0
                              ? cfg_.detector_sigma_px
-                             : std::max(cfg_.detector_sigma_px_floor, std::sqrt(0.5 * det->pixel_covariance.trace()));
+                             : std::max(cfg_.detector_sigma_px_floor, std::sqrt(0.5 * det.pixel_covariance.trace()));
     // A pause longer than a track can coast (or than the tracker accepts as a step forward) ends
     // the dart: the tracker starts afresh, as for a new throw (its buffer and counters too, which
     // would refuse a stamp that far ahead).
@@ -66,9 +78,10 @@ public:
     }
     submitted_ = true;
     last_submit_ = std::max(last_submit_, f.stamp);
-    const tracking::ImageMeasurement m{next_id_++, ci, f.stamp, det->pixel, sigma};
+    const tracking::ImageMeasurement m{next_id_++, ci, f.stamp, det.pixel, sigma};
     if (tel_) tel_->measurement({"camera" + std::to_string(ci), m.t, m.id, m.uv, Eigen::VectorXd::Constant(2, sigma)});
-    if (tracker_.submit(m) != tracking::Refusal::None) {
+    if (const tracking::Refusal refusal = tracker_.submit(m); refusal != tracking::Refusal::None) {
+      faults_.note(std::string("tracker_refused_") + tracking::toString(refusal));
       ++sum_.refused;
       return;
     }
@@ -120,6 +133,7 @@ private:
   std::vector<vision::BallDetector> detectors_;
   DartFootageSummary& sum_;
   runtime::TelemetrySink* tel_;
+  runtime::FaultPlan& faults_;
   planning::CrossingPlane plane_;
   planning::CrossingModel model_;
   std::uint64_t next_id_ = 1;
@@ -131,23 +145,50 @@ private:
 
 }  // namespace
 
-DartFootageSummary runDartFootage(const DartScenarioConfig& cfg, runtime::TelemetrySink* telemetry) {
+DartFootageSummary runDartFootage(const DartScenarioConfig& cfg, runtime::TelemetrySink* telemetry,
+                                  runtime::WallClock* clock, std::uint64_t seed) {
   cfg.validate();
   if (!cfg.onFootage()) throw core::InvalidInput("cameras[].source: no camera has footage (sim: runDartExperiments)");
   const auto wall0 = std::chrono::steady_clock::now();
   DartFootageSummary sum;
+  sum.seed = seed;
   std::vector<runtime::MergedCamera> footage;
   for (const DartCameraConfig& c : cfg.cameras) footage.push_back({c.name, c.source, c.width, c.height});
-  runtime::MergedFrameSource source(footage);
+  runtime::MergedFrameSource source(footage, clock);
   for (std::size_t i = 0; i < source.cameraCount(); ++i) sum.cameras.push_back({cfg.cameras[i].name, source.sourceName(i), 0, 0, 0});
   const std::optional<double> first = source.nextReadyTime();
   if (!first) throw core::InvalidInput("cameras[].source: the footage holds no frame");
   sum.t_first = *first;
   sum.t_last = *first;
-  DartFootageSession session(cfg, makeDartCameras(cfg), sum, telemetry);
-  while (const std::optional<double> t = source.nextReadyTime()) {
+
+  // Live: each frame timed from its grab to the end of its processing, against one frame period
+  // of the fastest camera (as ball catching's footage session).
+  std::optional<runtime::ProcessingTimer> timer;
+  double rate = 0.0;
+  for (const DartCameraConfig& c : cfg.cameras) rate = std::max(rate, c.rate_hz);
+  char origin[96];
+  std::snprintf(origin, sizeof origin, "one frame period at %.4g fps (the fastest camera's rate_hz)", rate);
+  if (source.live()) timer.emplace(1.0 / rate, clock);
+
+  runtime::FaultPlan faults(cfg.faults, core::deriveSeed(seed, 0xFA));
+  runtime::FrameSource& frames = faults.wrap(source);
+  runtime::StaleFrameFilter stale;
+  DartFootageSession session(cfg, makeDartCameras(cfg), sum, telemetry, faults);
+  std::uint64_t frame_count = 0;
+  while (const std::optional<double> t = frames.nextReadyTime()) {
     sum.t_last = std::max(sum.t_last, *t);
-    if (const std::optional<runtime::Frame> f = source.grab()) session.frame(*f);
+    const std::optional<runtime::Frame> f = frames.grab();
+    if (!f) continue;  // lost (counted by the source)
+    const std::uint64_t id = ++frame_count;
+    if (timer) timer->resume(id);
+    if (faults.missesDeadline(*f)) {
+      faults.note("frames_late_dropped");
+    } else if (stale.repeats(*f)) {  // a frozen camera's old image with a new stamp (stale_frames.h)
+      faults.note("frames_frozen_dropped");
+    } else {
+      session.frame(*f);
+    }
+    if (timer) timer->finish(id);
   }
   session.finish();
   for (std::size_t i = 0; i < source.cameraCount(); ++i) {
@@ -155,6 +196,10 @@ DartFootageSummary runDartFootage(const DartScenarioConfig& cfg, runtime::Teleme
     sum.cameras[i].lost = source.lost(i);
     sum.frames += source.frames(i);
   }
+  if (timer) sum.live = runtime::liveReport(source, *timer, origin);
+  // Reported when anything was counted: injected faults, or the defences' own catches (a
+  // detector's exception, a screened pixel, a refused image) on clean footage too.
+  sum.faults = faults.report();
   if (telemetry) telemetry->flush();
   sum.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   return sum;
@@ -167,10 +212,6 @@ nlohmann::json vec3(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
 }  // namespace
 
 nlohmann::json dartFootageSummaryJson(const DartFootageSummary& s, const DartScenarioConfig& cfg) {
-  nlohmann::json cams = nlohmann::json::array();
-  for (const auto& c : s.cameras)
-    cams.push_back({{"name", c.name}, {"source", c.source}, {"frames", c.frames}, {"lost", c.lost},
-                    {"detections", c.detections}});
   nlohmann::json tracks = nlohmann::json::array();
   for (const auto& t : s.tracks) {
     nlohmann::json hit = nullptr;
@@ -182,44 +223,35 @@ nlohmann::json dartFootageSummaryJson(const DartFootageSummary& s, const DartSce
     tracks.push_back({{"track", t.track}, {"t_first_s", t.t_first}, {"t_last_s", t.t_last}, {"fused", t.fused},
                       {"board_hit", hit}});
   }
-  return {{"scenario", "dart_tracking"},
-          {"mode", "footage"},
-          {"cameras", cams},
-          {"footage_s", {{"first_stamp", s.t_first}, {"last_stamp", s.t_last}}},
-          {"frames", s.frames},
-          {"detections", s.detections},
-          {"fused", s.fused},
-          {"gated", s.gated},
-          {"refused", s.refused},
-          {"tracks_started", s.tracks_started},
-          {"tracks", tracks},
-          {"board_plane_x_m", cfg.board_center.x()},
-          {"nis_mean", s.nis_samples > 0 ? nlohmann::json(s.nis_mean) : nlohmann::json(nullptr)},
-          {"nis_samples", s.nis_samples},
-          {"rmse_position", nullptr},
-          {"experiments", nullptr},
-          {"truth", "not scored (the frame source has no truth)"},
-          {"wall_time_s", s.wall_s}};
+  nlohmann::json j = {{"scenario", "dart_tracking"},
+                      {"mode", "footage"},
+                      {"seed", s.seed},
+                      {"cameras", footageCamerasJson(s.cameras)},
+                      {"footage_s", {{"first_stamp", s.t_first}, {"last_stamp", s.t_last}}},
+                      {"frames", s.frames},
+                      {"detections", s.detections},
+                      {"fused", s.fused},
+                      {"gated", s.gated},
+                      {"refused", s.refused},
+                      {"tracks_started", s.tracks_started},
+                      {"tracks", tracks},
+                      {"board_plane_x_m", cfg.board_center.x()},
+                      {"nis_mean", s.nis_samples > 0 ? nlohmann::json(s.nis_mean) : nlohmann::json(nullptr)},
+                      {"nis_samples", s.nis_samples},
+                      {"rmse_position", nullptr},
+                      {"experiments", nullptr},
+                      {"truth", "not scored (the frame source has no truth)"},
+                      {"wall_time_s", s.wall_s}};
+  if (s.live) j["live"] = runtime::toJson(*s.live);
+  if (!s.faults.empty()) j["faults"] = runtime::toJson(s.faults);
+  return j;
 }
 
 std::string dartFootageSummaryText(const DartFootageSummary& s, const DartScenarioConfig& cfg) {
-  std::string out;
+  std::string out = footageSessionText(
+      {"dart_tracking", s.t_first, s.t_last, s.frames, s.detections, s.fused, s.gated, s.refused, s.tracks_started},
+      s.cameras);
   char line[512];
-  std::snprintf(line, sizeof line,
-                "dart_tracking on footage: one session, stamps %.3f to %.3f s, %llu frames, %llu detections\n",
-                s.t_first, s.t_last, static_cast<unsigned long long>(s.frames),
-                static_cast<unsigned long long>(s.detections));
-  out += line;
-  for (const auto& c : s.cameras) {
-    std::snprintf(line, sizeof line, "  camera %-8s %s: %llu frames, %llu lost, %llu detections\n", c.name.c_str(),
-                  c.source.c_str(), static_cast<unsigned long long>(c.frames), static_cast<unsigned long long>(c.lost),
-                  static_cast<unsigned long long>(c.detections));
-    out += line;
-  }
-  std::snprintf(line, sizeof line, "  tracker: %d tracks started, %llu images fused, %llu gated, %llu refused\n",
-                s.tracks_started, static_cast<unsigned long long>(s.fused), static_cast<unsigned long long>(s.gated),
-                static_cast<unsigned long long>(s.refused));
-  out += line;
   for (const auto& t : s.tracks) {
     std::snprintf(line, sizeof line, "  track %d (%.3f-%.3f s, %d fused): ", t.track, t.t_first, t.t_last, t.fused);
     out += line;
@@ -238,6 +270,8 @@ std::string dartFootageSummaryText(const DartFootageSummary& s, const DartScenar
     out += line;
   }
   out += "  RMSE, NEES and the experiments A-E: not scored: no truth (footage has no true flight)\n";
+  out += footageLiveText(s.live);
+  if (!s.faults.empty()) out += "  " + runtime::summaryLine(s.faults) + "\n";
   return out;
 }
 

@@ -15,6 +15,7 @@
 #include "viewline/runtime/scheduler.h"
 #include "viewline/runtime/source_config.h"
 #include "viewline/runtime/stale_frames.h"
+#include "viewline/scenarios/mobile_capture/chase.h"
 #include "viewline/scenarios/mobile_capture/world.h"
 #include "viewline/tracking/unicycle_tracker.h"
 #include "viewline/vision/ball_detector.h"
@@ -64,23 +65,16 @@ MobileFootageSummary runMobileCaptureFootage(const MobileCaptureConfig& cfg, std
   sum.head = robot.q;
   core::Camera camera = estimatorCamera(cfg);
   camera.c_M_w = estimatorCamera_c_M_w(cfg, trueCamera_c_M_w(robot.head, robot.q, pose.x, pose.y, pose.theta));
-  const double plane_z = 0.5 * cfg.object_height;
 
   runtime::FaultPlan faults(cfg.faults, core::deriveSeed(seed, 0xFA));
   runtime::FrameSource& frames = faults.wrap(*source);
-  vision::BallDetector detector(cfg.detector);
-  tracking::UnicycleTracker track(cfg.filter);
-  const control::SearchPattern search(cfg.search);
-  const control::GoToPointParams go = cfg.goParams();
+  // The simulated loop's perception and commands (chase.h), on the held robot.
+  ChaseController chase(cfg);
+  const tracking::UnicycleTracker& track = chase.track();
   // Live: each frame timed from its grab to its capture plan, against one vision period.
   std::optional<runtime::ProcessingTimer> timer;
   if (live) timer.emplace(cfg.vision_period, clock);
 
-  planning::CapturePlan plan;
-  std::vector<Vector2d> prediction;  // the track's path over the planner's horizon (predictPath)
-  double last_seen = -1.0, sweep_start = -1.0, centre_bearing = 0.0;
-  bool have_bearing = false;
-  control::SearchMode mode = control::SearchMode::Sweeping;
   double last_stamp = -std::numeric_limits<double>::infinity();
   runtime::StaleFrameFilter stale;
   const unsigned width = camera.width, height = camera.height;
@@ -90,40 +84,24 @@ MobileFootageSummary runMobileCaptureFootage(const MobileCaptureConfig& cfg, std
     MobileFootageSample row;
     row.t = t;
     row.sequence = frame.sequence;
-    std::optional<Vector2d> predicted_px;
-    if (track.valid()) {
-      const Vector2d p = track.positionAt(t);
-      predicted_px = camera.project(Vector3d(p.x(), p.y(), plane_z));
+    const ChaseObservation o = chase.frame(faults, frame, camera, pose);
+    if (o.floor) {
+      row.detected = true;
+      row.measured = o.floor->z;
+      ++sum.detections;
+      row.fused = o.update->fused;
     }
-    const std::optional<Vector2d> det_px = detectScreened(detector, faults, frame, t, predicted_px);
-    if (det_px) {
-      // The floor point and its white noise through the ground-projection Jacobian, as in the
-      // simulated loop (loop.cpp): the bias stays out of R.
-      if (const auto fm = floorMeasurement(cfg, camera, *det_px, plane_z)) {
-        row.detected = true;
-        row.measured = fm->z;
-        ++sum.detections;
-        last_seen = t;
-        const Eigen::Matrix2d R = cfg.pixel_sigma * cfg.pixel_sigma * fm->unit_pixel_cov;
-        row.fused = track.update(t, fm->z, R).fused;
-      }
-    }
-    track.predictTo(t);
     if (track.valid()) {
       const Eigen::VectorXd& x = track.state().x();
+      const planning::CapturePlan& plan = chase.plan();
       row.track_valid = true;
       row.position = track.positionAt(t);
       row.heading = x[2];
       row.speed = x[3];
       row.turn_rate = x[4];
-      prediction = predictPath(track, cfg);
-      plan = planning::planCapture(prediction, {{pose.x, pose.y}, pose.theta}, cfg.plannerParams());
       row.reachable = plan.reachable;
       row.intercept = plan.point;
       row.intercept_time = t + plan.time;
-      const Vector2d rel = toRobot(pose, x.head<2>());
-      centre_bearing = std::atan2(rel.y(), rel.x());
-      have_bearing = true;
     }
     sum.samples.push_back(row);
     if (hooks && hooks->on_frame) {
@@ -131,7 +109,7 @@ MobileFootageSummary runMobileCaptureFootage(const MobileCaptureConfig& cfg, std
       f.t = t;
       f.image = &frame.image;
       f.detected = row.detected;
-      if (det_px) f.pixel = *det_px;
+      if (o.pixel) f.pixel = *o.pixel;
       f.robot = pose;
       f.joints = robot.q;
       // No truth on footage: the view centres on (and marks) the tracked position instead.
@@ -139,29 +117,19 @@ MobileFootageSummary runMobileCaptureFootage(const MobileCaptureConfig& cfg, std
       f.fused = row.fused;
       f.estimate_valid = track.valid();
       if (track.valid()) f.estimate = track.state().x();
-      f.prediction = prediction;
-      f.plan = plan;
-      f.mode = mode;
+      f.prediction = chase.prediction();
+      f.plan = chase.plan();
+      f.mode = chase.mode();
       hooks->on_frame(f);
     }
   };
 
   // Control period: the laws' commands from the held pose, checked and counted, never executed.
   auto tick = [&](double t) {
-    const control::SearchMode new_mode = track.valid() ? search.mode(t, last_seen) : control::SearchMode::Sweeping;
-    if (new_mode == control::SearchMode::Sweeping && mode != control::SearchMode::Sweeping) sweep_start = t;
-    if (sweep_start < 0.0) sweep_start = t;
-    mode = new_mode;
-    control::BaseCommand cmd;
-    robots::PanTiltJoints head_target = robot.q;
-    if (mode != control::SearchMode::Sweeping) {
-      cmd = control::goToPoint(pose, plan.point, go);
-      const Vector2d p = track.positionAt(t + cfg.controlPeriod());
-      head_target = control::headSetPoint(robot.head, pose, Vector3d(p.x(), p.y(), plane_z));
-    } else {
-      head_target = search.sweep(robot.head, t, sweep_start, have_bearing ? centre_bearing : 0.0);
-      cmd = search.baseWhileSearching(centre_bearing, have_bearing);
-    }
+    // The held robot does not turn: the search bearing stays where the last estimate put it.
+    const ChaseCommand c = chase.command(t, pose, robot.head, robot.q, 0.0);
+    const control::BaseCommand& cmd = c.base;
+    const robots::PanTiltJoints& head_target = c.head;
     ++sum.base_commands;
     ++sum.head_commands;
     sum.max_speed = std::max(sum.max_speed, std::abs(cmd.v));

@@ -9,6 +9,7 @@
 #include "viewline/core/interrupt.h"
 #include "viewline/runtime/stale_frames.h"
 #include "viewline/robots/mobile_ground_localization.h"
+#include "viewline/scenarios/mobile_capture/chase.h"
 #include "viewline/scenarios/mobile_capture/recording.h"
 #include "viewline/scenarios/mobile_capture/robot_link.h"
 #include "viewline/scenarios/mobile_capture/world.h"
@@ -123,23 +124,18 @@ MobileCaptureRun runMobileCapture(const MobileCaptureConfig& cfg, std::uint64_t 
   runtime::FaultPlan faults(cfg.faults, core::deriveSeed(seed, 0xFA));
   runtime::FrameSource& frames = faults.wrap(source);
   RobotLink link(robot, faults);  // commands through the robot faults (robot_link.h)
-  vision::BallDetector detector(cfg.detector);
+  // The chase's perception and commands, shared with the footage session (chase.h).
+  ChaseController chase(cfg);
+  const tracking::UnicycleTracker& track = chase.track();
   core::Camera camera = estimatorCamera(cfg);  // detection ROI, ground localisation
   const robots::AnglePerPixel printed{cfg.hfov, cfg.vfov, robots::AngleRange::PrintedSlant};
   const robots::AnglePerPixel horizontal{cfg.hfov, cfg.vfov, robots::AngleRange::Horizontal};
-  const double plane_z = 0.5 * cfg.object_height;
-  tracking::UnicycleTracker track(cfg.filter);
-  const control::SearchPattern search(cfg.search);
+  const double plane_z = chase.planeZ();
   runtime::TelemetrySink* sink = hooks ? hooks->telemetry : nullptr;
 
   Eigen::Matrix2d bias_cov = Eigen::Matrix2d::Zero();  // m², B of the last detection (floorMeasurement)
   double track_since = -1.0, next_nees = -1.0;  // s: start of the live track; time of the next NEES sample
-  double last_seen = -1.0, first_seen = -1.0, sweep_start = -1.0, last_grasp = -1e9;
-  double centre_bearing = 0.0;  // robot frame, for the search
-  bool have_bearing = false;
-  planning::CapturePlan plan;
-  std::vector<Vector2d> prediction;
-  control::SearchMode mode = control::SearchMode::Sweeping;
+  double first_seen = -1.0, last_grasp = -1e9;
 
   const TickClock clock = TickClock::of(cfg);
   runtime::Scheduler sched;
@@ -171,45 +167,34 @@ MobileCaptureRun runMobileCapture(const MobileCaptureConfig& cfg, std::uint64_t 
     const robots::BasePose pose = robot.base.pose();
     // The estimators' camera from odometry and the joint encoders at the frame's time.
     camera.c_M_w = estimatorCamera_c_M_w(cfg, trueCamera_c_M_w(robot.head, robot.q, pose.x, pose.y, pose.theta));
-    std::optional<Vector2d> predicted_px;
-    if (track.valid()) {
-      const Vector2d p = track.positionAt(t);
-      predicted_px = camera.project(Vector3d(p.x(), p.y(), plane_z));
-    }
-    const std::optional<Vector2d> det_px = detectScreened(detector, faults, frame, t, predicted_px);
+    // The track is settled (its NIS counts) once it has lived kConsistencySettle s before this update.
+    const bool settled = track.valid() && t - track_since >= kConsistencySettle;
+    const double seen_before = chase.lastSeen();
+    const ChaseObservation o = chase.frame(faults, frame, camera, pose);
     bool detected = false, fused = false;
     std::optional<FloorMeasurement> measurement;
     double nis = std::numeric_limits<double>::quiet_NaN();
     Vector2d pixel = Vector2d::Zero();
-    if (det_px) {
-      pixel = *det_px;
+    if (o.pixel) {
+      pixel = *o.pixel;
       if (sink) sink->measurement({channel::kPixel, t, frame.sequence, pixel, vec({cfg.pixel_sigma, cfg.pixel_sigma})});
-      // The floor point and its noise: white pixel noise through the range-dependent
-      // ground-projection Jacobian goes into R; the calibration and centroid bias does not (the
-      // innovations cannot see a bias that barely changes between frames, so in R it would only
-      // shrink the NIS): the track estimates the apparent position s = p + b, and the object's
-      // covariance is P_s + B (floorMeasurement(), world.h).
-      const auto fm = floorMeasurement(cfg, camera, pixel, plane_z);
-      const std::optional<Vector2d> exact = fm ? std::optional<Vector2d>(fm->z) : std::nullopt;
-      if (fm) {
+      if (o.floor) {
+        const Vector2d& exact = o.floor->z;
         detected = true;
         ++run.detections;
-        if (last_seen >= 0.0) run.longest_lost = std::max(run.longest_lost, t - last_seen);
+        if (seen_before >= 0.0) run.longest_lost = std::max(run.longest_lost, t - seen_before);
         if (first_seen < 0.0) first_seen = t;
-        last_seen = t;
         const auto a = robots::groundPointAnglePerPixel(camera, pixel, printed, plane_z);
         const auto h = robots::groundPointAnglePerPixel(camera, pixel, horizontal, plane_z);
         if (a && h) {
-          run.localization.sse_exact += (*exact - obj).squaredNorm();
+          run.localization.sse_exact += (exact - obj).squaredNorm();
           run.localization.sse_printed += (*a - obj).squaredNorm();
           run.localization.sse_horizontal += (*h - obj).squaredNorm();
           ++run.localization.count;
         }
-        const Eigen::Matrix2d R = cfg.pixel_sigma * cfg.pixel_sigma * fm->unit_pixel_cov;
-        bias_cov = fm->bias_cov;
-        measurement = *fm;
-        const bool settled = track.valid() && t - track_since >= kConsistencySettle;
-        const tracking::UnicycleUpdate u = track.update(t, *exact, R);
+        bias_cov = o.floor->bias_cov;
+        measurement = *o.floor;
+        const tracking::UnicycleUpdate& u = *o.update;
         fused = u.fused;
         nis = u.report.nis;
         if (settled && std::isfinite(nis)) {
@@ -218,7 +203,7 @@ MobileCaptureRun runMobileCapture(const MobileCaptureConfig& cfg, std::uint64_t 
         }
         if (sink) {
           const double nan = std::numeric_limits<double>::quiet_NaN();
-          sink->measurement({channel::kFloor, t, frame.sequence, *exact, R.diagonal().cwiseSqrt()});
+          sink->measurement({channel::kFloor, t, frame.sequence, exact, o.R.diagonal().cwiseSqrt()});
           sink->measurement({channel::kFloorAnglePerPixel, t, frame.sequence,
                              vec({a ? a->x() : nan, a ? a->y() : nan, h ? h->x() : nan, h ? h->y() : nan}),
                              {}});
@@ -229,7 +214,6 @@ MobileCaptureRun runMobileCapture(const MobileCaptureConfig& cfg, std::uint64_t 
         }
       }
     }
-    track.predictTo(t);
     if (!track.valid()) {
       track_since = -1.0;
     } else if (track_since < 0.0) {
@@ -242,13 +226,6 @@ MobileCaptureRun runMobileCapture(const MobileCaptureConfig& cfg, std::uint64_t 
       ++run.nees_count;
       next_nees = t + kNeesSpacing;
     }
-    if (track.valid()) {
-      prediction = predictPath(track, cfg);
-      plan = planning::planCapture(prediction, {{pose.x, pose.y}, pose.theta}, cfg.plannerParams());
-      const Vector2d rel = toRobot(pose, track.state().x().head<2>());
-      centre_bearing = std::atan2(rel.y(), rel.x());
-      have_bearing = true;
-    }
     if (sink) {
       sink->estimate({channel::kTruthObject, t, vec({truth.x, truth.y, truth.theta, truth.v, truth.omega}), {}});
       sink->estimate({channel::kTruthRobot, t, vec({pose.x, pose.y, pose.theta, robot.q.tilt, robot.q.pan}), {}});
@@ -260,9 +237,10 @@ MobileCaptureRun runMobileCapture(const MobileCaptureConfig& cfg, std::uint64_t 
         P.topLeftCorner<2, 2>() += bias_cov;
         sink->estimate({channel::kObject, t, track.state().x(), P});
       }
+      const planning::CapturePlan& plan = chase.plan();
       sink->command({channel::kPlan, t,
                      vec({plan.reachable ? 1.0 : 0.0, static_cast<double>(plan.steps), plan.point.x(), plan.point.y(),
-                          static_cast<double>(static_cast<int>(mode))})});
+                          static_cast<double>(static_cast<int>(chase.mode()))})});
     }
     if (hooks && hooks->on_frame) {
       MobileCaptureFrame f;
@@ -279,9 +257,9 @@ MobileCaptureRun runMobileCapture(const MobileCaptureConfig& cfg, std::uint64_t 
       f.nis = nis;
       f.estimate_valid = track.valid();
       if (track.valid()) f.estimate = track.state().x();
-      f.prediction = prediction;
-      f.plan = plan;
-      f.mode = mode;
+      f.prediction = chase.prediction();
+      f.plan = chase.plan();
+      f.mode = chase.mode();
       hooks->on_frame(f);
     }
     if (hooks && hooks->quit_requested && hooks->quit_requested()) {
@@ -315,25 +293,9 @@ MobileCaptureRun runMobileCapture(const MobileCaptureConfig& cfg, std::uint64_t 
   // Control: base law to the capture point and head towards the prediction, or the search.
   Ticks drive(sched, clock, 1, kDrive, [&](long, double t) {
     const robots::BasePose pose = robot.base.pose();
-    const control::SearchMode new_mode = track.valid() ? search.mode(t, last_seen) : control::SearchMode::Sweeping;
-    if (new_mode == control::SearchMode::Sweeping && mode != control::SearchMode::Sweeping) sweep_start = t;
-    if (sweep_start < 0.0) sweep_start = t;
-    mode = new_mode;
-    control::BaseCommand cmd;
-    robots::PanTiltJoints head_target = robot.q;
-    if (mode != control::SearchMode::Sweeping) {
-      cmd = control::goToPoint(pose, plan.point, cfg.goParams());
-      const Vector2d p = track.positionAt(t + cfg.controlPeriod());
-      head_target = control::headSetPoint(robot.head, pose, Vector3d(p.x(), p.y(), plane_z));
-    } else {
-      head_target = search.sweep(robot.head, t, sweep_start, have_bearing ? centre_bearing : 0.0);
-      cmd = search.baseWhileSearching(centre_bearing, have_bearing);
-      if (have_bearing) {
-        // The base turns towards the bearing; it is expressed in the robot frame at the last
-        // estimate, so update it with the base's own rotation.
-        centre_bearing = std::remainder(centre_bearing - robot.base.turnRate() * cfg.controlPeriod(), 2.0 * M_PI);
-      }
-    }
+    const ChaseCommand c = chase.command(t, pose, robot.head, robot.q, robot.base.turnRate());
+    const control::BaseCommand& cmd = c.base;
+    const robots::PanTiltJoints& head_target = c.head;
     link.send(t, cmd, head_target);
     robot.base.step(rng.drive);
     if (sink) {

@@ -2,6 +2,9 @@
 # on the scenario runtime with its oracle, and the metrics (filter test, localisation sweep, batch).
 list(APPEND scenarios_sources mobile_capture/config.cpp mobile_capture/world.cpp mobile_capture/loop.cpp
   mobile_capture/metrics.cpp)
+# The chase's perception and commands (chase.h): one piece for the simulated loop and the footage session.
+list(APPEND scenarios_sources mobile_capture/chase.cpp)
+list(APPEND scenarios_tests test/mobile_capture_chase_test.cpp)
 # --record / --replay: the head camera's frames and the object's truth per run (session recordings).
 list(APPEND scenarios_sources mobile_capture/recording.cpp)
 list(APPEND scenarios_tests test/mobile_capture_sources_test.cpp)

@@ -6,11 +6,14 @@
 // lossless, with a stamps file). The second flight comes well after the first ends (> max_coast_s).
 // The session must count every file's frames, start one track per flight and predict each
 // flight's board hit within a few cm of the true one (which the footage does not carry: the test
-// knows it from the flight).
+// knows it from the flight). Played as live cameras (source.pace) on a test clock, a slow frame
+// misses exactly the frames the cameras delivered meanwhile; injected detector faults (a throwing
+// detector, a NaN centre) are counted and skipped, and the board hits stand.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -22,6 +25,8 @@
 #include "viewline/core/error.h"
 #include "viewline/core/random.h"
 #include "viewline/io/config_edit.h"
+#include "viewline/runtime/live.h"
+#include "viewline/runtime/telemetry.h"
 #include "viewline/scenarios/dart/footage.h"
 #include "viewline/scenarios/dart/loop.h"
 #include "viewline/scenarios/dart/world.h"
@@ -66,6 +71,8 @@ void writeText(const fs::path& file, const std::string& text) {
 Footage makeFootage() {
   Footage f;
   f.dir = fs::path(testing::TempDir()) / ("viewline_dart_footage_" + std::to_string(::getpid()));
+  // VIEWLINE_DART_FOOTAGE_DIR: the footage written there and kept (the app runs of docs/results.md).
+  if (const char* keep = std::getenv("VIEWLINE_DART_FOOTAGE_DIR")) f.dir = keep;
   fs::remove_all(f.dir);
   const scenarios::DartScenarioConfig cfg = scenarios::loadDartScenario(kConfig);
   const std::vector<core::Camera> cams = scenarios::makeDartCameras(cfg);
@@ -148,7 +155,7 @@ class DartFootage : public testing::Test {
 protected:
   static void SetUpTestSuite() { footage_ = new Footage(makeFootage()); }
   static void TearDownTestSuite() {
-    fs::remove_all(footage_->dir);
+    if (!std::getenv("VIEWLINE_DART_FOOTAGE_DIR")) fs::remove_all(footage_->dir);
     delete footage_;
     footage_ = nullptr;
   }
@@ -202,6 +209,129 @@ TEST_F(DartFootage, ImageSequencesGiveTheBoardHits) {
   EXPECT_EQ(j.at("truth"), "not scored (the frame source has no truth)");
   EXPECT_EQ(j.at("tracks").size(), static_cast<std::size_t>(kFlights));
   EXPECT_NE(scenarios::dartFootageSummaryText(s, cfg).find("not scored: no truth"), std::string::npos);
+  EXPECT_FALSE(j.contains("live"));  // unpaced files: no live figures
+  // Nothing injected; the only defence that acted is the frozen-camera one: these renders carry
+  // no sensor noise, so the images of a dart at rest in the board repeat bit for bit (the hits
+  // use only the images before them).
+  EXPECT_TRUE(s.faults.injected.empty());
+  ASSERT_EQ(s.faults.outcome.size(), 1u);
+  EXPECT_GT(s.faults.outcomeOf("frames_frozen_dropped"), 0u);
+}
+
+namespace {
+
+/// A wall clock that moves only when told to (sleepUntil jumps to the time asked for).
+class TestClock : public runtime::WallClock {
+public:
+  double now() const override { return t_; }
+  void sleepUntil(double t) override {
+    if (t > t_) t_ = t;
+  }
+  void advance(double dt) { t_ += dt; }
+
+private:
+  double t_ = 0.0;
+};
+
+/// The slow part of a frame's processing, as a telemetry sink (called while the session processes
+/// a frame with a detection): the side camera's third detection takes 110 ms, the rest no time.
+class SlowDetection : public runtime::TelemetrySink {
+public:
+  explicit SlowDetection(TestClock& clock) : clock_(clock) {}
+  void measurement(const runtime::MeasurementRecord& r) override {
+    if (r.channel == "camera0" && ++side_ == 3) {
+      clock_.advance(0.110);
+      slow_stamp = r.t;
+    }
+  }
+  double slow_stamp = -1.0;  // s, the slow frame's stamp
+
+private:
+  TestClock& clock_;
+  int side_ = 0;
+};
+
+std::vector<std::string> paced(std::vector<std::string> sets) {
+  for (std::size_t c = 0; c < 2; ++c) sets.push_back("cameras[" + std::to_string(c) + "].source.pace=true");
+  return sets;
+}
+
+}  // namespace
+
+TEST_F(DartFootage, PacedFootageWithASlowFrameCountsTheFramesMissed) {
+  // The cameras alternate on one clock (side at even, rear at odd 10 ms steps, 50 Hz each: the
+  // deadline is one 20 ms period). Each camera's PacedSource sets its origin at its first grab,
+  // both at wall 0, so a side frame of stamp s arrives at wall s and a rear one at s - 10 ms. With
+  // no processing time the session takes side frame s at wall s, then rear s + 10 ms. The slow
+  // side frame s ends at s + 110 ms: by then the side frames s + 20 ... s + 100 ms (5) and the
+  // rear frames s + 10 ... s + 110 ms (6) have arrived. The session takes the newest of the rear
+  // (its next stamp is the earliest), dropping 5, then the newest of the side, dropping 4. Missed:
+  // the slow frame (late) and 9 dropped, of the 165 delivered.
+  const Footage& f = *footage_;
+  const std::uint64_t all = f.frames[0] + f.frames[1];
+  const auto cfg = configWith(paced(f.image_sets));
+  TestClock clock;
+  SlowDetection slow(clock);
+  const auto s = scenarios::runDartFootage(cfg, &slow, &clock);
+  ASSERT_TRUE(s.live.has_value());
+  const runtime::LiveReport& live = *s.live;
+  EXPECT_GT(slow.slow_stamp, kStart);  // the slow frame was in the first flight
+  EXPECT_EQ(live.delivered, all);
+  EXPECT_EQ(live.dropped, 9u);
+  EXPECT_EQ(live.late, 1u);
+  EXPECT_EQ(live.missed(), 10u);
+  EXPECT_EQ(live.processed, all - 9);
+  EXPECT_EQ(s.frames, all - 9);  // frames handed out
+  EXPECT_DOUBLE_EQ(live.deadline_s, 0.02);
+  EXPECT_NEAR(live.wall.max_ms, 110.0, 1e-6);  // the test clock's 110 ms (real work is not on it)
+  const nlohmann::json j = scenarios::dartFootageSummaryJson(s, cfg);
+  EXPECT_EQ(j["live"]["frames_missed"], 10);
+  EXPECT_EQ(j["live"]["frames_dropped"], 9);
+  EXPECT_EQ(j["live"]["deadline"], "one frame period at 50 fps (the fastest camera's rate_hz)");
+  const std::string text = scenarios::dartFootageSummaryText(s, cfg);
+  EXPECT_NE(text.find("  " + runtime::summaryLine(live) + "\n"), std::string::npos) << text;
+  EXPECT_NE(text.find("  " + runtime::processingLine(live) + "\n"), std::string::npos) << text;
+  EXPECT_EQ(s.tracks.size(), static_cast<std::size_t>(kFlights));  // both darts tracked meanwhile
+
+  // Without the slow frame nothing is missed, every frame is timed, and the hits are the unpaced
+  // session's: pacing changes when, never what.
+  TestClock instant;
+  const auto on_time = scenarios::runDartFootage(cfg, nullptr, &instant);
+  ASSERT_TRUE(on_time.live.has_value());
+  EXPECT_EQ(on_time.live->missed(), 0u);
+  EXPECT_EQ(on_time.live->processed, all);
+  const auto unpaced = scenarios::runDartFootage(configWith(f.image_sets));
+  ASSERT_EQ(on_time.tracks.size(), unpaced.tracks.size());
+  for (std::size_t k = 0; k < unpaced.tracks.size(); ++k) {
+    ASSERT_TRUE(on_time.tracks[k].board_hit && unpaced.tracks[k].board_hit) << "track " << k;
+    EXPECT_EQ(on_time.tracks[k].board_hit->p, unpaced.tracks[k].board_hit->p) << "track " << k;
+  }
+}
+
+TEST_F(DartFootage, AThrowingDetectorAndANaNCentreAreCountedAndSkipped) {
+  // The side camera's detector throws over [0.27, 0.33) s (its frames at 0.28, 0.30 and 0.32 s,
+  // in the first flight) and the rear camera's centres are NaN over [0.28, 0.34) s: each is
+  // counted (injected, and what the session did about it) and the frame goes on without a
+  // detection; the flights are still tracked to their board hits.
+  std::vector<std::string> sets = footage_->image_sets;
+  sets.push_back("faults=[{kind: detector_throw, camera: 0, from_s: 0.27, to_s: 0.33}, "
+                 "{kind: detect_nan, camera: 1, from_s: 0.28, to_s: 0.34}]");
+  const auto cfg = configWith(sets);
+  const auto s = scenarios::runDartFootage(cfg);
+  checkSession(s, cfg, 30.0);
+  EXPECT_EQ(s.faults.of(runtime::FaultKind::DetectorThrow), 3u);
+  EXPECT_EQ(s.faults.outcomeOf("detector_errors"), 3u);
+  EXPECT_GE(s.faults.of(runtime::FaultKind::DetectNan), 1u);
+  EXPECT_EQ(s.faults.outcomeOf("detections_rejected"), s.faults.of(runtime::FaultKind::DetectNan));
+  const auto clean = scenarios::runDartFootage(configWith(footage_->image_sets));
+  EXPECT_EQ(s.cameras[1].detections + s.faults.of(runtime::FaultKind::DetectNan), clean.cameras[1].detections);
+  const nlohmann::json j = scenarios::dartFootageSummaryJson(s, cfg);
+  EXPECT_EQ(j["faults"]["injected"]["detector_throw"], 3);
+  EXPECT_EQ(j["faults"]["outcome"]["detector_errors"], 3);
+  EXPECT_NE(scenarios::dartFootageSummaryText(s, cfg).find("faults injected"), std::string::npos);
+  // Generated detections have no frames to fault: refused by name.
+  const std::string e = errorOf([] { scenarios::loadDartScenario(kConfig, {"faults=[{kind: freeze, from_s: 0, to_s: 1}]"}); });
+  EXPECT_NE(e.find("faults: injected on footage only"), std::string::npos) << e;
 }
 
 TEST_F(DartFootage, VideosPerCameraGiveTheSameBoardHits) {

@@ -90,14 +90,41 @@ struct CatchFootageTrack {
   std::optional<Eigen::Vector3d> hole_at_crossing;
 };
 
-/// What one camera of a footage session gave.
-struct CatchFootageCamera {
+/// What one camera of a multi-camera footage session gave (ball catching's, dart's).
+struct FootageCamera {
   std::string name;         ///< the rig's camera name
   std::string source;       ///< describeSource()
   std::uint64_t frames = 0,      ///< frames handed out
                 lost = 0,        ///< grabs that lost their frame
-                detections = 0;  ///< frames the ball was detected in
+                detections = 0;  ///< frames the ball (or the dart's marker) was detected in
 };
+
+/// What one camera of a ball-catching footage session gave.
+using CatchFootageCamera = FootageCamera;
+
+/// The session-wide counts a multi-camera footage summary opens with (ball catching, dart).
+struct FootageSessionCounts {
+  std::string scenario;  ///< the scenario's name, first word of the summary
+  double t_first = 0.0,  ///< s, first frame's stamp
+         t_last = 0.0;   ///< s, last frame's stamp
+  std::uint64_t frames = 0,      ///< frames over the cameras
+                detections = 0,  ///< detections over the cameras
+                fused = 0,       ///< detections the tracker fused
+                gated = 0,       ///< detections its gate rejected
+                refused = 0;     ///< detections the tracker refused (tracking::Refusal)
+  int tracks_started = 0;  ///< tracks the tracker started
+};
+
+/// The opening lines of a multi-camera footage session's console summary (ball catching, dart):
+/// the session (stamps, frames, detections), one line per camera, the tracker's counts.
+std::string footageSessionText(const FootageSessionCounts& counts, const std::vector<FootageCamera>& cameras);
+
+/// A footage summary's "cameras" array: name, source, frames, lost and detections per camera.
+nlohmann::json footageCamerasJson(const std::vector<FootageCamera>& cameras);
+
+/// A footage summary's live lines (runtime::summaryLine, runtime::processingLine; indented, one
+/// per line); empty when the session ran on no live source.
+std::string footageLiveText(const std::optional<runtime::LiveReport>& live);
 
 /// The summary of a footage session (footage.h): what is known without truth.
 struct CatchFootageSummary {

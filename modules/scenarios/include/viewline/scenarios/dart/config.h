@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "viewline/io/config.h"
+#include "viewline/runtime/faults.h"
 #include "viewline/runtime/source_config.h"
 #include "viewline/tracking/tracker.h"
 #include "viewline/vision/ball_detector.h"
@@ -79,6 +80,9 @@ struct DartScenarioConfig {
   double detector_sigma_px = 0.0;
   /// Footage: floor of the blob's own std, px (a few-pixel blob's edge noise model is optimistic).
   double detector_sigma_px_floor = 0.3;
+  /// Footage: injected camera and detector faults (runtime/faults.h; windows on the footage's
+  /// stamps; empty: none). Refused on generated detections, which have no frames to fault.
+  runtime::FaultConfig faults;
 
   /// True when the cameras give footage (cameras[].source), not generated detections.
   bool onFootage() const;

@@ -24,9 +24,22 @@
 // dart at rest in the board) and the mean NIS of the fused images tested against their track
 // before that time. The experiments' RMSE, NEES and gate figures are "not scored: no truth".
 //
-// Limits: footage with pace: true (or a V4L2 camera) is taken at its own pace, but the session
-// times no frame and reports no deadline misses (ball catching's footage session does); there
-// is no fault injection on footage; v4l2 is untested on hardware.
+// Live: on footage with pace: true (or a V4L2 camera) the cameras run at their own pace
+// (runtime::PacedSource per camera, merged): a frame the session is too busy to take is dropped
+// and counted, and each frame is timed from its grab to the end of its processing (the tracker's
+// update and the board-hit prediction; wall and thread CPU, runtime::ProcessingTimer) against one
+// frame period of the fastest camera (cameras[].rate_hz): the summary's `live` object and lines,
+// as ball catching's footage session gives them (runtime::LiveReport). Each camera's PacedSource
+// sets its wall-clock origin at its own first grab, so the frames of a camera whose first stamp
+// is later (alternating cameras: the second, 10 ms) arrive that much earlier, relative to the
+// other camera's, than their stamps say; the stamps the tracker sees are the footage's own.
+//
+// Faults: the `faults:` list (runtime/faults.h, windows on the footage's stamps) is injected into
+// the footage and the detector as in ball catching's footage session, and the same defences run
+// with or without it: a frame delivered past frame_deadline_s is dropped, a frozen camera's repeated
+// image is dropped (runtime::StaleFrameFilter), a detector exception is caught and a non-finite or
+// outside pixel screened (runtime::guardedDetect, runtime::usablePixel), each counted in the
+// summary's `faults` (present when anything was counted). v4l2 is untested on hardware.
 
 #include <cstdint>
 #include <nlohmann/json.hpp>
@@ -35,19 +48,16 @@
 #include <vector>
 
 #include "viewline/planning/crossing.h"
+#include "viewline/runtime/faults.h"
+#include "viewline/runtime/live.h"
 #include "viewline/runtime/telemetry.h"
+#include "viewline/scenarios/ball_catching/footage.h"
 #include "viewline/scenarios/dart/config.h"
 
 namespace viewline::scenarios {
 
-/// What one camera of a dart footage session gave.
-struct DartFootageCamera {
-  std::string name;              ///< the rig's camera name
-  std::string source;            ///< runtime::describeSource()
-  std::uint64_t frames = 0,      ///< frames handed out
-                lost = 0,        ///< grabs that lost their frame
-                detections = 0;  ///< frames the marker was detected in
-};
+/// What one camera of a dart footage session gave (ball catching's footage camera counts).
+using DartFootageCamera = FootageCamera;
 
 /// One track of a dart footage session and its predicted board hit.
 struct DartFootageTrack {
@@ -63,6 +73,7 @@ struct DartFootageTrack {
 
 /// The summary of a dart footage session (footage.h): what is known without truth.
 struct DartFootageSummary {
+  std::uint64_t seed = 0;  ///< the seed (injected faults)
   std::vector<DartFootageCamera> cameras;  ///< per camera, in the rig's order
   double t_first = 0.0,  ///< s, first frame's stamp
          t_last = 0.0;   ///< s, last frame's stamp
@@ -75,6 +86,8 @@ struct DartFootageSummary {
   std::vector<DartFootageTrack> tracks;  ///< the tracks with a fused image, in order
   double nis_mean = 0.0;        ///< mean NIS of the fused images tested against their track before its hit (2 dof)
   std::uint64_t nis_samples = 0;  ///< images in nis_mean
+  std::optional<runtime::LiveReport> live;  ///< processing times and misses on a live source
+  runtime::FaultReport faults;  ///< injected faults and the defences' counts (empty: nothing counted)
   double wall_s = 0.0;  ///< wall-clock time of the session, s
 };
 
@@ -83,8 +96,11 @@ planning::CrossingPlane dartBoardPlane(const DartScenarioConfig& cfg);
 
 /// Runs the session over the footage of cfg's cameras (cfg.onFootage(); the header comment).
 /// `telemetry` (optional): the detections, the tracker's updates (channel "dart") and estimates.
-/// Throws core::InvalidInput naming the file or device a source cannot open or read.
-DartFootageSummary runDartFootage(const DartScenarioConfig& cfg, runtime::TelemetrySink* telemetry = nullptr);
+/// `clock`: the wall clock of paced footage and of the processing timer (null: the steady clock).
+/// `seed`: the injected faults' (corrupt images). Throws core::InvalidInput naming the file or
+/// device a source cannot open or read.
+DartFootageSummary runDartFootage(const DartScenarioConfig& cfg, runtime::TelemetrySink* telemetry = nullptr,
+                                  runtime::WallClock* clock = nullptr, std::uint64_t seed = 1);
 
 /// The summary as JSON (RMSE and experiments null: "truth": not scored).
 nlohmann::json dartFootageSummaryJson(const DartFootageSummary& s, const DartScenarioConfig& cfg);
