@@ -44,7 +44,7 @@ int main(int argc, char** argv) {
       // Footage: one session over the cameras' frames, no truth (dart/footage.h).
       if (!opt.record_dir.empty()) throw core::InvalidInput("--record: footage is recorded already (a recording holds generated detections)");
       if (!opt.replay_dir.empty()) throw core::InvalidInput("--replay: the cameras' footage is the input (cameras[].source)");
-      const scenarios::DartFootageSummary s = scenarios::runDartFootage(cfg, log.enabled() ? &telemetry : nullptr);
+      const scenarios::DartFootageSummary s = scenarios::runDartFootage(cfg, log.enabled() ? &telemetry : nullptr, nullptr, opt.seed);
       log.flush();
       nlohmann::json j = scenarios::dartFootageSummaryJson(s, cfg);
       if (!opt.sets.empty()) j["config_set"] = opt.sets;
