@@ -47,7 +47,8 @@ std::string configText(const io::ConfigNode& root) {
 std::pair<nlohmann::json, nlohmann::json> tuneOnAcheckOnB(const std::string& scenario, const std::string& config,
                                                          const std::vector<std::string>& set, double start_scale,
                                                          const fs::path& a, const fs::path& b, const fs::path& out,
-                                                         const std::map<std::string, double>& start_values = {}) {
+                                                         const std::map<std::string, double>& start_values = {},
+                                                         const tuning::AdapterOptions& options = {}) {
   tuning::AutotuneSessionOptions ao;
   ao.scenario = scenario;
   ao.config = config;
@@ -55,6 +56,7 @@ std::pair<nlohmann::json, nlohmann::json> tuneOnAcheckOnB(const std::string& sce
   ao.recording = a.string();
   ao.start_scale = start_scale;
   ao.start_values = start_values;
+  ao.adapter_options = options;
   ao.grid_points = 5;
   ao.workers = 2;
   ao.out_dir = out.string();
@@ -66,6 +68,7 @@ std::pair<nlohmann::json, nlohmann::json> tuneOnAcheckOnB(const std::string& sce
   co.scenario = scenario;
   co.config = at["autotuned_config"].get<std::string>();
   co.recording = b.string();
+  co.adapter_options = options;
   co.quiet = true;
   return {at, tuning::runCheckSession(tuning::makeBuiltinAdapters(), co)};
 }
@@ -192,15 +195,19 @@ fs::path recordDart(const std::string& name, std::uint64_t seed) {
 TEST(TuneOnScenarioRecording, DartTunedOnOneIsConsistentOnAnother) {
   const fs::path a = recordDart("dart_a", 41), b = recordDart("dart_b", 42), out = scratch("dart_out");
   // The shipped tracker assumes no process noise (the true flights are ballistic): q starts at 1.
-  const auto [at, check] = tuneOnAcheckOnB("dart", kDart, {}, 10.0, a, b, out, {{"tracker.accel_psd", 1.0}});
+  // The full scenario's flights (experiment D: free-running cameras), as a rig records them.
+  const tuning::AdapterOptions d_scenario = {{"log_experiment", "D_scenario"}};
+  const auto [at, check] = tuneOnAcheckOnB("dart", kDart, {}, 10.0, a, b, out, {{"tracker.accel_psd", 1.0}}, d_scenario);
   expectConsistent("dart", at, check, 100);
-  EXPECT_NE(check["data"].get<std::string>().find("A_alternating, 10 run(s)"), std::string::npos) << check["data"];
+  EXPECT_NE(check["data"].get<std::string>().find("D_scenario, 10 run(s)"), std::string::npos) << check["data"];
+  EXPECT_NEAR(at["parameters"]["measurement"]["tuned"].get<double>(), 0.5, 0.1);  // the recorded pixel noise
 
   // The check can fail: B replayed with the pixel noise assumed 10 x smaller is overconfident.
   tuning::CheckOptions co;
   co.scenario = "dart";
   co.config = at["autotuned_config"].get<std::string>();
-  co.adapter_options = {{"assumed_pixel_noise_px", std::to_string(0.1 * at["parameters"]["measurement"]["tuned"].get<double>())}};
+  co.adapter_options = d_scenario;
+  co.adapter_options["assumed_pixel_noise_px"] = std::to_string(0.1 * at["parameters"]["measurement"]["tuned"].get<double>());
   co.recording = b.string();
   co.quiet = true;
   const nlohmann::json off = tuning::runCheckSession(tuning::makeBuiltinAdapters(), co);
