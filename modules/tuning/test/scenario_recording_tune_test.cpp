@@ -1,9 +1,9 @@
 // Tuning on one's own data, for the scenarios other than pan-tilt: per scenario, two short
 // recordings of the same setting (different seeds) as the scenario's app writes them with --record,
 // the noise auto-tuned on the first from a start several times off, checked on the second: NIS
-// inside its two-sided 99 % band. The recordings' truth files are removed first, as a rig's
-// recording has none; nothing but the frames (and the config) is read. A folder that is not a
-// recording is refused naming it. Runs from the source root (ctest's working directory).
+// inside its two-sided 99 % band. A rig's recording has no truth: ball catching's truth files are
+// removed, table ball's recording has none, dart's truth columns are not read. A folder that is not
+// a recording is refused naming it, and mobile capture refuses recordings saying why. Runs from the source root (ctest's working directory).
 #include <gtest/gtest.h>
 #include <unistd.h>
 #include <yaml-cpp/yaml.h>
@@ -43,7 +43,8 @@ std::string configText(const io::ConfigNode& root) {
 }
 
 /// Auto-tunes `scenario` on recording `a` (the config with `set`, noise started at `start_scale`
-/// times the config's, or as `start_values` gives by key), then checks the tuned config on recording `b`; returns {autotune, check}.
+/// times the config's, or as `start_values` gives by key, adapter `options`), then checks the tuned
+/// config on recording `b`; returns {autotune, check}.
 std::pair<nlohmann::json, nlohmann::json> tuneOnAcheckOnB(const std::string& scenario, const std::string& config,
                                                          const std::vector<std::string>& set, double start_scale,
                                                          const fs::path& a, const fs::path& b, const fs::path& out,
