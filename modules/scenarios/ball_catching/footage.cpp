@@ -12,6 +12,7 @@
 #include "viewline/core/random.h"
 #include "viewline/robots/cartesian_robot.h"
 #include "viewline/runtime/delay_line.h"
+#include "viewline/runtime/recording.h"
 #include "viewline/runtime/scheduler.h"
 #include "viewline/runtime/stale_frames.h"
 #include "viewline/scenarios/ball_catching/detection.h"
@@ -56,7 +57,7 @@ struct ToPlanner {
 // loop.cpp's ThrowLoop without the throw's truth.
 class FootageSession {
 public:
-  FootageSession(const BallCatchingConfig& cfg, CatchFootageFrames& source, std::vector<core::Camera> est_cams,
+  FootageSession(const BallCatchingConfig& cfg, runtime::FrameSource& source, std::vector<core::Camera> est_cams,
                  robots::SimulatedCartesianRobot& robot, CatchFootageSummary& sum, const CatchHooks& hooks,
                  runtime::TelemetrySink* tel, std::uint64_t seed, runtime::FaultPlan& faults,
                  runtime::ProcessingTimer* timer, double t0)
@@ -253,6 +254,37 @@ private:
   int tracks_before_ = 0;     // tracks of the tracker before its last reset
 };
 
+// The session's clock: the control ticks from t0, every frame at its ready time, then the states
+// and set points still in flight. `on_frame` runs after each frame. Returns the last ready time.
+double runSession(const BallCatchingConfig& cfg, runtime::FrameSource& source, FootageSession& session,
+                  const robots::SimulatedCartesianRobot& robot, double t0, const std::function<void()>& on_frame) {
+  runtime::Scheduler sched(t0);
+  sched.every(t0, cfg.control_period, runtime::priority::Control, [&](double t) { session.tick(t); });
+  bool source_done = false;
+  double t_last = t0;
+  std::function<void()> next_capture = [&] {
+    const std::optional<double> t_ready = source.nextReadyTime();
+    if (!t_ready) {
+      source_done = true;
+      return;
+    }
+    t_last = std::max(t_last, *t_ready);
+    sched.at(std::max(*t_ready, sched.now()), runtime::priority::Capture, [&](double) {
+      if (!session.capture()) sched.requestStop();
+      on_frame();
+      next_capture();
+    });
+  };
+  next_capture();
+  while (!source_done && sched.step()) {
+  }
+  // The states and set points in flight reach the planner and the box after the last frame.
+  if (!sched.stopRequested())
+    sched.runUntil(sched.now() + cfg.processing_latency + robot.commandLatency() + 2.0 * cfg.control_period);
+  session.finish();
+  return t_last;
+}
+
 }  // namespace
 
 CatchFootageSummary runCatchFootage(const BallCatchingConfig& cfg, std::uint64_t seed, const CatchHooks& hooks,
@@ -290,30 +322,9 @@ CatchFootageSummary runCatchFootage(const BallCatchingConfig& cfg, std::uint64_t
   FootageSession session(cfg, source, std::move(est_cams), robot, sum, hooks, telemetry.get(), seed, faults,
                          timer ? &*timer : nullptr, t0);
 
-  runtime::Scheduler sched(t0);
-  sched.every(t0, cfg.control_period, runtime::priority::Control, [&](double t) { session.tick(t); });
-  bool source_done = false;
-  double t_last = t0;
-  std::function<void()> next_capture = [&] {
-    const std::optional<double> t_ready = source.nextReadyTime();
-    if (!t_ready) {
-      source_done = true;
-      return;
-    }
-    t_last = std::max(t_last, *t_ready);
-    sched.at(std::max(*t_ready, sched.now()), runtime::priority::Capture, [&](double) {
-      if (!session.capture()) sched.requestStop();
-      if (hooks.progress) hooks.progress(static_cast<int>(source.delivered()), 0);
-      next_capture();
-    });
-  };
-  next_capture();
-  while (!source_done && sched.step()) {
-  }
-  // The states and set points in flight reach the planner and the box after the last frame.
-  if (!sched.stopRequested())
-    sched.runUntil(sched.now() + cfg.processing_latency + robot.commandLatency() + 2.0 * cfg.control_period);
-  session.finish();
+  const double t_last = runSession(cfg, source, session, robot, t0, [&] {
+    if (hooks.progress) hooks.progress(static_cast<int>(source.delivered()), 0);
+  });
 
   for (std::size_t i = 0; i < source.cameraCount(); ++i) {
     sum.cameras[i].frames = source.frames(i);
@@ -327,6 +338,53 @@ CatchFootageSummary runCatchFootage(const BallCatchingConfig& cfg, std::uint64_t
   sum.max_speed = robot.maxSpeedSeen();
   sum.max_acceleration = robot.maxAccelerationSeen();
   if (timer) sum.live = runtime::liveReport(source, *timer, origin);
+  if (!faults.empty()) sum.faults = faults.report();
+  if (telemetry) telemetry->flush();
+  sum.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  return sum;
+}
+
+CatchFootageSummary runCatchFootageOnRecording(const BallCatchingConfig& cfg, std::uint64_t seed,
+                                               const std::string& dir, const CatchHooks& hooks) {
+  cfg.validate();
+  if (!hooks.record_dir.empty()) throw core::InvalidInput("--record: the frames are recorded already");
+  if (!hooks.replay_dir.empty()) throw core::InvalidInput("--replay: the recording is the input");
+  const auto wall0 = std::chrono::steady_clock::now();
+  runtime::RecordingSource source(dir);
+  if (source.cameraCount() > cfg.activeCameras())
+    throw core::InvalidInput(dir + ": a recording of " + std::to_string(source.cameraCount()) + " cameras, the config has " +
+                             std::to_string(cfg.activeCameras()) + " active");
+  CatchFootageSummary sum;
+  sum.seed = seed;
+  for (std::size_t i = 0; i < cfg.activeCameras(); ++i)
+    sum.cameras.push_back({cfg.cameras[i].name, "recording " + dir, 0, 0, 0});
+  const std::optional<double> first = source.nextReadyTime();
+  if (!first) throw core::InvalidInput(dir + ": the recording holds no frame");
+  const double t0 = *first;
+  std::shared_ptr<runtime::TelemetrySink> telemetry = hooks.telemetry ? hooks.telemetry(0) : nullptr;
+  robots::SimulatedCartesianRobot robot(cfg.robot);
+  robot.reset(t0);
+  std::vector<core::Camera> est_cams;  // the rig's calibration, taken as registered (as on footage)
+  for (std::size_t i = 0; i < cfg.activeCameras(); ++i) est_cams.push_back(cfg.cameras[i].estimatorCamera());
+  runtime::FaultPlan faults(cfg.faults, core::deriveSeed(seed, 0xFA));
+  FootageSession session(cfg, source, std::move(est_cams), robot, sum, hooks, telemetry.get(), seed, faults, nullptr, t0);
+  int grabs = 0;
+  sum.t_last = runSession(cfg, source, session, robot, t0, [&] {
+    ++grabs;
+    if (hooks.progress) hooks.progress(grabs, 0);
+  });
+  for (const runtime::RecordingEntry& e : source.entries()) {
+    if (e.camera >= sum.cameras.size()) continue;
+    CatchFootageCamera& c = sum.cameras[e.camera];
+    if (e.file.empty()) ++c.lost;
+    else ++c.frames;
+  }
+  for (const CatchFootageCamera& c : sum.cameras) sum.frames += c.frames;
+  sum.t_first = t0;
+  sum.limit_violations = robot.velocityViolations() + robot.accelerationViolations();
+  sum.refused_setpoints = robot.refusedSetpoints();
+  sum.max_speed = robot.maxSpeedSeen();
+  sum.max_acceleration = robot.maxAccelerationSeen();
   if (!faults.empty()) sum.faults = faults.report();
   if (telemetry) telemetry->flush();
   sum.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();

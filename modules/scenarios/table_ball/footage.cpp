@@ -13,6 +13,7 @@
 #include "viewline/robots/table_tilt.h"
 #include "viewline/runtime/delay_line.h"
 #include "viewline/runtime/merged_source.h"
+#include "viewline/runtime/recording.h"
 #include "viewline/runtime/scheduler.h"
 #include "viewline/runtime/source_config.h"
 #include "viewline/runtime/stale_frames.h"
@@ -34,21 +35,24 @@ constexpr double kTimeTolerance = 1e-9;
 
 std::string tableBallFootageName(const runtime::SourceConfig& s) { return runtime::describeSource(s); }
 
-TableBallFootageSummary runTableBallFootage(const TableBallConfig& cfg, std::uint64_t seed, const TableBallHooks& hooks,
-                                            runtime::WallClock* clock) {
-  cfg.validate();
-  if (!cfg.onFootage())
-    throw core::InvalidInput(std::string("source.kind: expected footage (images, video or v4l2), got ") +
-                             runtime::toString(cfg.source.kind));
+namespace {
+
+/// The hooks a session over recorded frames cannot honour (footage.h), refused.
+void refuseRecordReplayPacing(const TableBallHooks& hooks) {
   if (!hooks.record_dir.empty())
     throw core::InvalidInput("--record: footage is recorded already (a recording holds a simulated run)");
   if (!hooks.replay_dir.empty()) throw core::InvalidInput("--replay: the footage is the input (source:)");
   if (hooks.pacing.paced()) throw core::InvalidInput("--realtime: footage is paced by its source (source.pace: true)");
+}
+
+/// The session (footage.h) over footage already opened; `source_name` names it in the summary.
+TableBallFootageSummary runOnFootage(const TableBallConfig& cfg, std::uint64_t seed, const TableBallHooks& hooks,
+                                     runtime::WallClock* clock, runtime::SingleCameraFootage opened,
+                                     const std::string& source_name) {
   const auto wall0 = std::chrono::steady_clock::now();
   TableBallFootageSummary sum;
   sum.seed = seed;
-  sum.source = tableBallFootageName(cfg.source);
-  runtime::SingleCameraFootage opened = runtime::openSingleCameraFootage(cfg.source, clock, "the head camera");
+  sum.source = source_name;
   const std::unique_ptr<runtime::FrameSource>& footage = opened.source;
   const double t0 = opened.t0;
   runtime::LiveFrameSource* const live = opened.live;
@@ -257,6 +261,35 @@ TableBallFootageSummary runTableBallFootage(const TableBallConfig& cfg, std::uin
   if (sink != nullptr) sink->flush();
   sum.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   return sum;
+}
+
+}  // namespace
+
+TableBallFootageSummary runTableBallFootage(const TableBallConfig& cfg, std::uint64_t seed, const TableBallHooks& hooks,
+                                            runtime::WallClock* clock) {
+  cfg.validate();
+  if (!cfg.onFootage())
+    throw core::InvalidInput(std::string("source.kind: expected footage (images, video or v4l2), got ") +
+                             runtime::toString(cfg.source.kind));
+  refuseRecordReplayPacing(hooks);
+  const std::string name = tableBallFootageName(cfg.source);
+  return runOnFootage(cfg, seed, hooks, clock, runtime::openSingleCameraFootage(cfg.source, clock, "the head camera"), name);
+}
+
+TableBallFootageSummary runTableBallOnRecording(const TableBallConfig& cfg, std::uint64_t seed, const std::string& dir,
+                                                const TableBallHooks& hooks) {
+  cfg.validate();
+  refuseRecordReplayPacing(hooks);
+  runtime::SingleCameraFootage opened;
+  auto recording = std::make_unique<runtime::RecordingSource>(dir);
+  if (recording->cameraCount() != 1)
+    throw core::InvalidInput(dir + ": a recording of " + std::to_string(recording->cameraCount()) +
+                             " cameras (table_ball has one, the head camera)");
+  const std::optional<double> first = recording->nextReadyTime();
+  if (!first) throw core::InvalidInput(dir + ": the recording holds no frame");
+  opened.t0 = *first;
+  opened.source = std::move(recording);
+  return runOnFootage(cfg, seed, hooks, nullptr, std::move(opened), "recording " + dir);
 }
 
 namespace {

@@ -30,12 +30,17 @@
 // predicted elsewhere might have detected other blobs; the tuned config is therefore checked
 // live on a fresh seed (autotune's verify runs), where its windows are its own. Only with
 // detector.sigma_px > 0 (one told std); with 0 the std is per detection (blob covariance) and
-// auto-tuning is refused.
+// auto-tuning is refused. From a recording (ball_catching --record DIR: session.json and
+// throw_iii/, or one throw's folder): each throw's frames through the footage session
+// (scenarios::runCatchFootageOnRecording: windowed detection around the shipped filter's
+// prediction, the rig's calibration taken as registered, the added pixel noise from a fixed seed),
+// the images it gave its tracker kept; throw.json and truth.csv are not read (NIS only).
 // The scenario's live view (viz::BallCatchingDisplay) is not wired here: this module does not
 // link viz.
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <memory>
 #include <optional>
 
@@ -45,6 +50,7 @@
 #include "viewline/estimation/consistency.h"
 #include "viewline/runtime/telemetry.h"
 #include "viewline/scenarios/ball_catching.h"
+#include "viewline/scenarios/ball_catching/recording.h"
 #include "viewline/tuning/scenario.h"
 
 namespace viewline::tuning {
@@ -70,6 +76,10 @@ detail::OptionTable<CatchOptions> catchOptions() {
   return options;
 }
 
+/// Base seed of the footage sessions over a recording's throws (throw i: deriveSeed(base, i)): it
+/// draws only the added pixel noise and the config's injected faults.
+constexpr std::uint64_t kRecordingSeed = 1;
+
 const detail::SeriesLabels kLabels{"time since release [s]", "tracker position error |p_hat - p| [m]",
                                    "innovation number (in the run)", 2.0, "world x (towards the box) [m]", "world y [m]"};
 
@@ -79,6 +89,7 @@ struct CatchThrow {
   std::vector<core::Camera> cameras;               ///< the tracker's cameras (registered)
   Eigen::Vector3d release = Eigen::Vector3d::Zero(), launch = Eigen::Vector3d::Zero();  ///< the flight, world
   double t_end = 0.0;                              ///< end of the true flight, s (throw clock)
+  bool has_truth = true;                           ///< false: from a recording (no NEES)
 };
 
 using CatchReplayData = detail::Recording<CatchThrow>;
@@ -128,16 +139,48 @@ public:
         t.release = tr.release;
         t.launch = tr.launch_velocity;
         t.t_end = tr.t_cross + cfg_.post_crossing_s + 0.3;
-        for (const runtime::MeasurementRecord& m : sinks[static_cast<std::size_t>(tr.index)]->measurements) {
-          if (m.channel.rfind("camera", 0) != 0 || m.z.size() != 2 || m.sigma.size() < 1) continue;
-          const std::size_t k = static_cast<std::size_t>(std::stoul(m.channel.substr(6)));
-          if (k >= t.cameras.size()) throw core::Error("ball_catching record: an image of a camera the loop did not show");
-          t.images.push_back({m.id, k, m.t, Eigen::Vector2d(m.z(0), m.z(1)), m.sigma(0)});
-        }
+        addImages(*sinks[static_cast<std::size_t>(tr.index)], t);
         d->items.push_back(std::move(t));
       }
     }
     d->source = detail::liveSource(runs, seed);
+    return d;
+  }
+
+  /// A recording's throws (ball_catching --record DIR: session.json and throw_iii/, or one throw's
+  /// folder) through the footage session (scenarios::runCatchFootageOnRecording): each frame
+  /// detected in a window around the shipped filter's prediction and given to its tracker, as live;
+  /// the images it was given are kept. The throws' truth is not read: NIS only.
+  std::unique_ptr<ReplayData> loadRecording(const std::string& dir) const override {
+    namespace fs = std::filesystem;
+    std::vector<std::string> throw_dirs;
+    if (fs::exists(fs::path(dir) / "session.json")) {
+      const int n = scenarios::recordedCatchThrows(dir);
+      for (int i = 0; i < n; ++i) throw_dirs.push_back(scenarios::catchThrowDir(dir, i));
+    } else if (fs::exists(fs::path(dir) / "recording.csv")) {
+      throw_dirs.push_back(dir);
+    } else {
+      throw core::InvalidInput(dir + ": not a recording (no session.json, as ball_catching --record DIR writes, nor "
+                                     "one throw's recording.csv)");
+    }
+    auto d = std::make_unique<CatchReplayData>("ball-catching throws", "images", &imagesOf);
+    std::vector<core::Camera> cams;  // the estimators' cameras on a recording: the rig's calibration
+    for (std::size_t i = 0; i < cfg_.activeCameras(); ++i) cams.push_back(cfg_.cameras[i].estimatorCamera());
+    for (std::size_t i = 0; i < throw_dirs.size(); ++i) {
+      const auto sink = std::make_shared<runtime::MemorySink>();
+      scenarios::CatchHooks hooks;
+      hooks.telemetry = [&sink](int) { return sink; };
+      // The seed draws the added pixel noise (pixel_noise_px) and injected faults, as in a footage session.
+      scenarios::runCatchFootageOnRecording(cfg_, core::deriveSeed(kRecordingSeed, i), throw_dirs[i], hooks);
+      CatchThrow t;
+      t.cameras = cams;
+      t.has_truth = false;
+      addImages(*sink, t);
+      d->items.push_back(std::move(t));
+    }
+    if (d->measurements() == 0) throw core::InvalidInput(dir + ": the ball was detected in none of the recording's frames");
+    d->source = "recording " + dir + " (" + std::to_string(throw_dirs.size()) +
+                " throw(s) through the footage session: windowed detection, the config's calibration)";
     return d;
   }
 
@@ -199,13 +242,24 @@ public:
   }
 
 private:
+  /// The image measurements the loop gave its tracker (the telemetry's camera<k> channels), in order.
+  static void addImages(const runtime::MemorySink& sink, CatchThrow& t) {
+    for (const runtime::MeasurementRecord& m : sink.measurements) {
+      if (m.channel.rfind("camera", 0) != 0 || m.z.size() != 2 || m.sigma.size() < 1) continue;
+      const std::size_t k = static_cast<std::size_t>(std::stoul(m.channel.substr(6)));
+      if (k >= t.cameras.size()) throw core::Error("ball_catching record: an image of a camera the loop did not show");
+      t.images.push_back({m.id, k, m.t, Eigen::Vector2d(m.z(0), m.z(1)), m.sigma(0)});
+    }
+  }
+
   /// One recorded throw through a fresh tracker: NIS as the loop counts it (ThrowLoop::consistency),
   /// the innovation cost from the tracker's own update, NEES at the kNeesFusedImage-th fused image.
   void replayThrow(const CatchThrow& t, const tracking::TrackerConfig& tc, double sigma, double eps,
                    detail::InnovationTally& a, RunSeries* series, std::size_t& sample) const {
     if (t.images.empty()) return;
     tracking::ViewlineTracker tracker(t.cameras, tc);
-    const sim::DragFlight flight({t.release, t.launch}, 0.0, t.t_end, cfg_.throws.body);
+    std::optional<sim::DragFlight> flight;
+    if (t.has_truth) flight.emplace(sim::FlightState{t.release, t.launch}, 0.0, t.t_end, cfg_.throws.body);
     int in_track = 0, fused_total = 0;
     for (tracking::ImageMeasurement m : t.images) {
       m.sigma_px = sigma;
@@ -226,10 +280,10 @@ private:
       if (starts) in_track = 0;
       in_track += fused;
       fused_total += fused;
-      if (fused && fused_total == scenarios::kNeesFusedImage && cfg_.object == "ball" && tracker.initialised()) {
+      if (fused && fused_total == scenarios::kNeesFusedImage && cfg_.object == "ball" && flight && tracker.initialised()) {
         const estimation::StateEstimate& s = tracker.state();
-        if (s.t() >= flight.startTime() && s.t() <= flight.endTime()) {
-          const sim::FlightState f = flight.state(s.t());
+        if (s.t() >= flight->startTime() && s.t() <= flight->endTime()) {
+          const sim::FlightState f = flight->state(s.t());
           Eigen::VectorXd x(6);
           x << f.p, f.v;
           a.nees.add(estimation::nees(s, x), 6.0);

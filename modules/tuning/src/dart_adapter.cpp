@@ -18,6 +18,9 @@
 // adapter option `assumed_pixel_noise_px` (> 0) makes the tracker assume another value while the
 // simulation keeps the file's noise — that is how a session starts "10x off". The tuned σ is
 // written to pixel_noise_px: for a real rig that is the detector noise the tracker should assume.
+// A recording (dart_tracking --record DIR) holds the detections themselves (the dart scenario
+// renders no frames): each run's flight of experiment `log_experiment` is replayed as recorded,
+// its truth and outlier flags not read (NIS only).
 //
 // Outlier density for the likelihood mixture (autotune.h): a gross outlier is uniform over the
 // W x H image; the two rows map pixel errors to row residuals with |det| = sqrt(det R2) / σ²
@@ -35,9 +38,11 @@
 #include "adapter_util.h"
 #include "viewline/core/error.h"
 #include "viewline/core/random.h"
+#include "viewline/runtime/recording.h"
 #include "viewline/estimation/consistency.h"
 #include "viewline/scenarios/dart/config.h"
 #include "viewline/scenarios/dart/loop.h"
+#include "viewline/scenarios/dart/recording.h"
 #include "viewline/scenarios/dart/world.h"
 #include "viewline/tracking/tracker.h"
 #include "viewline/tuning/scenario.h"
@@ -76,7 +81,7 @@ detail::OptionTable<DartOptions> dartOptions() {
                "fused images of a track before its innovations count in NIS / likelihood")
       .choice<std::string>("log_experiment", &DartOptions::log_experiment, "A_alternating",
                            {{"A_alternating", "A_alternating"}, {"D_scenario", "D_scenario"}},
-                           "which experiment of a dart_tracking --log folder the auto-tuner replays");
+                           "which experiment of a dart_tracking --log or --record folder the auto-tuner replays");
   return options;
 }
 
@@ -202,6 +207,35 @@ public:
     if (d->items.empty())
       throw core::InvalidInput(path + ": no rows of experiment '" + opt_.log_experiment + "' (adapter option log_experiment)");
     d->source = path + " (" + opt_.log_experiment + ")";
+    return d;
+  }
+
+  /// A dart_tracking --record folder (recording.h: session.json, run_iii.json): the dart scenario's
+  /// frames are its detections, so each run's flight of experiment `log_experiment` is replayed as
+  /// recorded (the tracker's input: id, camera, stamp, pixel). Its truth (the state, the outlier
+  /// flag) and the recorded sigma_px are not read: NIS only, as on a rig's detections.
+  std::unique_ptr<ReplayData> loadRecording(const std::string& dir) const override {
+    if (!std::filesystem::exists(std::filesystem::path(dir) / "session.json"))
+      throw core::InvalidInput(dir + ": not a recording (no session.json, as dart_tracking --record DIR writes)");
+    const runtime::SessionRecording session = runtime::readSessionRecording(dir, "dart_tracking");
+    scenarios::DartFlights flights("", dir, session.seed, session.units, "");
+    core::Rng unused = core::makeRng(0);  // a replayed flight draws nothing
+    auto d = newReplayData();
+    for (int run = 0; run < session.units; ++run) {
+      flights.beginRun(run);
+      Flight fl;
+      fl.has_truth = false;
+      for (const DartDetection& recorded :
+           flights.flight(opt_.log_experiment, cfg_, cams_, opt_.clock, 0.0, unused).detections) {
+        DartDetection det;
+        det.m = recorded.m;
+        det.truth.setZero();
+        fl.dets.push_back(det);
+      }
+      d->items.push_back(std::move(fl));
+    }
+    if (d->measurements() == 0) throw core::InvalidInput(dir + ": no detections of experiment '" + opt_.log_experiment + "'");
+    d->source = "recording " + dir + " (" + opt_.log_experiment + ", " + std::to_string(session.units) + " run(s))";
     return d;
   }
 

@@ -106,6 +106,18 @@ public:
         "of each detection); record live runs instead (viewline_tune autotune without --log, --record-seed N)");
   }
 
+  /// Refused, naming why: a detection becomes the filter's measurement only through the head
+  /// camera's pose at its frame, which a recording does not hold.
+  std::unique_ptr<ReplayData> loadRecording(const std::string& dir) const override {
+    throw core::InvalidInput(
+        "mobile_capture: " + dir +
+        ": tuning on a recording is not supported: a detection becomes the track's measurement (its floor point and "
+        "ground-projection Jacobian) only through the head camera's pose at that frame, i.e. the base's odometry and "
+        "the pan/tilt joints, which move with the closed loop (the head aims at the filter's prediction) and which a "
+        "mobile_capture --record folder does not hold (frames, clocks and the object's truth only); record live runs "
+        "instead (viewline_tune autotune without --recording)");
+  }
+
   ReplayResult replay(const ReplayData& data, const std::vector<double>& noise, double outlier_prior,
                       bool want_series) const override {
     return detail::replayRecording<Chase, detail::InnovationTally>(

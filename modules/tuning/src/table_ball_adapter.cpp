@@ -18,7 +18,12 @@
 // stationary gain, S uses the DARE's a-priori covariance). Gross outliers: uniform over the
 // reachable square (L − 2r)². From a log: the files table_ball_balancing --log writes through
 // its runtime::CsvSink, measurements_ball_acceleration.csv (every frame: t, the filter's input
-// a_xy) and measurements_ball.csv (t, the ball on the table when found).
+// a_xy) and measurements_ball.csv (t, the ball on the table when found). From a recording
+// (table_ball_balancing --record DIR, or a rig's): its frames through the observer as a footage
+// session runs them (scenarios::runTableBallOnRecording: each frame's PnP table pose, the head at
+// its calibrated rest pose, since a recording holds neither the head's sway nor the wrist's tilt),
+// the same (y, a_xy, t) read from the session's telemetry; NIS only. The σv fitted there is the
+// per-frame pose's, not the filtered pose's of a simulated run (table_pose_time_constant).
 //
 // Timing metrics (frame_time_ratio_to_reference) are wall-clock and would make results depend on
 // the machine load, so sweeps run with metrics.time_reference off.
@@ -26,6 +31,7 @@
 #include <cmath>
 #include <filesystem>
 #include <limits>
+#include <map>
 #include <optional>
 
 #include "adapter_util.h"
@@ -33,6 +39,7 @@
 #include "viewline/core/random.h"
 #include "viewline/runtime/telemetry.h"
 #include "viewline/scenarios/table_ball.h"
+#include "viewline/scenarios/table_ball/footage.h"
 #include "viewline/scenarios/table_ball/observer.h"
 #include "viewline/tracking/rolling_ball_tracker.h"
 #include "viewline/tuning/scenario.h"
@@ -112,6 +119,9 @@ std::vector<std::string> metricNames() {
   names.insert(names.end(), {"nis_mean", "nees_mean"});
   return names;
 }
+
+/// Seed of a session over a recording: it draws only the config's injected faults.
+constexpr std::uint64_t kRecordingSeed = 1;
 
 const detail::SeriesLabels kLabels{"t [s]", "ball position error |p_hat - p| [mm]", "t [s]", 2.0, "table x [m]",
                                    "table y [m]"};
@@ -195,6 +205,40 @@ public:
     if (b < balls.rows()) throw core::InvalidInput(balls.where(b) + ": a ball measurement without its frame in " + inputs_path);
     if (d->measurements() == 0) throw core::InvalidInput(balls_path + ": no ball measurements");
     d->source = balls_path;
+    return d;
+  }
+
+  /// A recording's frames through the observer as a footage session runs them
+  /// (scenarios::runTableBallOnRecording): the same measurements (y, a_xy, t) a rig's footage gives
+  /// the filter, from the frames alone; NIS only (a recording of a rig has no truth).
+  std::unique_ptr<ReplayData> loadRecording(const std::string& dir) const override {
+    if (!fs::exists(fs::path(dir) / "recording.csv"))
+      throw core::InvalidInput(dir + ": not a recording (no recording.csv, as table_ball_balancing --record DIR writes)");
+    runtime::MemorySink sink;
+    scenarios::TableBallHooks hooks;
+    hooks.telemetry = &sink;
+    // The seed draws only the config's injected faults (faults:), as in a footage session.
+    const scenarios::TableBallFootageSummary sum = scenarios::runTableBallOnRecording(cfg_, kRecordingSeed, dir, hooks);
+    std::map<double, Eigen::Vector2d> balls;  // a frame's ball measurement, by its stamp
+    for (const runtime::MeasurementRecord& z : sink.measurements)
+      if (z.channel == "ball") balls[z.t] = z.z.head<2>();
+    auto d = newReplayData();
+    d->items.emplace_back();
+    BallRun& run = d->items.back();
+    for (const runtime::MeasurementRecord& z : sink.measurements) {  // every processed frame has its input
+      if (z.channel != "ball_acceleration") continue;
+      BallFrame f;
+      f.t = z.t;
+      f.a_xy = z.z.head<2>();
+      if (const auto b = balls.find(z.t); b != balls.end()) f.y = b->second;
+      run.push_back(f);
+    }
+    if (d->measurements() == 0)
+      throw core::InvalidInput(dir + ": the ball was found in none of the recording's " + std::to_string(sum.frames) +
+                               " frames (nothing to replay)");
+    d->source = "recording " + dir + " (" + std::to_string(sum.frames) +
+                " frames through the observer as on footage: each frame's PnP table pose, the head at its calibrated "
+                "rest pose)";
     return d;
   }
 

@@ -157,6 +157,16 @@ struct CatchFootageSummary {
 CatchFootageSummary runCatchFootage(const BallCatchingConfig& cfg, std::uint64_t seed, const CatchHooks& hooks = {},
                                     runtime::WallClock* clock = nullptr);
 
+/// The same session over the frames of one throw of a viewline recording (`dir` = DIR/throw_iii of
+/// ball_catching --record DIR, or a rig's own recording of its cameras in one index, camera k being
+/// the rig's active camera k; runtime/recording.h): the frames, stamps and lost grabs as recorded,
+/// no truth read (throw.json and truth.csv are not opened). The estimators' cameras are the rig's
+/// calibration as on footage. What the tuning tool's `--recording` runs. Throws core::InvalidInput
+/// naming the folder when it is not a recording, holds no frame or more cameras than the config's
+/// active ones, and for record_dir or replay_dir in `hooks`.
+CatchFootageSummary runCatchFootageOnRecording(const BallCatchingConfig& cfg, std::uint64_t seed, const std::string& dir,
+                                               const CatchHooks& hooks = {});
+
 /// The summary as JSON ("truth": not scored; "registration": off on footage).
 nlohmann::json footageSummaryJson(const CatchFootageSummary& s, const BallCatchingConfig& cfg);
 

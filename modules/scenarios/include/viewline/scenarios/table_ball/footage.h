@@ -86,6 +86,15 @@ std::string tableBallFootageName(const runtime::SourceConfig& source);
 TableBallFootageSummary runTableBallFootage(const TableBallConfig& config, std::uint64_t seed,
                                             const TableBallHooks& hooks = {}, runtime::WallClock* clock = nullptr);
 
+/// The same session over the head camera's frames of a viewline recording folder (DIR of
+/// table_ball_balancing --record DIR, or a rig's own; runtime/recording.h), whatever cfg.source
+/// says: the frames, their stamps and lost grabs as recorded, no truth read (a simulated run's
+/// table and ball are not in the folder). What the tuning tool's `--recording` runs (each frame
+/// through the observer as on footage). Throws core::InvalidInput naming the folder when it is
+/// not a recording, holds more than one camera or no frame, and for the hooks refused above.
+TableBallFootageSummary runTableBallOnRecording(const TableBallConfig& config, std::uint64_t seed,
+                                                const std::string& dir, const TableBallHooks& hooks = {});
+
 /// The summary as JSON ("mode": "footage"; the truth-scored figures null, "truth": not scored).
 nlohmann::json toJson(const TableBallFootageSummary& s);
 
