@@ -599,7 +599,8 @@ tracking::PlanarHistory randomHistory(core::Rng& rng, int n, int dim) {
 
 TEST(PlanarTargetFilter, JumpScanEqualsTheScanAsFirstWritten) {
   // Constant-velocity, coordinated-turn (the curved fit) and constant-acceleration states; hard test and
-  // soft mixture (kink or given Bayes factors, region odds or not, test or posterior decision): the
+  // soft mixture (kink or given Bayes factors, region odds or not, test or posterior decision; variant 3 is
+  // the shipped mixture's posterior decision on the legs' Bayes factors, where the scan fits nothing): the
   // same jump and the same log odds to the last bit.
   core::Rng rng = core::makeRng(17);
   int scans = 0, jumps = 0;
@@ -610,18 +611,18 @@ TEST(PlanarTargetFilter, JumpScanEqualsTheScanAsFirstWritten) {
       std::vector<double> region(static_cast<std::size_t>(n));
       for (double& v : region) v = core::uniform(rng, -6.0, -1.0);
       for (const bool soft : {false, true}) {
-        for (const int variant : {0, 1, 2}) {
+        for (const int variant : {0, 1, 2, 3}) {
           tracking::JumpScanSettings st;
           st.min_samples = 3 + variant * 2;
           st.threshold = 15.0;
           st.soft = soft;
           st.jump_rate = 1.0;
           st.prior_sigma = 0.2;
-          st.posterior_decision = variant == 2;
+          st.posterior_decision = variant >= 2;
           st.posterior_mass = 0.99;
           std::function<double(int)> leg;
-          if (variant == 1) leg = [](int j) { return 0.1 * j - 2.0; };
-          const std::vector<double> odds_j = variant == 2 ? region : std::vector<double>{};
+          if (variant == 1 || variant == 3) leg = [](int j) { return 0.1 * j - 2.0; };
+          const std::vector<double> odds_j = variant >= 2 ? region : std::vector<double>{};
           const tracking::JumpScan ours = tracking::scanForJump(h, st, leg, odds_j);
           const tracking::JumpScan ref = scanForJumpAsWritten(h, st, leg, odds_j);
           EXPECT_EQ(ours.jump, ref.jump) << dim << " " << n << " " << soft << " " << variant;
@@ -637,7 +638,7 @@ TEST(PlanarTargetFilter, JumpScanEqualsTheScanAsFirstWritten) {
       }
     }
   }
-  EXPECT_EQ(scans, 3 * 3 * 2 * 3);
+  EXPECT_EQ(scans, 3 * 3 * 2 * 4);
   EXPECT_GT(jumps, 5);    // the kinks are found: the jump index is compared, not only -1
   EXPECT_GT(odds, 500u);  // and many soft-mixture odds
 }
