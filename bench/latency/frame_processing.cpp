@@ -246,7 +246,7 @@ PanTiltFigures panTilt(const std::string& config, double seconds, std::size_t fr
   cfg.duration = seconds;
   cfg.metrics_start = std::min(cfg.metrics_start, 0.5 * seconds);  // scoring only; short recordings
   cfg.run_baseline = false;
-  PanTiltRecorder rec(200);
+  PanTiltRecorder rec(static_cast<std::size_t>(std::ceil(seconds * cfg.fps)) + 20);  // every frame of the run
   scenarios::PanTiltRunIo io;
   io.frames = &rec;
   scenarios::runPanTilt(cfg, 1, scenarios::PanTiltControllerKind::Predictive, io);
