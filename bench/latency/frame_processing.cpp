@@ -8,6 +8,8 @@
 // and the controller.
 // Pan-tilt (640x480, config/pan_tilt_rectangle.yaml): the predictive controller's frames of the
 // first --record-seconds (6 s), replayed through detection, back-projection, target filter and law.
+// Every frame is kept (0.9 MB each): 6 s end before the filter's steady state (the legs' corner
+// evidence starts after the first corner); --pan-tilt-only --record-seconds 30 covers it.
 // Ball catching (656x480, the default config's two cameras): the frames of real throws are
 // recorded from the scenario (catch_pipeline.h) and replayed through detector, tracker and
 // planner, pass after pass (the tracker and planner restart at each pass), until --frames frames
