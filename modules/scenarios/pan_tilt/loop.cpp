@@ -282,6 +282,9 @@ PanTiltRunMetrics runPanTilt(const PanTiltScenarioConfig& cfg, std::uint64_t see
   runtime::Scheduler sched;
   sched.setPacing(hardware && !io.pacing.paced() ? runtime::Pacing{1.0} : io.pacing);
   std::size_t grabbed = 0;
+  // The detector's last pixel: it looks around it first (a window instead of the whole frame; the same
+  // detection whenever the disc is inside it, else the full frame: screen_target_detector.h).
+  std::optional<Vector2d> last_detected_px;
   // The camera's half of a frame: grab, detect, measure, and send the observation on.
   std::function<void(double)> capture = [&](double) {
     const std::size_t k = grabbed++;
@@ -318,7 +321,9 @@ PanTiltRunMetrics runPanTilt(const PanTiltScenarioConfig& cfg, std::uint64_t see
       control::TargetObservation& obs = p.obs;
       obs.stamp = frame->stamp;
       const auto det = runtime::guardedDetect(faults, frame->camera, tc,
-                                              [&] { return detector.detect(frame->image, frame->stamp); });
+                                              [&] { return detector.detect(frame->image, frame->stamp, last_detected_px); });
+      last_detected_px.reset();
+      if (det && det->ok()) last_detected_px = det->value().pixel;
       std::optional<Vector2d> det_px;
       if (det && det->ok())
         det_px = faults.detected(frame->camera, tc, det->value().pixel, frame->image.cols, frame->image.rows);

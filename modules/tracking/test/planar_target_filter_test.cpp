@@ -599,7 +599,8 @@ tracking::PlanarHistory randomHistory(core::Rng& rng, int n, int dim) {
 
 TEST(PlanarTargetFilter, JumpScanEqualsTheScanAsFirstWritten) {
   // Constant-velocity, coordinated-turn (the curved fit) and constant-acceleration states; hard test and
-  // soft mixture (kink or given Bayes factors, region odds or not, test or posterior decision): the
+  // soft mixture (kink or given Bayes factors, region odds or not, test or posterior decision; variant 3 is
+  // the shipped mixture's posterior decision on the legs' Bayes factors, where the scan fits nothing): the
   // same jump and the same log odds to the last bit.
   core::Rng rng = core::makeRng(17);
   int scans = 0, jumps = 0;
@@ -610,18 +611,18 @@ TEST(PlanarTargetFilter, JumpScanEqualsTheScanAsFirstWritten) {
       std::vector<double> region(static_cast<std::size_t>(n));
       for (double& v : region) v = core::uniform(rng, -6.0, -1.0);
       for (const bool soft : {false, true}) {
-        for (const int variant : {0, 1, 2}) {
+        for (const int variant : {0, 1, 2, 3}) {
           tracking::JumpScanSettings st;
           st.min_samples = 3 + variant * 2;
           st.threshold = 15.0;
           st.soft = soft;
           st.jump_rate = 1.0;
           st.prior_sigma = 0.2;
-          st.posterior_decision = variant == 2;
+          st.posterior_decision = variant >= 2;
           st.posterior_mass = 0.99;
           std::function<double(int)> leg;
-          if (variant == 1) leg = [](int j) { return 0.1 * j - 2.0; };
-          const std::vector<double> odds_j = variant == 2 ? region : std::vector<double>{};
+          if (variant == 1 || variant == 3) leg = [](int j) { return 0.1 * j - 2.0; };
+          const std::vector<double> odds_j = variant >= 2 ? region : std::vector<double>{};
           const tracking::JumpScan ours = tracking::scanForJump(h, st, leg, odds_j);
           const tracking::JumpScan ref = scanForJumpAsWritten(h, st, leg, odds_j);
           EXPECT_EQ(ours.jump, ref.jump) << dim << " " << n << " " << soft << " " << variant;
@@ -637,7 +638,53 @@ TEST(PlanarTargetFilter, JumpScanEqualsTheScanAsFirstWritten) {
       }
     }
   }
-  EXPECT_EQ(scans, 3 * 3 * 2 * 3);
+  EXPECT_EQ(scans, 3 * 3 * 2 * 4);
   EXPECT_GT(jumps, 5);    // the kinks are found: the jump index is compared, not only -1
   EXPECT_GT(odds, 500u);  // and many soft-mixture odds
+}
+
+TEST(PlanarTargetFilter, LegPriorTablesGiveTheEvaluatedPriorBitForBit) {
+  // The filter's memo hands legs their logPrior on the evidence grid and on moments()' first grid: with the
+  // tables, logEvidence and moments() must return what they return evaluating logPrior point by point
+  // (region prior and learnt-turn mixture both on, the case with a normalisation).
+  core::Rng rng = core::makeRng(41);
+  int compared = 0;
+  for (int trial = 0; trial < 6; ++trial) {
+    tracking::ConstantSpeedLeg leg;
+    leg.t_c = 1.0;
+    leg.region = true;
+    leg.region_lo = Eigen::Vector2d(-0.4, -0.2);
+    leg.region_hi = Eigen::Vector2d(0.4, 0.2);
+    leg.region_c = Eigen::Vector2d(core::uniform(rng, -0.35, 0.35), core::uniform(rng, -0.18, 0.18));
+    leg.region_log_scale = std::log(core::kPi / (0.8 * 0.4));
+    const double from = core::uniform(rng, -core::kPi, core::kPi);
+    for (int k = 0; k < 3; ++k) leg.prior_mu.push_back(from + core::uniform(rng, -2.0, 2.0));
+    leg.prior_weight = 0.25;
+    leg.prior_sigma = 4.0 * core::kPi / 180.0;
+    leg.log_norm = core::uniform(rng, -0.5, 0.5);
+    leg.beta0 << leg.region_c, 0.15;
+    leg.P0_inv = Eigen::Vector3d(1e4, 1e4, 4e4).asDiagonal();
+    const double th = core::uniform(rng, -core::kPi, core::kPi);
+    const Eigen::Matrix2d R = 1e-4 * Eigen::Matrix2d::Identity();
+    for (int i = 1; i <= 5 + 10 * trial; ++i) {
+      const double t = leg.t_c + i / 30.0;
+      const Eigen::Vector2d z = leg.region_c + 0.15 * (t - leg.t_c) * Eigen::Vector2d(std::cos(th), std::sin(th)) +
+                                0.01 * Eigen::Vector2d(core::gaussian(rng), core::gaussian(rng));
+      leg.add(t, z, R);
+    }
+    tracking::ConstantSpeedLeg tabled = leg;
+    const int points = tracking::legEvidencePoints(4.0);
+    tabled.log_prior_evidence = std::make_shared<const std::vector<double>>(leg.logPriorOnGrid(points, true));
+    tabled.log_prior_moments = std::make_shared<const std::vector<double>>(leg.logPriorOnGrid(180, false));
+    EXPECT_EQ(tabled.logEvidence(points), leg.logEvidence(points)) << trial;
+    EXPECT_EQ(tabled.logEvidence(360), leg.logEvidence(360)) << trial;  // (no table of that size: evaluated)
+    const estimation::StateEstimate a = tabled.moments(leg.t_c + 2.0), b = leg.moments(leg.t_c + 2.0);
+    EXPECT_EQ(a.x(), b.x()) << trial;
+    EXPECT_EQ(a.P(), b.P()) << trial;
+    // A table is what logPrior gives at its points (the moments grid's θ_k = −π + (2π/180) k).
+    const double step = 2.0 * core::kPi / 180.0;
+    for (int k = 0; k < 180; k += 17) EXPECT_EQ((*tabled.log_prior_moments)[static_cast<std::size_t>(k)], leg.logPrior(-core::kPi + step * k));
+    ++compared;
+  }
+  EXPECT_EQ(compared, 6);
 }

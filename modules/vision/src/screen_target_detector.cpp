@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <optional>
 #include <opencv2/core/hal/intrin.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -27,6 +28,8 @@ void ScreenTargetDetectorConfig::validate() const {
     throw core::InvalidInput("ScreenTargetDetectorConfig.min_fill must be in [0, 1]");
   core::requirePositive(edge_noise_px, "ScreenTargetDetectorConfig.edge_noise_px");
   core::requirePositive(min_sigma_px, "ScreenTargetDetectorConfig.min_sigma_px");
+  if (window_half_size_px < 0)
+    throw core::InvalidInput("ScreenTargetDetectorConfig.window_half_size_px must be >= 0 (0: always the full frame)");
 }
 
 namespace {
@@ -60,22 +63,29 @@ int lastNonZero(const std::uint8_t* p, int n) {
 }  // namespace
 
 BinaryBlobMoments medianBlobMoments(const cv::Mat& binary, int ksize, std::vector<std::int32_t>& scratch) {
+  return medianBlobMoments(binary, ksize, scratch, cv::Rect(0, 0, binary.cols, binary.rows));
+}
+
+BinaryBlobMoments medianBlobMoments(const cv::Mat& binary, int ksize, std::vector<std::int32_t>& scratch,
+                                    const cv::Rect& foreground_roi) {
   if (binary.type() != CV_8UC1 || binary.empty())
     throw core::InvalidInput("medianBlobMoments: expected a non-empty CV_8UC1 image");
   if (ksize < 1 || ksize % 2 == 0) throw core::InvalidInput("medianBlobMoments: ksize must be odd and >= 1");
   const int W = binary.cols, H = binary.rows, r = ksize / 2;
+  const cv::Rect roi = foreground_roi & cv::Rect(0, 0, W, H);
   // The median of k² values in {0, 255} is 255 iff at least (k² + 1) / 2 of them are 255: the filter is
   // a majority vote over the window (cv::medianBlur replicates the border, as the clamps below do). A
   // pixel whose window holds no foreground stays 0, so only the input foreground's box grown by r is
   // filtered.
   const int need = (ksize * ksize + 1) / 2;
+  // (Only the roi is searched: the caller guarantees 0 outside it.)
   int fx0 = W, fx1 = -1, fy0 = H, fy1 = -1;
-  for (int y = 0; y < H; ++y) {
-    const std::uint8_t* row = binary.ptr<std::uint8_t>(y);
-    const int first = firstNonZero(row, W);
+  for (int y = roi.y; y < roi.y + roi.height; ++y) {
+    const std::uint8_t* row = binary.ptr<std::uint8_t>(y) + roi.x;
+    const int first = firstNonZero(row, roi.width);
     if (first < 0) continue;
-    fx0 = std::min(fx0, first);
-    fx1 = std::max(fx1, lastNonZero(row, W));
+    fx0 = std::min(fx0, roi.x + first);
+    fx1 = std::max(fx1, roi.x + lastNonZero(row, roi.width));
     if (fy1 < 0) fy0 = y;
     fy1 = y;
   }
@@ -224,10 +234,25 @@ ScreenTargetDetector::ScreenTargetDetector(ScreenTargetDetectorConfig config)
   config_.validate();
 }
 
-Result<ScreenTargetMeasurement> ScreenTargetDetector::detect(const cv::Mat& image,
-                                                             core::Timestamp stamp) {
+namespace {
+// True when a row or column on the edge of `win` (inside `binary`) holds a foreground pixel.
+bool edgeHasForeground(const cv::Mat& binary, const cv::Rect& win) {
+  const std::uint8_t* top = binary.ptr<std::uint8_t>(win.y) + win.x;
+  const std::uint8_t* bottom = binary.ptr<std::uint8_t>(win.y + win.height - 1) + win.x;
+  if (firstNonZero(top, win.width) >= 0 || firstNonZero(bottom, win.width) >= 0) return true;
+  for (int y = win.y; y < win.y + win.height; ++y) {
+    const std::uint8_t* row = binary.ptr<std::uint8_t>(y);
+    if (row[win.x] != 0 || row[win.x + win.width - 1] != 0) return true;
+  }
+  return false;
+}
+}  // namespace
+
+Result<ScreenTargetMeasurement> ScreenTargetDetector::detect(const cv::Mat& image, core::Timestamp stamp,
+                                                             const std::optional<Eigen::Vector2d>& predicted) {
   requireGrayOrBgrImage(image, "ScreenTargetDetector::detect");
   core::requireFinite(stamp, "ScreenTargetDetector::detect: stamp");
+  used_window_ = false;
   const int w = image.cols - config_.crop_left - config_.crop_right;
   const int h = image.rows - config_.crop_top - config_.crop_bottom;
   if (w < 8 || h < 8)
@@ -236,7 +261,15 @@ Result<ScreenTargetMeasurement> ScreenTargetDetector::detect(const cv::Mat& imag
   const cv::Rect crop(config_.crop_left, config_.crop_top, w, h);
   const double s = config_.scale;
   double level = config_.threshold;
-  if (config_.threshold >= 0 && s == 0.5 && w % 2 == 0 && h % 2 == 0) {
+  const bool one_pass = config_.threshold >= 0 && s == 0.5 && w % 2 == 0 && h % 2 == 0;
+  if (one_pass && predicted && config_.window_half_size_px > 0 && predicted->allFinite()) {
+    if (auto r = detectInWindow(image(crop), *predicted, stamp)) {
+      used_window_ = true;
+      return std::move(*r);
+    }
+  }
+  binary_clean_ = false;
+  if (one_pass) {
     // 1.-3. crop, grey, resize 50 %, binarise (target = 255) in one pass (halfScaleBinary: the same
     // image as the OpenCV calls below, bit for bit)
     halfScaleBinary(image(crop), config_.threshold, config_.dark_target, binary_);
@@ -260,7 +293,47 @@ Result<ScreenTargetMeasurement> ScreenTargetDetector::detect(const cv::Mat& imag
   }
   // 4.-5. median filter, then the centroid and bounding box of the binary image (medianBlobMoments:
   // cv::medianBlur + cv::moments + cv::boundingRect bit for bit, over the foreground's neighbourhood only).
-  const BinaryBlobMoments m = medianBlobMoments(binary_, config_.median_ksize, scratch_);
+  return measure(medianBlobMoments(binary_, config_.median_ksize, scratch_), level, stamp);
+}
+
+std::optional<Result<ScreenTargetMeasurement>> ScreenTargetDetector::detectInWindow(const cv::Mat& cropped,
+                                                                                    const Eigen::Vector2d& predicted,
+                                                                                    core::Timestamp stamp) {
+  // The half-resolution image is (cropped.cols / 2) x (cropped.rows / 2); the predicted pixel maps to
+  // q = (u − crop_left + 0.5) s − 0.5 there (the inverse of the header's u = crop_left + (q + 0.5) / s − 0.5).
+  const int W = cropped.cols / 2, H = cropped.rows / 2;
+  const double s = config_.scale;
+  const double qu = (predicted.x() - config_.crop_left + 0.5) * s - 0.5;
+  const double qv = (predicted.y() - config_.crop_top + 0.5) * s - 0.5;
+  const double half = std::ceil(config_.window_half_size_px * s);
+  // (Clamped in double first: a prediction far off the image must not overflow the int conversion.)
+  const auto lo = [half](double q, int n) { return static_cast<int>(std::clamp(std::floor(q - half), 0.0, double(n))); };
+  const auto hi = [half](double q, int n) { return static_cast<int>(std::clamp(std::floor(q + half) + 1.0, 0.0, double(n))); };
+  const int x0 = lo(qu, W), x1 = hi(qu, W), y0 = lo(qv, H), y1 = hi(qv, H);
+  if (x1 - x0 < 3 || y1 - y0 < 3) return std::nullopt;  // the prediction is off the image
+  if (x1 - x0 == W && y1 - y0 == H) return std::nullopt;  // the window is the whole frame
+  if (!binary_clean_ || binary_.rows != H || binary_.cols != W || binary_.type() != CV_8UC1) {
+    binary_.create(H, W, CV_8UC1);
+    binary_.setTo(0);
+    binary_clean_ = true;
+  }
+  const cv::Rect win(x0, y0, x1 - x0, y1 - y0);
+  cv::Mat part = binary_(win);
+  halfScaleBinary(cropped(cv::Rect(2 * x0, 2 * y0, 2 * win.width, 2 * win.height)), config_.threshold,
+                  config_.dark_target, part);
+  std::optional<Result<ScreenTargetMeasurement>> out;
+  // Foreground on the window's edge may continue outside it: the full frame decides.
+  if (!edgeHasForeground(binary_, win)) {
+    auto r = measure(medianBlobMoments(binary_, config_.median_ksize, scratch_, win), config_.threshold, stamp);
+    if (r.ok()) out = std::move(r);  // a failure (no target here, too small, ...): the full frame decides
+  }
+  part.setTo(0);  // binary_ stays all 0 for the next window
+  return out;
+}
+
+Result<ScreenTargetMeasurement> ScreenTargetDetector::measure(const BinaryBlobMoments& m, double level,
+                                                              core::Timestamp stamp) const {
+  const double s = config_.scale;
   const double full_area = m.m00 / (s * s);
   if (m.m00 <= 0.0)
     return Result<ScreenTargetMeasurement>::fail(FailureReason::NotFound,

@@ -7,6 +7,7 @@
 
 #include "synthetic.h"
 #include "viewline/core/error.h"
+#include "viewline/core/frames.h"
 #include "viewline/vision/color.h"
 #include "viewline/vision/screen_target_detector.h"
 
@@ -216,6 +217,105 @@ TEST(ScreenTargetDetector, DetectionEqualsOpenCvPipelineOnRenderedFrames) {
     }
   }
   EXPECT_GE(detected, 10);  // most discs lie inside the crop
+}
+
+TEST(ScreenTargetDetector, WindowEqualsFullFrameBitForBit) {
+  // The window pass against the full frame on noisy grey and BGR discs, predictions near and far from the
+  // disc (in the window, cut by its edge, elsewhere, off the image): every result equal to the last bit,
+  // and the window used whenever the disc lies inside it.
+  core::Rng rng = core::makeRng(23);
+  ScreenTargetDetectorConfig cfg;
+  cfg.crop_left = cfg.crop_top = cfg.crop_right = cfg.crop_bottom = 8;
+  cfg.threshold = 110;
+  cfg.min_area_px = 200;
+  ScreenTargetDetector windowed(cfg), full(cfg);
+  int in_window = 0, fell_back = 0, compared = 0;
+  for (int i = 0; i < 60; ++i) {
+    const double u = core::uniform(rng, 10.0, 630.0), v = core::uniform(rng, 10.0, 470.0);
+    const double radius = core::uniform(rng, 6.0, 40.0);
+    cv::Mat img = test::screenWithDisc(640, 480, u, v, radius);
+    if (i % 2 == 1) {
+      cv::Mat bgr;
+      cv::cvtColor(img, bgr, cv::COLOR_GRAY2BGR);
+      img = bgr;
+    }
+    test::addNoise(img, core::uniform(rng, 0.0, 30.0), rng);
+    const auto ref = full.detect(img, 0.5);
+    for (const double off : {0.0, 3.0, 20.0, 55.0, 90.0, 400.0, 2000.0}) {
+      const double a = core::uniform(rng, 0.0, 2.0 * core::kPi);
+      const Eigen::Vector2d predicted(u + off * std::cos(a), v + off * std::sin(a));
+      const auto r = windowed.detect(img, 0.5, predicted);
+      ++compared;
+      ASSERT_EQ(r.ok(), ref.ok()) << i << " " << off;
+      if (!ref.ok()) {
+        EXPECT_EQ(r.failure().reason, ref.failure().reason);
+        EXPECT_FALSE(windowed.usedWindow());
+        continue;
+      }
+      EXPECT_EQ(r->pixel.x(), ref->pixel.x()) << i << " " << off;
+      EXPECT_EQ(r->pixel.y(), ref->pixel.y()) << i << " " << off;
+      EXPECT_EQ(r->area_px, ref->area_px);
+      EXPECT_EQ(r->fill, ref->fill);
+      EXPECT_EQ(r->pixel_covariance, ref->pixel_covariance);
+      EXPECT_EQ(r->score, ref->score);
+      EXPECT_EQ(r->quality, ref->quality);
+      EXPECT_EQ(r->threshold_used, ref->threshold_used);
+      // A disc well inside the window (its radius + 2 px margin from the predicted pixel's window edge) uses it.
+      if (off + radius + 6.0 < cfg.window_half_size_px) {
+        EXPECT_TRUE(windowed.usedWindow()) << i << " " << off;
+      }
+      (windowed.usedWindow() ? in_window : fell_back) += 1;
+    }
+  }
+  EXPECT_EQ(compared, 60 * 7);
+  EXPECT_GE(in_window, 80);
+  EXPECT_GE(fell_back, 80);
+}
+
+TEST(ScreenTargetDetector, WindowIgnoresOnlyForegroundWhollyOutsideIt) {
+  // A second dark disc far from the prediction: the full frame sees two blobs (Ambiguous); the window sees
+  // the predicted one alone. A disc cut by the window's edge makes it fall back to the full frame.
+  ScreenTargetDetectorConfig cfg;
+  cfg.threshold = 110;
+  cv::Mat img = test::screenWithDisc(640, 480, 200.0, 200.0, 20.0);
+  cv::Mat other = test::screenWithDisc(640, 480, 480.0, 300.0, 20.0);
+  cv::min(img, other, img);
+  ScreenTargetDetector det(cfg);
+  const auto full = det.detect(img, 0.0);
+  ASSERT_FALSE(full.ok());
+  EXPECT_EQ(full.failure().reason, FailureReason::Ambiguous);
+  const auto near = det.detect(img, 0.0, Eigen::Vector2d(205.0, 195.0));
+  ASSERT_TRUE(near.ok());
+  EXPECT_TRUE(det.usedWindow());
+  EXPECT_NEAR(near->pixel.x(), 200.0, 0.3);
+  const auto cut = det.detect(img, 0.0, Eigen::Vector2d(200.0 + 64.0, 200.0));  // the disc crosses the window's edge
+  EXPECT_FALSE(det.usedWindow());
+  ASSERT_FALSE(cut.ok());
+  EXPECT_EQ(cut.failure().reason, FailureReason::Ambiguous);
+  cfg.window_half_size_px = -1;
+  EXPECT_THROW(ScreenTargetDetector{cfg}, core::InvalidInput);
+}
+
+TEST(ScreenTargetDetector, BlobMomentsInARoiEqualTheWholeImage) {
+  // medianBlobMoments told where the foreground lies gives the whole image's moments bit for bit.
+  core::Rng rng = core::makeRng(31);
+  std::vector<std::int32_t> scratch;
+  for (int i = 0; i < 40; ++i) {
+    cv::Mat bin(240, 320, CV_8UC1, cv::Scalar(0));
+    const cv::Rect roi(static_cast<int>(core::uniform(rng, 0.0, 250.0)), static_cast<int>(core::uniform(rng, 0.0, 170.0)),
+                       static_cast<int>(core::uniform(rng, 10.0, 70.0)), static_cast<int>(core::uniform(rng, 10.0, 70.0)));
+    cv::Mat part = bin(roi);
+    for (int y = 0; y < part.rows; ++y)
+      for (int x = 0; x < part.cols; ++x) part.at<std::uint8_t>(y, x) = core::uniform(rng, 0.0, 1.0) < 0.6 ? 255 : 0;
+    for (const int k : {1, 3, 5}) {
+      const BinaryBlobMoments whole = medianBlobMoments(bin, k, scratch);
+      const BinaryBlobMoments in_roi = medianBlobMoments(bin, k, scratch, roi);
+      EXPECT_EQ(in_roi.m00, whole.m00);
+      EXPECT_EQ(in_roi.m10, whole.m10);
+      EXPECT_EQ(in_roi.m01, whole.m01);
+      EXPECT_EQ(in_roi.box, whole.box);
+    }
+  }
 }
 
 TEST(ScreenTargetDetector, RejectsBadConfigAndImages) {

@@ -47,10 +47,16 @@ JumpScan scanForJump(const PlanarHistory& history, const JumpScanSettings& setti
   std::vector<std::pair<double, int>>& log_odds = out.log_odds;  // soft: log(π_j BF_j), j
   const double prior_precision = soft ? 1.0 / (settings.prior_sigma * settings.prior_sigma) : 0.0;
   const bool leg_bf = soft && static_cast<bool>(leg_bayes_factor);  // the soft mixture's Bayes factors from legs, not kinks
+  // What the candidates need: the test statistic l decides only without the posterior decision (with it the
+  // posterior below picks the jump), and the kink fits' Bayes factor only without leg_bayes_factor. The fits
+  // nothing reads are skipped (the shipped mixture: posterior decision and, once the speed is learnt, the
+  // legs' Bayes factors, so no fit at all); the values that are computed are unchanged.
+  const bool need_test = !(soft && settings.posterior_decision);
+  const bool need_kink_bf = soft && !leg_bf;
   for (int j = m; j + (soft ? 2 : m) < n; ++j) {
     const PlanarSnapshot& sj = history[static_cast<std::size_t>(j)];
     const Eigen::VectorXd& xj = sj.state.x();
-    for (int i = 0; i < n; ++i) {
+    for (int i = 0; i < n && (need_test || need_kink_bf); ++i) {
       const PlanarSnapshot& si = history[static_cast<std::size_t>(i)];
       const double ti = si.t - sj.t;
       tau[static_cast<std::size_t>(i)] = ti;
@@ -66,30 +72,33 @@ JumpScan scanForJump(const PlanarHistory& history, const JumpScanSettings& setti
     const bool curved = sigma_gamma > 0.0;  // (CV/CA: no γ column)
     const double gamma_weight = curved ? 1.0 / (sigma_gamma * sigma_gamma) : 1.0;
     double l = 0.0, log_bf = 0.0;
-    for (int a = 0; a < 2; ++a) {
-      // Penalised least squares (γ with its prior, α, β and Δv free) under H0 and H1:
+    if (need_test || need_kink_bf) {
+      // Penalised least squares (γ with its prior, α, β and Δv free) under H0 and H1, per axis a:
       // min ‖r − X θ‖²_W + θᵀ Λ θ = rᵀ W r − (Xᵀ W r)ᵀ (Xᵀ W X + Λ)⁻¹ Xᵀ W r.
       // M = Σ w_i x_i x_iᵀ, g = Σ w_i r_i x_i with x_i = (1, τ, c, p), c = τ² (curved) or 0, p = max(τ, 0).
       // Each entry is summed over i in order with the rounding of Eigen's `M += w * x * xᵀ` (entry (k, l) adds
       // x_l (w x_k)) and `g += w r x` ((w r) x_k), so M and g are the same to the last bit; the terms that
       // are ±0 (c = 0 when not curved, p = 0 for τ <= 0) are skipped: a sum that starts at +0 is not changed
-      // by them. Only the distinct products are formed (x_0 = 1: (0, l) and (l, 0) are both w x_l).
-      double s00 = 0.0, s01 = 0.0, s02 = 0.0, s03 = 0.0, s11 = 0.0, s12 = 0.0, s13 = 0.0, s21 = 0.0, s22 = 0.0,
-             s23 = 0.0, s31 = 0.0, s32 = 0.0, s33 = 0.0;
-      double h0 = 0.0, h1 = 0.0, h2 = 0.0, h3 = 0.0;
+      // by them. Only the distinct products are formed (x_0 = 1: (0, l) and (l, 0) are both w x_l; p = τ
+      // where it is not skipped, so (1, 3), (3, 1) and (3, 3) all add τ (w τ)). Both axes run in one pass,
+      // one per lane of a 2-vector: each lane does the scalar operations in the scalar order.
+      using A2 = Eigen::Array2d;
+      A2 s00 = A2::Zero(), s01 = A2::Zero(), s02 = A2::Zero(), s03 = A2::Zero(), s11 = A2::Zero(), s12 = A2::Zero(),
+         s13 = A2::Zero(), s21 = A2::Zero(), s22 = A2::Zero(), s23 = A2::Zero(), s32 = A2::Zero();
+      A2 h0 = A2::Zero(), h1 = A2::Zero(), h2 = A2::Zero(), h3 = A2::Zero();
       for (int i = 0; i < n; ++i) {
-        const double wi = w[static_cast<std::size_t>(i)](a);
+        const A2 wi = w[static_cast<std::size_t>(i)].array();
         const double ti = tau[static_cast<std::size_t>(i)];
-        const double wr = wi * r[static_cast<std::size_t>(i)](a);
-        const double wt = wi * ti;
+        const A2 wr = wi * r[static_cast<std::size_t>(i)].array();
+        const A2 wt = wi * ti;
         s00 += wi;
         s01 += wt;
         s11 += ti * wt;
         h0 += wr;
         h1 += wr * ti;
-        double ci = 0.0, wc = 0.0;
+        A2 wc = A2::Zero();
+        const double ci = curved ? ti * ti : 0.0;
         if (curved) {
-          ci = ti * ti;
           wc = wi * ci;
           s02 += wc;
           s12 += ci * wt;
@@ -98,39 +107,40 @@ JumpScan scanForJump(const PlanarHistory& history, const JumpScanSettings& setti
           h2 += wr * ci;
         }
         if (ti > 0.0) {
-          const double wp = wi * ti;  // p = τ
-          s03 += wp;
+          s03 += wt;  // w p, p = τ
           s13 += ti * wt;
-          s31 += ti * wp;
-          s33 += ti * wp;
           h3 += wr * ti;
           if (curved) {
             s23 += ti * wc;
-            s32 += ci * wp;
+            s32 += ci * wt;
           }
         }
       }
-      Eigen::Matrix4d M;
-      M << s00, s01, s02, s03,
-           s01, s11, s12, s13,
-           s02, s21, s22, s23,
-           s03, s31, s32, s33;
-      Eigen::Vector4d g(h0, h1, h2, h3);
-      M(2, 2) += gamma_weight;
-      const Eigen::Vector3d g0 = g.head<3>();
-      const auto ldlt0 = M.topLeftCorner<3, 3>().ldlt();
-      const double fit0 = g0.dot(ldlt0.solve(g0));
-      const double fit1 = g.dot(M.ldlt().solve(g));
-      l += fit1 - fit0;
-      if (soft && !leg_bf) {
-        // Bayes factor with Δv_a ~ N(0, jump_prior_sigma²) (α, β flat under both hypotheses):
-        // log BF_a = ½ (fit1' − fit0) − ½ log(det M1' / det M0) − ½ log σ_Δ², M1' = M1 + diag(0, 0, 0, 1/σ_Δ²).
-        Eigen::Matrix4d M1 = M;
-        M1(3, 3) += prior_precision;
-        const auto ldlt1 = M1.ldlt();
-        const double fit1p = g.dot(ldlt1.solve(g));
-        const double logdet1 = ldlt1.vectorD().array().log().sum(), logdet0 = ldlt0.vectorD().array().log().sum();
-        log_bf += 0.5 * (fit1p - fit0) - 0.5 * (logdet1 - logdet0) + 0.5 * std::log(prior_precision);
+      for (int a = 0; a < 2; ++a) {
+        Eigen::Matrix4d M;
+        M << s00(a), s01(a), s02(a), s03(a),
+             s01(a), s11(a), s12(a), s13(a),
+             s02(a), s21(a), s22(a), s23(a),
+             s03(a), s13(a), s32(a), s13(a);
+        Eigen::Vector4d g(h0(a), h1(a), h2(a), h3(a));
+        M(2, 2) += gamma_weight;
+        const Eigen::Vector3d g0 = g.head<3>();
+        const auto ldlt0 = M.topLeftCorner<3, 3>().ldlt();
+        const double fit0 = g0.dot(ldlt0.solve(g0));
+        if (need_test) {
+          const double fit1 = g.dot(M.ldlt().solve(g));
+          l += fit1 - fit0;
+        }
+        if (need_kink_bf) {
+          // Bayes factor with Δv_a ~ N(0, jump_prior_sigma²) (α, β flat under both hypotheses):
+          // log BF_a = ½ (fit1' − fit0) − ½ log(det M1' / det M0) − ½ log σ_Δ², M1' = M1 + diag(0, 0, 0, 1/σ_Δ²).
+          Eigen::Matrix4d M1 = M;
+          M1(3, 3) += prior_precision;
+          const auto ldlt1 = M1.ldlt();
+          const double fit1p = g.dot(ldlt1.solve(g));
+          const double logdet1 = ldlt1.vectorD().array().log().sum(), logdet0 = ldlt0.vectorD().array().log().sum();
+          log_bf += 0.5 * (fit1p - fit0) - 0.5 * (logdet1 - logdet0) + 0.5 * std::log(prior_precision);
+        }
       }
     }
     if (j + m < n && l > best) {

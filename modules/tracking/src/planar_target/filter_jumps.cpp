@@ -190,6 +190,50 @@ void PlanarTargetFilter::applyJump(int best_j) {
   }
 }
 
+const PlanarTargetFilter::LegPriorMemo& PlanarTargetFilter::legPriorMemo(const ConstantSpeedLeg& leg) const {
+  const auto same = [&leg](const LegPriorMemo& e) {
+    return e.region == leg.region && e.region_c == leg.region_c && e.prior_mu == leg.prior_mu &&
+           e.prior_weight == leg.prior_weight && e.prior_sigma == leg.prior_sigma && e.region_lo == leg.region_lo &&
+           e.region_hi == leg.region_hi && e.region_log_scale == leg.region_log_scale;
+  };
+  ++memo_clock_;
+  for (LegPriorMemo& e : leg_prior_memo_) {
+    if (same(e)) {
+      e.used = memo_clock_;
+      return e;
+    }
+  }
+  if (leg_prior_memo_.size() >= kLegPriorMemoSize) {  // drop the least recently used
+    leg_prior_memo_.erase(std::min_element(leg_prior_memo_.begin(), leg_prior_memo_.end(),
+                                           [](const LegPriorMemo& a, const LegPriorMemo& b) { return a.used < b.used; }));
+  }
+  LegPriorMemo e;
+  e.region = leg.region;
+  e.region_c = leg.region_c;
+  e.region_lo = leg.region_lo;
+  e.region_hi = leg.region_hi;
+  e.region_log_scale = leg.region_log_scale;
+  e.prior_mu = leg.prior_mu;
+  e.prior_weight = leg.prior_weight;
+  e.prior_sigma = leg.prior_sigma;
+  ConstantSpeedLeg prior = leg;
+  prior.log_norm = 0.0;
+  if (leg.region && !leg.prior_mu.empty()) {
+    // Both priors: normalise their product on a fine grid (each alone already has mean 1 in 2π p(θ)).
+    constexpr int kPoints = 720;
+    double sum = 0.0;
+    for (int k = 0; k < kPoints; ++k) sum += std::exp(prior.logPrior(-core::kPi + 2.0 * core::kPi * k / kPoints));
+    prior.log_norm = -std::log(sum / kPoints);
+  }
+  e.log_norm = prior.log_norm;
+  e.evidence = std::make_shared<const std::vector<double>>(
+      prior.logPriorOnGrid(legEvidencePoints(config_.turn_prior_sigma_deg), true));
+  e.moments = std::make_shared<const std::vector<double>>(prior.logPriorOnGrid(180, false));
+  e.used = memo_clock_;
+  leg_prior_memo_.push_back(std::move(e));
+  return leg_prior_memo_.back();
+}
+
 ConstantSpeedLeg PlanarTargetFilter::makeLeg(core::Timestamp t_c, const Eigen::Vector2d& c, const Eigen::Matrix2d& P_c,
                                              double from_direction) const {
   ConstantSpeedLeg leg;
@@ -206,14 +250,14 @@ ConstantSpeedLeg PlanarTargetFilter::makeLeg(core::Timestamp t_c, const Eigen::V
     leg.region_hi = region_.hi();
     leg.region_c = region_.clampInside(c);
     leg.region_log_scale = std::log(core::kPi / (config_.region_size.x() * config_.region_size.y()));
-    if (!leg.prior_mu.empty()) {
-      // Both priors: normalise their product on a fine grid (each alone already has mean 1 in 2π p(θ)).
-      constexpr int kPoints = 720;
-      double sum = 0.0;
-      for (int k = 0; k < kPoints; ++k) sum += std::exp(leg.logPrior(-core::kPi + 2.0 * core::kPi * k / kPoints));
-      leg.log_norm = -std::log(sum / kPoints);
-    }
   }
+  // The prior of θ is a function of the fields set above alone, and the scan asks for the same ones at
+  // every measurement (one per candidate corner): the normalisation and the θ grids' logPrior tables are
+  // memoised, keyed by those fields compared exactly, so a hit gives the values a fresh evaluation would.
+  const LegPriorMemo& memo = legPriorMemo(leg);
+  leg.log_norm = memo.log_norm;
+  leg.log_prior_evidence = memo.evidence;
+  leg.log_prior_moments = memo.moments;
   leg.beta0 << c, speed_.estimate();
   Eigen::Matrix3d P0 = Eigen::Matrix3d::Zero();
   P0.topLeftCorner<2, 2>() = P_c + std::pow(cornerSigma(), 2) * Eigen::Matrix2d::Identity();

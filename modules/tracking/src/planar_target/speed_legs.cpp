@@ -77,15 +77,27 @@ double ConstantSpeedLeg::logEvidence(int points) const {
   const Eigen::Vector2d g = Mi * eta_c;
   const double base = zz + beta0.dot(P0_b0) - eta_c.dot(g);
   const Eigen::Vector2d P0_cs = P0_inv.block<2, 1>(0, 2);
+  // The grid's cos and sin (the same θ_k, so the same values) are kept per thread for the last grid size;
+  // logPrior comes from the leg's table when it has one of this size (made from the same prior fields).
+  thread_local std::vector<Eigen::Vector2d> unit;
+  if (static_cast<int>(unit.size()) != points) {
+    unit.resize(static_cast<std::size_t>(points));
+    for (int k = 0; k < points; ++k) {
+      const double th = -core::kPi + 2.0 * core::kPi * k / points;
+      unit[static_cast<std::size_t>(k)] = Eigen::Vector2d(std::cos(th), std::sin(th));
+    }
+  }
+  const double* table = log_prior_evidence && static_cast<int>(log_prior_evidence->size()) == points
+                            ? log_prior_evidence->data() : nullptr;
   std::vector<double> ll(static_cast<std::size_t>(points));
   double top = -std::numeric_limits<double>::infinity();
   for (int k = 0; k < points; ++k) {
-    const double th = -core::kPi + 2.0 * core::kPi * k / points;
-    const Eigen::Vector2d u(std::cos(th), std::sin(th));
+    const Eigen::Vector2d& u = unit[static_cast<std::size_t>(k)];
     const Eigen::Vector2d b = P0_cs + Bt * u;
     const double schur = P0_inv(2, 2) + u.dot(Ctt * u) - b.dot(Mi * b);
     const double r = P0_b0(2) + u.dot(Ctz) - b.dot(g);
-    ll[static_cast<std::size_t>(k)] = -0.5 * (base - r * r / schur) - 0.5 * (logdet_M + std::log(schur)) + logPrior(th);
+    const double prior = table != nullptr ? table[k] : logPrior(-core::kPi + 2.0 * core::kPi * k / points);
+    ll[static_cast<std::size_t>(k)] = -0.5 * (base - r * r / schur) - 0.5 * (logdet_M + std::log(schur)) + prior;
     top = std::max(top, ll[static_cast<std::size_t>(k)]);
   }
   double sum = 0.0;
@@ -99,20 +111,22 @@ estimation::StateEstimate ConstantSpeedLeg::moments(double t) const {
     Eigen::Vector3d m = Eigen::Vector3d::Zero();
     Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
   };
-  const auto evaluate = [&](double th) {
+  const auto evaluate = [&](double th, const double* prior) {
     Point pt;
     pt.th = th;
-    pt.ll = logLikelihood(th, &pt.m, &pt.cov) + logPrior(th);
+    pt.ll = logLikelihood(th, &pt.m, &pt.cov) + (prior != nullptr ? *prior : logPrior(th));
     return pt;
   };
   // Grid over θ: 180 points on the circle, then refined (±2 steps of the previous grid, 81 points)
-  // while one point holds more than 30 % of the mass, so a narrow posterior is still resolved.
+  // while one point holds more than 30 % of the mass, so a narrow posterior is still resolved. The first
+  // grid's logPrior comes from the leg's table when it has one (the same values).
   double lo = -core::kPi, step = 2.0 * core::kPi / 180.0;
   int count = 180;
+  const double* table = log_prior_moments && log_prior_moments->size() == 180 ? log_prior_moments->data() : nullptr;
   std::vector<Point> grid;
   for (int level = 0; level < 6; ++level) {
     grid.clear();
-    for (int k = 0; k < count; ++k) grid.push_back(evaluate(lo + step * k));
+    for (int k = 0; k < count; ++k) grid.push_back(evaluate(lo + step * k, level == 0 && table != nullptr ? table + k : nullptr));
     const auto best = std::max_element(grid.begin(), grid.end(), [](const Point& a, const Point& b) { return a.ll < b.ll; });
     double total = 0.0;
     for (const Point& pt : grid) total += std::exp(pt.ll - best->ll);
@@ -145,6 +159,21 @@ estimation::StateEstimate ConstantSpeedLeg::moments(double t) const {
   P = 0.5 * (P + P.transpose()).eval();
   P.diagonal().array() += 1e-12;
   return estimation::StateEstimate(Eigen::VectorXd(mean), Eigen::MatrixXd(P), t);
+}
+
+std::vector<double> ConstantSpeedLeg::logPriorOnGrid(int points, bool evidence) const {
+  // The θ_k exactly as logEvidence and moments() form them.
+  std::vector<double> out(static_cast<std::size_t>(points));
+  const double step = 2.0 * core::kPi / points;
+  for (int k = 0; k < points; ++k)
+    out[static_cast<std::size_t>(k)] = logPrior(evidence ? -core::kPi + 2.0 * core::kPi * k / points : -core::kPi + step * k);
+  return out;
+}
+
+int legEvidencePoints(double turn_prior_sigma_deg) {
+  // Steps of 3° or the turn prior's σ if smaller: θ's likelihood is wider than ~2° over a few seconds of
+  // leg, so the rectangle rule's relative error stays below ~1e-4 (see logEvidence).
+  return std::max(120, static_cast<int>(std::ceil(360.0 / turn_prior_sigma_deg)));
 }
 
 void LegSpeed::set(double speed, double variance) {
@@ -231,10 +260,7 @@ double legBayesFactor(const PlanarHistory& history, int j, const LegFactory& mak
   const double logdet_P = 2.0 * Eigen::Matrix4d(llt_P.matrixL()).diagonal().array().log().sum();
   const double straight = -0.5 * (zz + x.dot(P_inv * x) - eta.dot(llt_L.solve(eta))) - 0.5 * logdet_L - 0.5 * logdet_P;
   const double logdet_P0 = -std::log(leg.P0_inv.determinant());
-  // Steps of 3° or the turn prior's σ if smaller: θ's likelihood is wider than ~2° over a few seconds of
-  // leg, so the rectangle rule's relative error stays below ~1e-4 (see logEvidence).
-  const int points = std::max(120, static_cast<int>(std::ceil(360.0 / turn_prior_sigma_deg)));
-  return leg.logEvidence(points) - 0.5 * logdet_P0 - straight;
+  return leg.logEvidence(legEvidencePoints(turn_prior_sigma_deg)) - 0.5 * logdet_P0 - straight;
 }
 
 int refineCornerTime(const PlanarHistory& history, int j, const LegFactory& make) {

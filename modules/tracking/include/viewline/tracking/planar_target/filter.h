@@ -160,6 +160,24 @@ private:
   ConstantSpeedLeg makeLeg(core::Timestamp t_c, const Eigen::Vector2d& c, const Eigen::Matrix2d& P_c,
                            double from_direction) const;
   LegFactory legFactory() const;  ///< makeLeg with the priors at the time of the call
+  /// A leg prior's normalisation and logPrior tables (ConstantSpeedLeg), keyed by the fields logPrior reads.
+  struct LegPriorMemo {
+    bool region = false;  ///< key: ConstantSpeedLeg::region
+    Eigen::Vector2d region_c = Eigen::Vector2d::Zero(),   ///< key: ConstantSpeedLeg::region_c, m
+                    region_lo = Eigen::Vector2d::Zero(),  ///< key: ConstantSpeedLeg::region_lo, m
+                    region_hi = Eigen::Vector2d::Zero();  ///< key: ConstantSpeedLeg::region_hi, m
+    double region_log_scale = 0.0;  ///< key: ConstantSpeedLeg::region_log_scale
+    std::vector<double> prior_mu;   ///< key: ConstantSpeedLeg::prior_mu, rad
+    double prior_weight = 0.0,      ///< key: ConstantSpeedLeg::prior_weight
+           prior_sigma = 0.0;       ///< key: ConstantSpeedLeg::prior_sigma, rad
+    double log_norm = 0.0;          ///< the normalisation for these fields
+    std::shared_ptr<const std::vector<double>> evidence,  ///< logPrior on legBayesFactor's grid
+                                               moments;   ///< logPrior on moments()' first grid
+    std::uint64_t used = 0;         ///< last use (memo_clock_), for dropping the least recent
+  };
+  /// The memo entry of this leg's prior fields (made on a miss).
+  const LegPriorMemo& legPriorMemo(const ConstantSpeedLeg& leg) const;
+  static constexpr std::size_t kLegPriorMemoSize = 256;  ///< entries kept (a scan asks for ~1 per measurement of the window)
   estimation::StateEstimate reopened(const Snapshot& sj) const;  ///< x(j|j) with the motion prior re-opened
   estimation::StateEstimate alternative(int j) const;            ///< the state now after a jump at history_[j]
   bool legEvidenceMixture() const;    ///< the soft mixture's Bayes factors from constant-speed legs
@@ -182,6 +200,8 @@ private:
   LearntTurns turns_;
   WaypointRegion region_;
   std::shared_ptr<const ConstantSpeedLeg> leg_;  ///< the current leg (immutable: copies share it until it changes)
+  mutable std::vector<LegPriorMemo> leg_prior_memo_;  ///< legPriorMemo's entries (a cache: no effect on values)
+  mutable std::uint64_t memo_clock_ = 0;              ///< counts legPriorMemo calls
   std::optional<estimation::StateEstimate> output_;  ///< the soft mixture, when it differs from state_
   PlanarHistory history_;  ///< measurements of the last jump_window s (since the last jump)
   std::size_t jumps_ = 0;

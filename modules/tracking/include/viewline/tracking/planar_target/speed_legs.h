@@ -36,6 +36,7 @@
 #include <Eigen/Core>
 #include <functional>
 #include <limits>
+#include <memory>
 #include <vector>
 
 #include "viewline/core/time.h"
@@ -65,6 +66,11 @@ struct ConstantSpeedLeg {
   Eigen::Vector2d Bz = Eigen::Vector2d::Zero(),   ///< B_z = Σ R_i⁻¹ z_i
                   Ctz = Eigen::Vector2d::Zero();  ///< C_τz = Σ τ_i R_i⁻¹ z_i
   double zz = 0.0;  ///< Σ z_iᵀ R_i⁻¹ z_i
+  /// Optional: logPrior(θ_k) at θ_k = −π + 2π k / N, k < N = its size (logEvidence(N) reads it instead of
+  /// evaluating logPrior; the same values, made by logPriorOnGrid from this leg's prior fields).
+  std::shared_ptr<const std::vector<double>> log_prior_evidence;
+  /// Optional: logPrior(θ_k) at θ_k = −π + (2π / 180) k, k < 180: moments()' first grid, as above.
+  std::shared_ptr<const std::vector<double>> log_prior_moments;
 
   /// Adds the measurement z (covariance R) at t to the statistics.
   void add(double t, const Eigen::Vector2d& z, const Eigen::Matrix2d& R);
@@ -76,7 +82,13 @@ struct ConstantSpeedLeg {
   double logEvidence(int points = 360) const;
   /// The posterior moments of (p, v) at time t (p = c + s (t − t_c) u, v = s u).
   estimation::StateEstimate moments(double t) const;
+  /// logPrior on the evidence grid of `points` (evidence = true: θ_k = −π + 2π k / points) or on moments()'
+  /// first grid (θ_k = −π + (2π / points) k), for the tables above.
+  std::vector<double> logPriorOnGrid(int points, bool evidence) const;
 };
+
+/// The θ grid legBayesFactor integrates on: steps of 3° or the turn prior's σ (deg) if smaller.
+int legEvidencePoints(double turn_prior_sigma_deg);
 
 /// Makes the leg from the corner (t_c, c ~ N(c, P_c)); from_direction: the direction (rad) of the leg
 /// that ended there, centre of the learnt turn prior (NaN: θ uniform). The filter's current priors.
