@@ -25,17 +25,10 @@ using namespace viewline::runtime;
 
 namespace {
 
-/// A wall clock that moves only when told to (sleepUntil jumps to the time asked for).
-class TestClock : public WallClock {
+/// The manual clock from an arbitrary origin: the source's times are relative to its first grab.
+class TestClock : public ManualClock {
 public:
-  double now() const override { return t_; }
-  void sleepUntil(double t) override {
-    if (t > t_) t_ = t;
-  }
-  void advance(double dt) { t_ += dt; }
-
-private:
-  double t_ = 100.0;  // any origin: the source's times are relative to its first grab
+  TestClock() : ManualClock(100.0) {}
 };
 
 /// `n` 16x16 grey images seq/image.%04d.pgm, frame i filled with the value 10 i (distinct, so the

@@ -405,14 +405,14 @@ nlohmann::json crossingJson(const std::optional<planning::Crossing>& c) {
 
 }  // namespace
 
-std::string footageSessionText(const FootageSessionCounts& n, const std::vector<FootageCamera>& cameras) {
+std::string footageSessionText(const std::string& scenario, const FootageSessionCounts& n) {
   std::string out;
   char line[512];
   std::snprintf(line, sizeof line, "%s on footage: one session, stamps %.3f to %.3f s, %llu frames, %llu detections\n",
-                n.scenario.c_str(), n.t_first, n.t_last, static_cast<unsigned long long>(n.frames),
+                scenario.c_str(), n.t_first, n.t_last, static_cast<unsigned long long>(n.frames),
                 static_cast<unsigned long long>(n.detections));
   out += line;
-  for (const auto& c : cameras) {
+  for (const auto& c : n.cameras) {
     std::snprintf(line, sizeof line, "  camera %-8s %s: %llu frames, %llu lost, %llu detections\n", c.name.c_str(),
                   c.source.c_str(), static_cast<unsigned long long>(c.frames), static_cast<unsigned long long>(c.lost),
                   static_cast<unsigned long long>(c.detections));
@@ -425,12 +425,22 @@ std::string footageSessionText(const FootageSessionCounts& n, const std::vector<
   return out;
 }
 
-nlohmann::json footageCamerasJson(const std::vector<FootageCamera>& cameras) {
+nlohmann::json footageSessionJson(const std::string& scenario, const FootageSessionCounts& n) {
   nlohmann::json cams = nlohmann::json::array();
-  for (const auto& c : cameras)
+  for (const auto& c : n.cameras)
     cams.push_back({{"name", c.name}, {"source", c.source}, {"frames", c.frames}, {"lost", c.lost},
                     {"detections", c.detections}});
-  return cams;
+  return {{"scenario", scenario},
+          {"mode", "footage"},
+          {"seed", n.seed},
+          {"cameras", cams},
+          {"footage_s", {{"first_stamp", n.t_first}, {"last_stamp", n.t_last}}},
+          {"frames", n.frames},
+          {"detections", n.detections},
+          {"fused", n.fused},
+          {"gated", n.gated},
+          {"refused", n.refused},
+          {"tracks_started", n.tracks_started}};
 }
 
 std::string footageLiveText(const std::optional<runtime::LiveReport>& live) {
@@ -439,7 +449,6 @@ std::string footageLiveText(const std::optional<runtime::LiveReport>& live) {
 }
 
 nlohmann::json footageSummaryJson(const CatchFootageSummary& s, const BallCatchingConfig& cfg) {
-  const nlohmann::json cams = footageCamerasJson(s.cameras);
   nlohmann::json tracks = nlohmann::json::array();
   for (const auto& t : s.tracks) {
     nlohmann::json j = {{"track", t.track},
@@ -459,39 +468,26 @@ nlohmann::json footageSummaryJson(const CatchFootageSummary& s, const BallCatchi
                                  : nlohmann::json(nullptr);
     tracks.push_back(j);
   }
-  nlohmann::json j = {{"scenario", cfg.name},
-                      {"mode", "footage"},
-                      {"seed", s.seed},
-                      {"cameras", cams},
-                      {"footage_s", {{"first_stamp", s.t_first}, {"last_stamp", s.t_last}}},
-                      {"frames", s.frames},
-                      {"detections", s.detections},
-                      {"fused", s.fused},
-                      {"gated", s.gated},
-                      {"refused", s.refused},
-                      {"tracks_started", s.tracks_started},
-                      {"tracks", tracks},
-                      {"robot",
-                       {{"commands", s.commands},
-                        {"limit_violations", s.limit_violations},
-                        {"refused_setpoints", s.refused_setpoints},
-                        {"max_speed", s.max_speed},
-                        {"max_acceleration", s.max_acceleration},
-                        {"v_max", cfg.robot.limits.v_max.x()},
-                        {"a_max", cfg.robot.limits.a_max.x()}}},
-                      {"catch_rate_all", nullptr},
-                      {"truth", "not scored (the frame source has no truth)"},
-                      {"registration", "off on footage (the rig's calibration is used as registered)"},
-                      {"wall_time_s", s.wall_s}};
+  nlohmann::json j = footageSessionJson(cfg.name, s);
+  j["tracks"] = tracks;
+  j["robot"] = {{"commands", s.commands},
+                {"limit_violations", s.limit_violations},
+                {"refused_setpoints", s.refused_setpoints},
+                {"max_speed", s.max_speed},
+                {"max_acceleration", s.max_acceleration},
+                {"v_max", cfg.robot.limits.v_max.x()},
+                {"a_max", cfg.robot.limits.a_max.x()}};
+  j["catch_rate_all"] = nullptr;
+  j["truth"] = "not scored (the frame source has no truth)";
+  j["registration"] = "off on footage (the rig's calibration is used as registered)";
+  j["wall_time_s"] = s.wall_s;
   if (s.live) j["live"] = runtime::toJson(*s.live);
   if (!s.faults.empty()) j["faults"] = runtime::toJson(s.faults);
   return j;
 }
 
 std::string footageSummaryText(const CatchFootageSummary& s, const BallCatchingConfig& cfg) {
-  std::string out = footageSessionText(
-      {cfg.name, s.t_first, s.t_last, s.frames, s.detections, s.fused, s.gated, s.refused, s.tracks_started},
-      s.cameras);
+  std::string out = footageSessionText(cfg.name, s);
   char line[512];
   for (const auto& t : s.tracks) {
     if (t.target) {

@@ -223,34 +223,22 @@ nlohmann::json dartFootageSummaryJson(const DartFootageSummary& s, const DartSce
     tracks.push_back({{"track", t.track}, {"t_first_s", t.t_first}, {"t_last_s", t.t_last}, {"fused", t.fused},
                       {"board_hit", hit}});
   }
-  nlohmann::json j = {{"scenario", "dart_tracking"},
-                      {"mode", "footage"},
-                      {"seed", s.seed},
-                      {"cameras", footageCamerasJson(s.cameras)},
-                      {"footage_s", {{"first_stamp", s.t_first}, {"last_stamp", s.t_last}}},
-                      {"frames", s.frames},
-                      {"detections", s.detections},
-                      {"fused", s.fused},
-                      {"gated", s.gated},
-                      {"refused", s.refused},
-                      {"tracks_started", s.tracks_started},
-                      {"tracks", tracks},
-                      {"board_plane_x_m", cfg.board_center.x()},
-                      {"nis_mean", s.nis_samples > 0 ? nlohmann::json(s.nis_mean) : nlohmann::json(nullptr)},
-                      {"nis_samples", s.nis_samples},
-                      {"rmse_position", nullptr},
-                      {"experiments", nullptr},
-                      {"truth", "not scored (the frame source has no truth)"},
-                      {"wall_time_s", s.wall_s}};
+  nlohmann::json j = footageSessionJson("dart_tracking", s);
+  j["tracks"] = tracks;
+  j["board_plane_x_m"] = cfg.board_center.x();
+  j["nis_mean"] = s.nis_samples > 0 ? nlohmann::json(s.nis_mean) : nlohmann::json(nullptr);
+  j["nis_samples"] = s.nis_samples;
+  j["rmse_position"] = nullptr;
+  j["experiments"] = nullptr;
+  j["truth"] = "not scored (the frame source has no truth)";
+  j["wall_time_s"] = s.wall_s;
   if (s.live) j["live"] = runtime::toJson(*s.live);
   if (!s.faults.empty()) j["faults"] = runtime::toJson(s.faults);
   return j;
 }
 
 std::string dartFootageSummaryText(const DartFootageSummary& s, const DartScenarioConfig& cfg) {
-  std::string out = footageSessionText(
-      {"dart_tracking", s.t_first, s.t_last, s.frames, s.detections, s.fused, s.gated, s.refused, s.tracks_started},
-      s.cameras);
+  std::string out = footageSessionText("dart_tracking", s);
   char line[512];
   for (const auto& t : s.tracks) {
     std::snprintf(line, sizeof line, "  track %d (%.3f-%.3f s, %d fused): ", t.track, t.t_first, t.t_last, t.fused);

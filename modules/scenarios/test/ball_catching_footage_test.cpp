@@ -202,11 +202,7 @@ TEST_F(BallCatchingFootage, ImageSequencesGiveTheSimulatedThrowsTargets) {
 
   // The same footage played as live cameras on a clock that is never waited on (the test's own):
   // no frame arrives before the loop asks for it, so none is dropped, and every frame is timed.
-  struct InstantClock : runtime::WallClock {
-    double t = 0.0;
-    double now() const override { return t; }
-    void sleepUntil(double until) override { t = std::max(t, until); }
-  } clock;
+  runtime::ManualClock clock;
   std::vector<std::string> sets = footage_->image_sets;
   for (std::size_t c = 0; c < footage_->image_sets.size(); ++c)
     sets.push_back("cameras[" + std::to_string(c) + "].source.pace=true");

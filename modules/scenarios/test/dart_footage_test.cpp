@@ -220,18 +220,7 @@ TEST_F(DartFootage, ImageSequencesGiveTheBoardHits) {
 
 namespace {
 
-/// A wall clock that moves only when told to (sleepUntil jumps to the time asked for).
-class TestClock : public runtime::WallClock {
-public:
-  double now() const override { return t_; }
-  void sleepUntil(double t) override {
-    if (t > t_) t_ = t;
-  }
-  void advance(double dt) { t_ += dt; }
-
-private:
-  double t_ = 0.0;
-};
+using TestClock = runtime::ManualClock;
 
 /// The slow part of a frame's processing, as a telemetry sink (called while the session processes
 /// a frame with a detection): the side camera's third detection takes 110 ms, the rest no time.

@@ -190,11 +190,7 @@ TEST_F(MobileCaptureFootage, ImageSequenceTracksTheRenderedObjectWithinAFewCenti
 
   // The same footage (one render per test process: making the footage is the slow part) played as
   // a live camera on a clock the test advances itself: nothing is dropped, every frame is timed.
-  struct InstantClock : runtime::WallClock {
-    double t = 0.0;
-    double now() const override { return t; }
-    void sleepUntil(double until) override { t = std::max(t, until); }
-  } clock;
+  runtime::ManualClock clock;
   auto sets = imageSets();
   sets.push_back("source.pace=true");
   const auto paced_cfg = configWith(sets);

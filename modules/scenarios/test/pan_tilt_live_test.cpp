@@ -19,18 +19,7 @@ using namespace viewline;
 
 namespace {
 
-/// A wall clock that moves only when told to (sleepUntil jumps to the time asked for).
-class TestClock : public runtime::WallClock {
-public:
-  double now() const override { return t_; }
-  void sleepUntil(double t) override {
-    if (t > t_) t_ = t;
-  }
-  void advance(double dt) { t_ += dt; }
-
-private:
-  double t_ = 0.0;
-};
+using TestClock = runtime::ManualClock;
 
 /// The slow part of each frame's processing, as a frame sink (called from the loop's control
 /// event, before the frame's processing ends): 10 ms, and 110 ms on the sixth frame.

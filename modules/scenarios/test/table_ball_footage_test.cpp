@@ -212,11 +212,7 @@ TEST_F(TableBallFootage, ImageSequencePutsTheBallWithinMillimetresOfTheRenderedO
 
   // Played as a live camera on a clock that is never waited on: no frame arrives before the
   // loop asks for it, so none is dropped and every one is timed; pacing changes when, not what.
-  struct InstantClock : runtime::WallClock {
-    double t = 0.0;
-    double now() const override { return t; }
-    void sleepUntil(double until) override { t = std::max(t, until); }
-  } clock;
+  runtime::ManualClock clock;
   const auto paced_cfg = configWith({footage_->images_set, "source.pace=true"});
   Observed paced_obs;
   const auto paced = run(paced_cfg, paced_obs, &clock);

@@ -49,6 +49,25 @@ public:
 /// std::chrono::steady_clock (CLOCK_MONOTONIC, the clock of V4L2 buffer stamps) as a WallClock.
 WallClock& steadyWallClock();
 
+/// A wall clock that moves only when told to: sleepUntil() jumps to the time asked for, advance()
+/// adds processing time. Paced runs on it count their missed frames exactly (tests, simulations).
+class ManualClock : public WallClock {
+public:
+  /// A clock reading `origin` (s).
+  explicit ManualClock(double origin = 0.0) : t_(origin) {}
+  /// The clock's reading, s.
+  double now() const override { return t_; }
+  /// Jumps to t (s) when t is ahead; never goes back.
+  void sleepUntil(double t) override {
+    if (t > t_) t_ = t;
+  }
+  /// Moves the clock on by dt (s).
+  void advance(double dt) { t_ += dt; }
+
+private:
+  double t_;
+};
+
 /// The CPU time the calling thread has used, s (CLOCK_THREAD_CPUTIME_ID).
 double threadCpuSeconds();
 

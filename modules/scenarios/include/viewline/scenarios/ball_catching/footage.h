@@ -102,34 +102,11 @@ struct FootageCamera {
 /// What one camera of a ball-catching footage session gave.
 using CatchFootageCamera = FootageCamera;
 
-/// The session-wide counts a multi-camera footage summary opens with (ball catching, dart).
+/// What a multi-camera footage session (ball catching, dart) knows without truth: its cameras and
+/// the tracker's counts; each scenario's summary adds its own.
 struct FootageSessionCounts {
-  std::string scenario;  ///< the scenario's name, first word of the summary
-  double t_first = 0.0,  ///< s, first frame's stamp
-         t_last = 0.0;   ///< s, last frame's stamp
-  std::uint64_t frames = 0,      ///< frames over the cameras
-                detections = 0,  ///< detections over the cameras
-                fused = 0,       ///< detections the tracker fused
-                gated = 0,       ///< detections its gate rejected
-                refused = 0;     ///< detections the tracker refused (tracking::Refusal)
-  int tracks_started = 0;  ///< tracks the tracker started
-};
-
-/// The opening lines of a multi-camera footage session's console summary (ball catching, dart):
-/// the session (stamps, frames, detections), one line per camera, the tracker's counts.
-std::string footageSessionText(const FootageSessionCounts& counts, const std::vector<FootageCamera>& cameras);
-
-/// A footage summary's "cameras" array: name, source, frames, lost and detections per camera.
-nlohmann::json footageCamerasJson(const std::vector<FootageCamera>& cameras);
-
-/// A footage summary's live lines (runtime::summaryLine, runtime::processingLine; indented, one
-/// per line); empty when the session ran on no live source.
-std::string footageLiveText(const std::optional<runtime::LiveReport>& live);
-
-/// The summary of a footage session (footage.h): what is known without truth.
-struct CatchFootageSummary {
   std::uint64_t seed = 0;  ///< the seed (added pixel noise, injected faults)
-  std::vector<CatchFootageCamera> cameras;  ///< per active camera, in the rig's order
+  std::vector<FootageCamera> cameras;  ///< per active camera, in the rig's order
   double t_first = 0.0,  ///< s, first frame's stamp
          t_last = 0.0;   ///< s, last frame's stamp
   std::uint64_t frames = 0,      ///< frames over the cameras
@@ -138,6 +115,22 @@ struct CatchFootageSummary {
                 gated = 0,       ///< detections its gate rejected
                 refused = 0;     ///< detections the tracker refused (tracking::Refusal: stamp, pixel, duplicate)
   int tracks_started = 0;  ///< tracks the tracker started (a restart after rejections is the same track)
+};
+
+/// The opening lines of a multi-camera footage session's console summary (ball catching, dart):
+/// the session (stamps, frames, detections), one line per camera, the tracker's counts.
+std::string footageSessionText(const std::string& scenario, const FootageSessionCounts& session);
+
+/// A footage summary's common keys: scenario, mode, seed, cameras (name, source, frames, lost and
+/// detections per camera), the stamps' span and the tracker's counts.
+nlohmann::json footageSessionJson(const std::string& scenario, const FootageSessionCounts& session);
+
+/// A footage summary's live lines (runtime::summaryLine, runtime::processingLine; indented, one
+/// per line); empty when the session ran on no live source.
+std::string footageLiveText(const std::optional<runtime::LiveReport>& live);
+
+/// The summary of a footage session (footage.h): what is known without truth.
+struct CatchFootageSummary : FootageSessionCounts {
   std::vector<CatchFootageTrack> tracks;  ///< the tracks that reached the planner, in order
   std::size_t commands = 0,           ///< set points streamed to the robot
               limit_violations = 0,   ///< set points over the velocity or acceleration limits

@@ -72,17 +72,7 @@ struct DartFootageTrack {
 };
 
 /// The summary of a dart footage session (footage.h): what is known without truth.
-struct DartFootageSummary {
-  std::uint64_t seed = 0;  ///< the seed (injected faults)
-  std::vector<DartFootageCamera> cameras;  ///< per camera, in the rig's order
-  double t_first = 0.0,  ///< s, first frame's stamp
-         t_last = 0.0;   ///< s, last frame's stamp
-  std::uint64_t frames = 0,      ///< frames over the cameras
-                detections = 0,  ///< detections over the cameras
-                fused = 0,       ///< detections the tracker fused
-                gated = 0,       ///< detections its gate rejected
-                refused = 0;     ///< detections the tracker refused (tracking::Refusal)
-  int tracks_started = 0;  ///< tracks the tracker started (a restart after rejections is the same track)
+struct DartFootageSummary : FootageSessionCounts {
   std::vector<DartFootageTrack> tracks;  ///< the tracks with a fused image, in order
   double nis_mean = 0.0;        ///< mean NIS of the fused images tested against their track before its hit (2 dof)
   std::uint64_t nis_samples = 0;  ///< images in nis_mean
