@@ -26,10 +26,6 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kTick = TableBallWorld::kTick;
-// As in the loop (loop.h): at equal times a frame runs before the wrist's tick.
-constexpr int kFramePriority = runtime::priority::Physics;
-constexpr int kTickPriority = runtime::priority::Physics + 1;
-constexpr double kTimeTolerance = 1e-9;
 
 }  // namespace
 
@@ -126,7 +122,7 @@ TableBallFootageSummary runOnFootage(const TableBallConfig& cfg, std::uint64_t s
     wrist_tilt = wrist_sim.actual(t);
     if (sink != nullptr && k % 5 == 0) sink->command({"wrist", t, cmd});
     ++k;
-    sched.at(t0 + static_cast<double>(k) * kTick, kTickPriority, tick);
+    sched.at(t0 + static_cast<double>(k) * kTick, table_ball_order::kTick, tick);
   };
 
   // --- frames ----------------------------------------------------------------------------------
@@ -144,7 +140,7 @@ TableBallFootageSummary runOnFootage(const TableBallConfig& cfg, std::uint64_t s
       t_end = sched.now() + cfg.latency + cfg.wrist.delay + kTick;
       return;
     }
-    sched.at(std::max(sched.now(), *ready - kTimeTolerance), kFramePriority, on_frame);
+    sched.at(std::max(sched.now(), *ready - table_ball_order::kTimeTolerance), table_ball_order::kFrame, on_frame);
   };
   on_frame = [&](double) {
     std::optional<runtime::Frame> frame = camera.grab();
@@ -214,7 +210,7 @@ TableBallFootageSummary runOnFootage(const TableBallConfig& cfg, std::uint64_t s
       control::TiltRamp ramp = controller.update(t, {of->x[0], of->x[2]}, {of->x[1], of->x[3]}, ref);
       ramp.t0 = t + cfg.latency;
       to_arm.clear();
-      to_arm.send(ramp.t0 - kTimeTolerance, ramp);
+      to_arm.send(ramp.t0 - table_ball_order::kTimeTolerance, ramp);
       ++sum.ramps;
       if (sink != nullptr) {
         Eigen::VectorXd u(4);
@@ -251,7 +247,7 @@ TableBallFootageSummary runOnFootage(const TableBallConfig& cfg, std::uint64_t s
   };
 
   scheduleFrame();
-  sched.at(t0, kTickPriority, tick);
+  sched.at(t0, table_ball_order::kTick, tick);
   sched.runUntil(std::numeric_limits<double>::infinity());
 
   sum.stopped_early = sched.stopRequested();

@@ -23,12 +23,6 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kTick = TableBallWorld::kTick;
-// Tie order at equal times (see loop.h): the frame, then the physics tick.
-constexpr int kFramePriority = runtime::priority::Physics;
-constexpr int kTickPriority = runtime::priority::Physics + 1;
-// A frame ready at r sees the physics ticks that start before r − 1 ns (the 1 ms grid and the
-// capture times are rounded separately; a tick due at r itself simulates what follows it).
-constexpr double kTimeTolerance = 1e-9;
 
 /// CPU time of the calling thread, s (the observer and the reference run on it, one after the
 /// other; unlike wall time it does not count the time the thread waits for a core).
@@ -176,7 +170,8 @@ TableBallResult runTableBall(const TableBallConfig& cfg, std::uint64_t seed, con
   // --- physics: tick k at k · kTick (scheduled from k, not accumulated) -----------------------
   std::function<void(double)> tick = [&](double) {
     const double t = world.time();
-    if (!frame_pending && t >= cfg.duration - kTimeTolerance) return;  // past the last frame and the duration
+    // Past the last frame and the duration: stop ticking.
+    if (!frame_pending && t >= cfg.duration - table_ball_order::kTimeTolerance) return;
     to_arm.receive(t, [&](double, const control::TiltRamp& r) { current = r; });
     if (!wrist.send(t, current.commandAt(t))) {
       // Not taken: the wrist holds its set point, and so does the loop's command (the ramps
@@ -193,7 +188,7 @@ TableBallResult runTableBall(const TableBallConfig& cfg, std::uint64_t seed, con
     world.step();
     metrics.tick(world.time(), world.state().p);
     if (sink != nullptr && world.ticks() % 5 == 0) sink->command({"wrist", t, cmd});
-    sched.at(world.time(), kTickPriority, tick);
+    sched.at(world.time(), table_ball_order::kTick, tick);
   };
 
   // --- frames ----------------------------------------------------------------------------------
@@ -204,7 +199,8 @@ TableBallResult runTableBall(const TableBallConfig& cfg, std::uint64_t seed, con
   auto scheduleFrame = [&] {
     const std::optional<double> ready = camera.nextReadyTime();
     frame_pending = ready.has_value();
-    if (ready) sched.at(std::max(sched.now(), *ready - kTimeTolerance), kFramePriority, on_frame);
+    if (ready)
+      sched.at(std::max(sched.now(), *ready - table_ball_order::kTimeTolerance), table_ball_order::kFrame, on_frame);
   };
   on_frame = [&](double) {
     const double ready = camera.nextReadyTime().value_or(sched.now());
@@ -284,7 +280,7 @@ TableBallResult runTableBall(const TableBallConfig& cfg, std::uint64_t seed, con
       control::TiltRamp ramp = controller.update(t, positionOf(of->x), velocityOf(of->x), ref);
       ramp.t0 = cap.capture_time + cfg.latency;
       to_arm.clear();
-      to_arm.send(ramp.t0 - kTimeTolerance, ramp);
+      to_arm.send(ramp.t0 - table_ball_order::kTimeTolerance, ramp);
       if (sink != nullptr) sink->command({"tilt_ramp", ramp.t0, vec({ramp.start.x(), ramp.start.y(), ramp.rate.x(), ramp.rate.y()})});
     }
     if (sink != nullptr) {
@@ -317,7 +313,7 @@ TableBallResult runTableBall(const TableBallConfig& cfg, std::uint64_t seed, con
   };
 
   scheduleFrame();
-  sched.at(world.time(), kTickPriority, tick);
+  sched.at(world.time(), table_ball_order::kTick, tick);
   sched.runUntil(std::numeric_limits<double>::infinity());
 
   if (writer) writer->finish();

@@ -14,6 +14,7 @@
 #include "viewline/core/random.h"
 #include "viewline/robots/table_tilt.h"
 #include "viewline/runtime/frame_source.h"
+#include "viewline/runtime/scheduler.h"
 #include "viewline/scenarios/table_ball/config.h"
 #include "viewline/scenarios/table_ball/observer.h"
 #include "viewline/sim/physics.h"
@@ -38,6 +39,18 @@ struct HeadSway {
 /// The AprilTag layout of the simulated table (tags ids, sizes, and their poses in the table frame
 /// in vpDetectorAprilTag's tag frame: sim::TableWorld::table_M_vispTag).
 std::vector<vision::TagOnTable> tableTagLayout(const sim::TableWorld& world);
+
+/// Event order of a table-ball session, the same in the simulated loop (loop.cpp) and on footage
+/// (footage.cpp), so that both see a frame against the same physics ticks.
+namespace table_ball_order {
+/// At equal times the frame runs before the wrist's physics tick.
+inline constexpr int kFrame = runtime::priority::Physics;
+inline constexpr int kTick = runtime::priority::Physics + 1;
+/// A frame ready at r sees the physics ticks that start before r − 1 ns (the 1 ms grid and the
+/// capture times are rounded separately; a tick due at r itself simulates what follows it), and a
+/// ramp is sent 1 ns before its start.
+inline constexpr double kTimeTolerance = 1e-9;
+}  // namespace table_ball_order
 
 /// The simulated table-ball world: the tilting table and ball (physics at kTick), the wrist that
 /// tilts it, the swaying head camera and the rendered scene. Neither copied nor moved.
