@@ -1,6 +1,7 @@
 #include "viewline/core/checks.h"
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 #include <cmath>
 #include <sstream>
 
@@ -82,9 +83,13 @@ void requireSymmetricPositiveSemiDefinite(const Eigen::Ref<const Eigen::MatrixXd
   if (m.size() == 0) return;
   Eigen::LDLT<Eigen::MatrixXd> ldlt(m);
   const double scale = std::max(m.diagonal().cwiseAbs().maxCoeff(), 1e-300);
-  if (ldlt.info() != Eigen::Success || (ldlt.vectorD().array() < -rel_tol * scale).any()) {
+  if (ldlt.info() == Eigen::Success && (ldlt.vectorD().array() >= -rel_tol * scale).all()) return;
+  // Eigen's LDLT reports NumericalIssue when an exactly zero pivot comes before a nonzero one,
+  // which a rank-deficient PSD matrix can give (e.g. a rank-2 noise block G Σ Gᵀ beside a
+  // smaller diagonal entry): decide on the eigenvalues then (the fast path above is the usual one).
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(m, Eigen::EigenvaluesOnly);
+  if (eig.info() != Eigen::Success || eig.eigenvalues().minCoeff() < -rel_tol * scale)
     throw InvalidInput(what + " is not positive semi-definite");
-  }
 }
 
 }  // namespace viewline::core
