@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <exception>
 #include <fstream>
 #include <mutex>
 #include <sstream>
@@ -179,18 +180,30 @@ std::size_t parallelFor(std::size_t n, int workers, const std::function<void(std
   std::atomic<std::size_t> next{0};
   std::atomic<std::size_t> ran{0};
   std::mutex after_mutex;
+  // An exception thrown by a job (or `after`) on a worker thread would end the process
+  // (std::terminate): the first one is kept, the other workers stop taking jobs, and it is
+  // rethrown to the caller once every worker has joined.
+  std::mutex error_mutex;
+  std::exception_ptr error;
+  std::atomic<bool> failed{false};
   auto loop = [&]() {
     const OpenMpSerialInThisThread omp_serial;
-    for (;;) {
-      if (stop != nullptr && stop->load()) return;
-      const std::size_t i = next.fetch_add(1);
-      if (i >= n) return;
-      job(i);
-      ran.fetch_add(1);
-      if (after) {
-        std::lock_guard<std::mutex> lock(after_mutex);
-        after(i);
+    try {
+      for (;;) {
+        if (failed.load() || (stop != nullptr && stop->load())) return;
+        const std::size_t i = next.fetch_add(1);
+        if (i >= n) return;
+        job(i);
+        ran.fetch_add(1);
+        if (after) {
+          std::lock_guard<std::mutex> lock(after_mutex);
+          after(i);
+        }
       }
+    } catch (...) {
+      std::lock_guard<std::mutex> lock(error_mutex);
+      if (!error) error = std::current_exception();
+      failed.store(true);
     }
   };
   if (workers == 1) {
@@ -200,6 +213,7 @@ std::size_t parallelFor(std::size_t n, int workers, const std::function<void(std
     for (int w = 0; w < workers; ++w) threads.emplace_back(loop);
     for (auto& t : threads) t.join();
   }
+  if (error) std::rethrow_exception(error);
   return ran.load();
 }
 

@@ -1,9 +1,12 @@
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <filesystem>
 #include <fstream>
+#include <string>
 
 #include "toy_scenario.h"
+#include "viewline/core/error.h"
 #include "viewline/tuning/sweep_runner.h"
 
 using namespace viewline;
@@ -89,4 +92,22 @@ TEST(SweepRunner, ProgressText) {
   p.elapsed_s = 12.34;
   p.eta_s = 20.2;
   EXPECT_EQ(formatProgress(p), "[37/100] 12.3 s elapsed, ETA 20 s");
+}
+
+TEST(SweepRunner, AJobThatThrowsOnAWorkerReachesTheCaller) {
+  // On worker threads an escaping exception would call std::terminate; it must reach the caller
+  // (the tool then reports it and exits 1), whatever the worker count, and stop the hand-out.
+  for (const int workers : {1, 2, 4}) {
+    std::atomic<int> started{0};
+    try {
+      parallelFor(1000, workers, [&](std::size_t i) {
+        started.fetch_add(1);
+        if (i == 3) throw core::InvalidInput("job 3: process noise Q is not positive semi-definite");
+      });
+      ADD_FAILURE() << "no exception with " << workers << " workers";
+    } catch (const core::InvalidInput& e) {
+      EXPECT_NE(std::string(e.what()).find("job 3"), std::string::npos) << e.what();
+    }
+    EXPECT_LT(started.load(), 1000) << workers << " workers kept taking jobs after the failure";
+  }
 }

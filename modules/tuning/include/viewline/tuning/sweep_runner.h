@@ -94,7 +94,8 @@ std::optional<std::size_t> bestSetting(const SweepSpec& spec, const std::vector<
 bool sameResults(const SweepOutcome& a, const SweepOutcome& b, std::string* first_difference = nullptr);
 
 /// Runs `n` indexed jobs on `workers` threads (fixed hand-out order; `job(i)` must write only its
-/// own slot). Returns the number of jobs run (fewer when *stop became true). The jobs are the
+/// own slot). Returns the number of jobs run (fewer when *stop became true). A job that throws
+/// stops the hand-out; the first exception is rethrown here once every worker has joined. The jobs are the
 /// only parallelism while it runs: OpenCV's thread pool is off (cv::setNumThreads(0), restored
 /// after) and each worker runs OpenMP regions on one thread, so runs do not compete with the
 /// workers for the cores.
