@@ -211,6 +211,9 @@ MobileCaptureConfig loadMobileCaptureConfig(const io::ConfigNode& root) {
     const auto f = root.child("filter");
     readOpt(f, "q_v", c.filter.model.q_v);
     readOpt(f, "q_w", c.filter.model.q_w);
+    readOpt(f, "input_sigma_v", c.filter.model.input_sigma_v);
+    readOpt(f, "input_sigma_w", c.filter.model.input_sigma_w);
+    readOpt(f, "input_period", c.filter.model.input_period);
     readOpt(f, "init_speed", c.init_speed);
     readOpt(f, "init_speed_sigma", c.filter.init_speed_sigma);
     readOpt(f, "init_turn_sigma", c.filter.init_turn_sigma);

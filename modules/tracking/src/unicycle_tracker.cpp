@@ -17,6 +17,11 @@ void UnicycleTrackerConfig::validate(const char* what) const {
   const std::string w = what;
   if (!(model.q_v >= 0.0) || !(model.q_w >= 0.0) || !std::isfinite(model.q_v) || !std::isfinite(model.q_w))
     throw core::InvalidInput(w + ".q_v/q_w: expected >= 0 and finite");
+  if (!(model.input_sigma_v >= 0.0) || !(model.input_sigma_w >= 0.0) || !std::isfinite(model.input_sigma_v) ||
+      !std::isfinite(model.input_sigma_w))
+    throw core::InvalidInput(w + ".input_sigma_v/input_sigma_w: expected >= 0 and finite");
+  if (!(model.input_period > 0.0) || !std::isfinite(model.input_period))
+    throw core::InvalidInput(w + ".input_period: expected > 0 and finite");
   if (!(init_speed_sigma > 0.0) || !std::isfinite(init_speed_sigma))
     throw core::InvalidInput(w + ".init_speed_sigma: expected > 0");
   if (!(init_turn_sigma > 0.0) || !std::isfinite(init_turn_sigma))
@@ -40,7 +45,8 @@ UnicycleTracker::UnicycleTracker(const UnicycleTrackerConfig& config)
 
 void UnicycleTracker::predictTo(double t) {
   if (!valid_ || t <= est_.t() + 1e-12) return;
-  estimation::ekfPredict(est_, config_.model.transition(t - est_.t()));
+  // Q linearised at the prior mean (the held input noise's G depends on θ, v, ω: unicycle.h).
+  estimation::ekfPredict(est_, config_.model.transition(t - est_.t(), est_.x()));
 }
 
 void UnicycleTracker::start(double t, const Vector2d& z, const Eigen::Matrix2d& R) {

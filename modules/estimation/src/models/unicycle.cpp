@@ -1,5 +1,6 @@
 #include "viewline/estimation/models/unicycle.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "model_checks.h"
@@ -17,6 +18,9 @@ double wrapAngle(double a) {
 void UnicycleModel::validate() const {
   detail::requireNonNegative(q_v, "UnicycleModel.q_v");
   detail::requireNonNegative(q_w, "UnicycleModel.q_w");
+  detail::requireNonNegative(input_sigma_v, "UnicycleModel.input_sigma_v");
+  detail::requireNonNegative(input_sigma_w, "UnicycleModel.input_sigma_w");
+  core::requirePositive(input_period, "UnicycleModel.input_period");
 }
 
 namespace {
@@ -51,12 +55,36 @@ Eigen::MatrixXd UnicycleModel::jacobian(const Eigen::VectorXd& x, double dt) con
   return F;
 }
 
-Eigen::MatrixXd UnicycleModel::processNoise(double dt) const {
-  validate();
-  detail::requireDt(dt, "UnicycleModel");
+namespace {
+Eigen::MatrixXd randomWalkNoise(double q_v, double q_w, double dt) {
   Eigen::MatrixXd Q = Eigen::MatrixXd::Zero(5, 5);
   Q(3, 3) = q_v * dt;
   Q(4, 4) = q_w * dt;
+  return Q;
+}
+}  // namespace
+
+Eigen::MatrixXd UnicycleModel::processNoise(double dt) const {
+  validate();
+  detail::requireDt(dt, "UnicycleModel");
+  if (hasInputNoise())
+    throw core::InvalidInput("UnicycleModel.processNoise: held input noise (input_sigma_v/w) depends on the state: "
+                             "pass the state to linearise at");
+  return randomWalkNoise(q_v, q_w, dt);
+}
+
+Eigen::MatrixXd UnicycleModel::processNoise(const Eigen::VectorXd& x, double dt) const {
+  validate();
+  detail::requireDt(dt, "UnicycleModel");
+  checkState(x);
+  Eigen::MatrixXd Q = randomWalkNoise(q_v, q_w, dt);
+  if (!hasInputNoise()) return Q;
+  // G = ∂(x⁺, y⁺, θ⁺)/∂(v, ω): the v and ω columns of F (header), Σ_ε averaged over dt / T periods.
+  const Eigen::MatrixXd F = jacobian(x, dt);
+  const Eigen::Matrix<double, 3, 2> G = F.block<3, 2>(0, 3);
+  const double share = std::min(1.0, input_period / dt);
+  const Eigen::Vector2d var(input_sigma_v * input_sigma_v * share, input_sigma_w * input_sigma_w * share);
+  Q.topLeftCorner<3, 3>() += G * var.asDiagonal() * G.transpose();
   return Q;
 }
 
@@ -72,6 +100,14 @@ NonlinearTransition UnicycleModel::transition(double dt) const {
     y[2] = wrapAngle(y[2]);
     return Eigen::VectorXd(y);
   };
+  return tr;
+}
+
+NonlinearTransition UnicycleModel::transition(double dt, const Eigen::VectorXd& x) const {
+  UnicycleModel random_walks = *this;
+  random_walks.input_sigma_v = random_walks.input_sigma_w = 0.0;
+  NonlinearTransition tr = random_walks.transition(dt);
+  tr.Q = processNoise(x, dt);
   return tr;
 }
 

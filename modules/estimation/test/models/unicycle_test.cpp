@@ -67,6 +67,35 @@ TEST(UnicycleModel, ProcessNoiseIsRandomWalkOnSpeedAndTurnRate) {
   EXPECT_LT(maxAbs(Q - expected), 1e-16);
 }
 
+TEST(UnicycleModel, HeldInputNoiseIsTheInputsEffectOverTheStep) {
+  UnicycleModel model;
+  model.q_v = 0.2;
+  model.q_w = 0.03;
+  model.input_sigma_v = 0.05;
+  model.input_sigma_w = 0.4;
+  model.input_period = 0.1;
+  const Vec5 x = (Vec5() << 1, 2, 0.3, 2, 0.5).finished();
+  // One period: the held ε moves (x, y, θ) through the v and ω columns of F.
+  const Eigen::MatrixXd F = model.jacobian(x, 0.1);
+  const Eigen::MatrixXd G = F.block(0, 3, 3, 2);
+  const Eigen::Matrix2d S = Eigen::Vector2d(0.05 * 0.05, 0.4 * 0.4).asDiagonal();
+  Eigen::MatrixXd expected = Eigen::MatrixXd::Zero(5, 5);
+  expected.topLeftCorner(3, 3) = G * S * G.transpose();
+  expected(3, 3) = 0.02;
+  expected(4, 4) = 0.003;
+  EXPECT_LT(maxAbs(model.processNoise(x, 0.1) - expected), 1e-15);
+  // Three periods: the three independent ε average to Σ / 3 (θ's variance is (σ_εω T)² · 3).
+  EXPECT_NEAR(model.processNoise(x, 0.3)(2, 2), 3.0 * std::pow(0.4 * 0.1, 2), 1e-15);
+  // Without held noise the state-free Q is the same as the linearised one; with it, refused.
+  model.input_sigma_v = model.input_sigma_w = 0.0;
+  EXPECT_EQ(model.processNoise(0.1), model.processNoise(x, 0.1));
+  model.input_sigma_w = 0.4;
+  expectInvalid([&] { model.processNoise(0.1); }, "input_sigma");
+  expectInvalid([&] { model.transition(0.1); }, "input_sigma");
+  model.input_period = 0.0;
+  expectInvalid([&] { model.processNoise(x, 0.1); }, "UnicycleModel.input_period");
+}
+
 TEST(UnicycleModel, AnglesWrap) {
   EXPECT_NEAR(wrapAngle(3.0 * M_PI / 2.0), -M_PI / 2.0, 1e-15);
   EXPECT_NEAR(wrapAngle(-3.0 * M_PI / 2.0), M_PI / 2.0, 1e-15);
@@ -146,6 +175,52 @@ TEST(UnicycleModel, MonteCarloNeesConsistentEkf) { expectConsistent(unicycleMc(F
 TEST(UnicycleModel, MonteCarloNeesConsistentUkf) { expectConsistent(unicycleMc(Filter::kUkf, 1.0, 42)); }
 TEST(UnicycleModel, TooSmallProcessNoiseDetectedEkf) { expectOverconfident(unicycleMc(Filter::kEkf, 0.1, 43)); }
 TEST(UnicycleModel, TooSmallProcessNoiseDetectedUkf) { expectOverconfident(unicycleMc(Filter::kUkf, 0.1, 44)); }
+
+namespace {
+// Truth as [K] drives its object: the smooth (v̄, ω̄) random walks of the model plus ε drawn once
+// per step (one input period) and held over it. The filter is told the held noise or not.
+ConsistencyStats heldInputMc(bool told, std::uint64_t seed) {
+  UnicycleModel model;
+  model.q_v = 0.0005;  // the smooth speed stays away from 0 (where the heading is not observable)
+  model.q_w = 0.02;
+  model.input_sigma_v = 0.0141;  // [K]: var ξv 2 (cm/s)²
+  model.input_sigma_w = 0.316;   // [K]: var ξω 0.1 (rad/s)²
+  model.input_period = 0.1;
+  UnicycleModel filter_model = model;
+  if (!told) filter_model.input_sigma_v = filter_model.input_sigma_w = 0.0;
+  const double dt = 0.1, sigma = 0.01;
+  const int steps = 60, runs = 300;
+  UnicycleModel walks_only = model;
+  walks_only.input_sigma_v = walks_only.input_sigma_w = 0.0;
+  const test::NoiseSampler walk(walks_only.processNoise(dt)), rn(sigma * sigma * Eigen::MatrixXd::Identity(2, 2));
+  const Eigen::VectorXd m0 = (Vec5() << 0, 0, 0.5, 0.3, 0.2).finished();
+  const Eigen::MatrixXd P0 = Eigen::VectorXd((Vec5() << 1e-4, 1e-4, 0.01, 0.01, 0.04).finished()).asDiagonal();
+  const test::NoiseSampler p0(P0);
+  ConsistencyStats stats;
+  for (int run = 0; run < runs; ++run) {
+    core::Rng rng(core::deriveSeed(seed, static_cast<std::uint64_t>(run)));
+    Eigen::VectorXd x = m0 + p0(rng);
+    StateEstimate s(m0, P0);
+    for (int k = 0; k < steps; ++k) {
+      Eigen::VectorXd driven = x;
+      driven[3] += core::gaussian(rng, model.input_sigma_v);
+      driven[4] += core::gaussian(rng, model.input_sigma_w);
+      Eigen::VectorXd next = model.propagate(driven, dt);
+      next.tail<2>() = x.tail<2>();  // the held ε does not persist in (v̄, ω̄)
+      x = next + walk(rng);
+      x[2] = wrapAngle(x[2]);
+      ekfPredict(s, filter_model.transition(dt, s.x()));
+      ekfUpdate(s, UnicycleModel::positionMeasurement(x.head<2>() + rn(rng), sigma));
+    }
+    const Eigen::VectorXd e = UnicycleModel::difference(x, s.x());
+    stats.add(s.sqrtP().triangularView<Eigen::Lower>().solve(e).squaredNorm(), 5.0);
+  }
+  return stats;
+}
+}  // namespace
+
+TEST(UnicycleModel, HeldInputNoiseToldIsConsistent) { expectConsistent(heldInputMc(true, 45)); }
+TEST(UnicycleModel, HeldInputNoiseLeftOutIsOverconfident) { expectOverconfident(heldInputMc(false, 46)); }
 
 // ---------------------------------------------------------------- LS trajectory prediction
 
