@@ -83,7 +83,8 @@ TEST(MobileCaptureSources, ARecordedRunGivesTheLiveMeasurementsWithoutTheRobot) 
 
   // No robot, simulator or truth: the frames through the loop's detector, placed at head.csv's readings.
   ASSERT_TRUE(fs::remove(dir / "truth.csv"));
-  const scenarios::RecordedMobileCaptureRun replayed = scenarios::mobileCaptureRecordedMeasurements(cfg, dir.string(), 1);
+  const scenarios::RecordedMobileCaptureRun replayed =
+      scenarios::mobileCaptureRecordedMeasurements(cfg, dir.string(), 1);
   EXPECT_EQ(replayed.frames, static_cast<std::size_t>(run.frames));
   ASSERT_EQ(replayed.measurements.size(), live.size());
   for (std::size_t k = 0; k < live.size(); ++k) {
