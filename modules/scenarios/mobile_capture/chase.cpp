@@ -7,6 +7,23 @@ namespace viewline::scenarios::mobile_capture {
 using Eigen::Vector2d;
 using Eigen::Vector3d;
 
+bool FrameScreen::admit(runtime::FaultPlan& faults, const runtime::Frame& frame) {
+  if (faults.missesDeadline(frame)) {  // stale: dropped as a lost frame (faults.h)
+    faults.note("frames_late_dropped");
+    return false;
+  }
+  if (stale_.repeats(frame)) {  // a frozen camera's old image, new stamp (stale_frames.h)
+    faults.note("frames_frozen_dropped");
+    return false;
+  }
+  if (!(frame.stamp > last_stamp_)) {  // a repeated or backward stamp: the track only steps forward
+    faults.note("frames_stale_stamp_dropped");
+    return false;
+  }
+  last_stamp_ = frame.stamp;
+  return true;
+}
+
 ChaseController::ChaseController(const MobileCaptureConfig& cfg)
     : cfg_(cfg), detector_(cfg.detector), track_(cfg.filter), search_(cfg.search), go_(cfg.goParams()),
       plane_z_(0.5 * cfg.object_height) {}

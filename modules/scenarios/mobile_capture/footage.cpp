@@ -14,7 +14,6 @@
 #include "viewline/runtime/merged_source.h"
 #include "viewline/runtime/scheduler.h"
 #include "viewline/runtime/source_config.h"
-#include "viewline/runtime/stale_frames.h"
 #include "viewline/scenarios/mobile_capture/chase.h"
 #include "viewline/scenarios/mobile_capture/world.h"
 #include "viewline/tracking/unicycle_tracker.h"
@@ -64,7 +63,7 @@ MobileFootageSummary runMobileCaptureFootage(const MobileCaptureConfig& cfg, std
   sum.robot = pose;
   sum.head = robot.q;
   core::Camera camera = estimatorCamera(cfg);
-  camera.c_M_w = estimatorCamera_c_M_w(cfg, trueCamera_c_M_w(robot.head, robot.q, pose.x, pose.y, pose.theta));
+  camera.c_M_w = estimatorCamera_c_M_w(cfg, robot.head, robot.reading());
 
   runtime::FaultPlan faults(cfg.faults, core::deriveSeed(seed, 0xFA));
   runtime::FrameSource& frames = faults.wrap(*source);
@@ -75,8 +74,7 @@ MobileFootageSummary runMobileCaptureFootage(const MobileCaptureConfig& cfg, std
   std::optional<runtime::ProcessingTimer> timer;
   if (live) timer.emplace(cfg.vision_period, clock);
 
-  double last_stamp = -std::numeric_limits<double>::infinity();
-  runtime::StaleFrameFilter stale;
+  FrameScreen screen;  // late, frozen and stale-stamp frames dropped (chase.h)
   const unsigned width = camera.width, height = camera.height;
 
   auto process = [&](const runtime::Frame& frame) {
@@ -169,16 +167,7 @@ MobileFootageSummary runMobileCaptureFootage(const MobileCaptureConfig& cfg, std
         t_last = std::max(t_last, frame->stamp);
         const std::uint64_t id = ++frame_id;
         if (timer) timer->resume(id);
-        if (faults.missesDeadline(*frame)) {  // stale: dropped as a lost frame (faults.h)
-          faults.note("frames_late_dropped");
-        } else if (stale.repeats(*frame)) {  // a frozen camera's old image, new stamp (stale_frames.h)
-          faults.note("frames_frozen_dropped");
-        } else if (!(frame->stamp > last_stamp)) {  // the track only steps forward
-          faults.note("frames_stale_stamp_dropped");
-        } else {
-          last_stamp = frame->stamp;
-          process(*frame);
-        }
+        if (screen.admit(faults, *frame)) process(*frame);
         if (timer) timer->finish(id);
       }
       if (hooks && hooks->quit_requested && hooks->quit_requested()) sched.requestStop();

@@ -7,7 +7,6 @@
 #include <optional>
 
 #include "viewline/core/interrupt.h"
-#include "viewline/runtime/stale_frames.h"
 #include "viewline/robots/mobile_ground_localization.h"
 #include "viewline/scenarios/mobile_capture/chase.h"
 #include "viewline/scenarios/mobile_capture/recording.h"
@@ -119,7 +118,8 @@ MobileCaptureRun runMobileCapture(const MobileCaptureConfig& cfg, std::uint64_t 
   std::unique_ptr<MobileCaptureFrames> head_frames =
       replay_dir.empty() ? std::make_unique<MobileCaptureFrames>(cfg, target, rng, camera_pose)
                          : std::make_unique<MobileCaptureFrames>(replay_dir, target);
-  if (hooks && !hooks->record_dir.empty()) head_frames->record(hooks->record_dir, estimatorCamera(cfg));
+  if (hooks && !hooks->record_dir.empty())
+    head_frames->record(hooks->record_dir, estimatorCamera(cfg), [&] { return robot.reading(); });
   MobileCaptureFrames& source = *head_frames;
   runtime::FaultPlan faults(cfg.faults, core::deriveSeed(seed, 0xFA));
   runtime::FrameSource& frames = faults.wrap(source);
@@ -164,9 +164,11 @@ MobileCaptureRun runMobileCapture(const MobileCaptureConfig& cfg, std::uint64_t 
     ++run.frames;
     const auto truth = target.state(t);
     const Vector2d obj(truth.x, truth.y);
-    const robots::BasePose pose = robot.base.pose();
-    // The estimators' camera from odometry and the joint encoders at the frame's time.
-    camera.c_M_w = estimatorCamera_c_M_w(cfg, trueCamera_c_M_w(robot.head, robot.q, pose.x, pose.y, pose.theta));
+    // The estimators' camera from odometry and the joint encoders at the frame's time (the reading
+    // a recording keeps for this frame in head.csv: recording.h).
+    const HeadReading reading = robot.reading();
+    const robots::BasePose pose = reading.base;
+    camera.c_M_w = estimatorCamera_c_M_w(cfg, robot.head, reading);
     // The track is settled (its NIS counts) once it has lived kConsistencySettle s before this update.
     const bool settled = track.valid() && t - track_since >= kConsistencySettle;
     const double seen_before = chase.lastSeen();
@@ -268,23 +270,13 @@ MobileCaptureRun runMobileCapture(const MobileCaptureConfig& cfg, std::uint64_t 
     }
   };
   // Frames when the source has them (a renderer: every vision period, on the control ticks).
-  double last_stamp = -std::numeric_limits<double>::infinity();  // of the last frame processed
-  runtime::StaleFrameFilter stale;
+  FrameScreen screen;  // late, frozen and stale-stamp frames dropped (chase.h)
   std::function<void()> next_frame = [&] {
     const auto t = frames.nextReadyTime();
     if (!t) return;
     sched.at(*t, kVision, [&](double) {
       if (auto frame = frames.grab()) {
-        if (faults.missesDeadline(*frame)) {  // stale: dropped as a lost frame (faults.h)
-          faults.note("frames_late_dropped");
-        } else if (stale.repeats(*frame)) {  // a frozen camera's old image, new stamp (stale_frames.h)
-          faults.note("frames_frozen_dropped");
-        } else if (!(frame->stamp > last_stamp)) {  // a repeated or backward stamp: the track only steps forward
-          faults.note("frames_stale_stamp_dropped");
-        } else {
-          last_stamp = frame->stamp;
-          process(*frame);
-        }
+        if (screen.admit(faults, *frame)) process(*frame);
       }
       next_frame();
     });

@@ -5,6 +5,8 @@
 #include <vector>
 
 #include "viewline/core/error.h"
+#include "viewline/runtime/faults.h"
+#include "viewline/scenarios/mobile_capture/chase.h"
 
 namespace viewline::scenarios {
 
@@ -16,6 +18,18 @@ namespace {
 const std::vector<std::string> kTruthColumns = {"x", "y", "theta", "v", "omega"};
 
 std::vector<double> truthOf(const sim::GroundState& s) { return {s.x, s.y, s.theta, s.v, s.omega}; }
+
+// A head.csv row: the reading in headTableColumns()' order, and back.
+std::vector<double> headRow(const mobile_capture::HeadReading& r) {
+  return {r.base.x, r.base.y, r.base.theta, r.q.tilt, r.q.pan};
+}
+mobile_capture::HeadReading headReadingOf(const std::vector<double>& v) {
+  mobile_capture::HeadReading r;
+  r.base = {v[0], v[1], v[2]};
+  r.q.tilt = v[3];
+  r.q.pan = v[4];
+  return r;
+}
 
 }  // namespace
 
@@ -53,10 +67,17 @@ MobileCaptureFrames::MobileCaptureFrames(const std::string& run_dir, const sim::
 
 MobileCaptureFrames::~MobileCaptureFrames() = default;
 
-void MobileCaptureFrames::record(const std::string& run_dir, const core::Camera& camera) {
+const std::vector<std::string>& headTableColumns() {
+  static const std::vector<std::string> c = {"x", "y", "theta", "tilt", "pan"};
+  return c;
+}
+
+void MobileCaptureFrames::record(const std::string& run_dir, const core::Camera& camera, HeadProvider head) {
   writer_ = std::make_unique<runtime::RecordingWriter>(run_dir);
   writer_->setCamera(0, camera);
   writer_->setTruthColumns(kTruthColumns);
+  writer_->setTable(kHeadTable, headTableColumns());  // a replay without the robot needs its readings
+  head_ = std::move(head);
 }
 
 void MobileCaptureFrames::finishRecording() {
@@ -86,8 +107,55 @@ std::optional<runtime::Frame> MobileCaptureFrames::grab() {
   if (writer_ && ready) {
     writer_->frame(*ready, *frame);
     writer_->truth(frame->camera, frame->sequence, truth);
+    // The loop processes the frame at this instant, with this reading (loop.cpp).
+    writer_->tableRow(kHeadTable, frame->camera, frame->sequence, headRow(head_()));
   }
   return frame;
+}
+
+RecordedMobileCaptureRun mobileCaptureRecordedMeasurements(const MobileCaptureConfig& cfg, const std::string& run_dir,
+                                                           std::uint64_t fault_seed) {
+  cfg.validate();
+  if (!fs::is_regular_file(fs::path(run_dir) / "recording.csv"))
+    throw core::InvalidInput(run_dir + ": not a recording (no recording.csv, as each run_iii/ of mobile_capture "
+                             "--record DIR holds)");
+  RecordedMobileCaptureRun out;
+  out.dir = run_dir;
+  runtime::RecordingSource source(run_dir);
+  if (source.cameraCount() != 1)
+    throw core::InvalidInput(run_dir + "/recording.csv: frames of " + std::to_string(source.cameraCount()) +
+                             " cameras; the head camera is one");
+  const std::string head_file = run_dir + "/" + kHeadTable + ".csv";
+  const std::optional<runtime::RecordingTruth> head = source.table(kHeadTable);
+  if (!head)
+    throw core::InvalidInput(run_dir + ": no " + std::string(kHeadTable) +
+                             ".csv (the base pose and head joints per frame, which mobile_capture --record writes): "
+                             "without them a detection cannot be placed on the floor");
+  if (head->columns != headTableColumns())
+    throw core::InvalidInput(head_file + ": unexpected columns (expected camera,sequence,x,y,theta,tilt,pan)");
+
+  // The loop's perception (loop.cpp, process): the same screens, camera, detector and track.
+  runtime::FaultPlan faults(cfg.faults, fault_seed);
+  runtime::FrameSource& frames = faults.wrap(source);
+  mobile_capture::FrameScreen screen;
+  mobile_capture::ChaseController chase(cfg);
+  const robots::MobilePanTilt head_kinematics(cfg.head);
+  core::Camera camera = mobile_capture::estimatorCamera(cfg);
+  while (frames.nextReadyTime()) {
+    const std::optional<runtime::Frame> frame = frames.grab();
+    if (!frame) continue;  // a lost grab: nothing measured, as in the loop
+    ++out.frames;
+    const auto row = head->rows.find({frame->camera, frame->sequence});
+    if (row == head->rows.end())
+      throw core::InvalidInput(head_file + ": no row for camera " + std::to_string(frame->camera) + " sequence " +
+                               std::to_string(frame->sequence) + " of recording.csv");
+    if (!screen.admit(faults, *frame)) continue;
+    const mobile_capture::HeadReading reading = headReadingOf(row->second);
+    camera.c_M_w = mobile_capture::estimatorCamera_c_M_w(cfg, head_kinematics, reading);
+    const mobile_capture::ChaseObservation o = chase.frame(faults, *frame, camera, reading.base);
+    if (o.floor) out.measurements.push_back({frame->stamp, frame->sequence, *o.floor});
+  }
+  return out;
 }
 
 }  // namespace viewline::scenarios

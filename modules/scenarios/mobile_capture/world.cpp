@@ -45,6 +45,11 @@ Eigen::Isometry3d estimatorCamera_c_M_w(const MobileCaptureConfig& cfg, const Ei
   return cfg.rig ? Eigen::Isometry3d(cfg.rig->cal_M_c * true_c_M_w) : true_c_M_w;
 }
 
+Eigen::Isometry3d estimatorCamera_c_M_w(const MobileCaptureConfig& cfg, const robots::MobilePanTilt& head,
+                                        const HeadReading& r) {
+  return estimatorCamera_c_M_w(cfg, trueCamera_c_M_w(head, r.q, r.base.x, r.base.y, r.base.theta));
+}
+
 sim::GroundTargetParams targetParams(const MobileCaptureConfig& cfg, sim::GroundProfile profile, double duration) {
   sim::GroundTargetParams p;
   p.profile = profile;

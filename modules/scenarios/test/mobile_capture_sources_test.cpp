@@ -1,12 +1,15 @@
 // Mobile capture on a recording of its runs (mobile_capture/recording.h): a recorded batch replayed
 // with the same config and seed gives the same summary bit for bit (the wall-clock time aside); a
-// replay whose simulated object is not the recorded one is refused; footage kinds are read for the
-// footage session (mobile_capture/footage.h).
+// replay whose simulated object is not the recorded one is refused; a recorded run's frames, placed
+// with its head readings (head.csv) and no robot, give the live run's measurements bit for bit;
+// footage kinds are read for the footage session (mobile_capture/footage.h).
 #include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <filesystem>
+#include <fstream>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -61,6 +64,51 @@ TEST(MobileCaptureSources, ReplayOfARecordingGivesTheSameSummaryBitForBit) {
                 .find("the recorded object is not on the path"),
             std::string::npos);
   EXPECT_NE(errorOf([&] { scenarios::runMobileCaptureBatch(cfg, 1, 8, nullptr, replay); }).find("replay with --seed 7"),
+            std::string::npos);
+  fs::remove_all(dir);
+}
+
+TEST(MobileCaptureSources, ARecordedRunGivesTheLiveMeasurementsWithoutTheRobot) {
+  const auto cfg = scenarios::loadMobileCaptureConfig(io::loadConfigWithValues("config/mobile_capture.yaml", kShort));
+  const fs::path dir = fs::path(testing::TempDir()) / ("viewline_mc_head_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  std::vector<scenarios::RecordedFloorMeasurement> live;
+  scenarios::MobileCaptureHooks hooks;
+  hooks.record_dir = dir.string();
+  hooks.on_frame = [&](const scenarios::MobileCaptureFrame& f) {
+    if (f.measurement) live.push_back({f.t, 0, *f.measurement});
+  };
+  const auto run = scenarios::runMobileCapture(cfg, 5, &hooks);
+  ASSERT_GT(live.size(), 40u);
+
+  // No robot, simulator or truth: the frames through the loop's detector, placed at head.csv's readings.
+  ASSERT_TRUE(fs::remove(dir / "truth.csv"));
+  const scenarios::RecordedMobileCaptureRun replayed =
+      scenarios::mobileCaptureRecordedMeasurements(cfg, dir.string(), 1);
+  EXPECT_EQ(replayed.frames, static_cast<std::size_t>(run.frames));
+  ASSERT_EQ(replayed.measurements.size(), live.size());
+  for (std::size_t k = 0; k < live.size(); ++k) {
+    const auto& r = replayed.measurements[k];
+    EXPECT_EQ(r.t, live[k].t);
+    EXPECT_EQ(r.floor.z, live[k].floor.z) << k;
+    EXPECT_EQ(r.floor.unit_pixel_cov, live[k].floor.unit_pixel_cov) << k;
+    EXPECT_EQ(r.floor.bias_cov, live[k].floor.bias_cov) << k;
+  }
+
+  // The head readings are what places a detection: one frame's row removed is refused, naming head.csv.
+  const fs::path head = dir / "head.csv";
+  std::ifstream in(head);
+  std::string header, first, rest, line;
+  std::getline(in, header);
+  std::getline(in, first);
+  while (std::getline(in, line)) rest += line + "\n";
+  in.close();
+  std::ofstream(head) << header << "\n" << rest;
+  EXPECT_NE(errorOf([&] { scenarios::mobileCaptureRecordedMeasurements(cfg, dir.string(), 1); })
+                .find("head.csv: no row for camera 0 sequence"),
+            std::string::npos);
+  fs::remove(head);
+  EXPECT_NE(errorOf([&] { scenarios::mobileCaptureRecordedMeasurements(cfg, dir.string(), 1); }).find(": no head.csv"),
             std::string::npos);
   fs::remove_all(dir);
 }

@@ -70,7 +70,7 @@ TuneCommandLine::TuneCommandLine(CLI::App& app) {
   autotune_->add_option("--log", ao.log_dir, "the scenario app's --log folder (default: record a live run)");
   autotune_->add_option("--recording", ao.recording,
                         "a recording of the scenario's frames (its app's --record folder; pan_tilt, table_ball, "
-                        "ball_catching, dart) to fit on; no truth needed");
+                        "ball_catching, dart, mobile_capture) to fit on; no truth needed");
   autotune_->add_option("--record-seed", ao.record_seed, "seed of the live recording");
   autotune_->add_option("--record-runs", ao.record_runs, "live runs recorded");
   autotune_->add_option("--start-scale", ao.start_scale, "start from the config's noise values times this");

@@ -19,8 +19,19 @@
 // measured (the camera's aim is a function of earlier measurements only), but a noise far from the
 // recording's would have aimed the camera differently; hence the fresh-seed check of the session,
 // a live run of the tuned config.
+//
+// From a recording (mobile_capture --record DIR: session.json and run_iii/, or one run's folder),
+// with no robot, simulator, seed or truth: a detection becomes the track's measurement only through
+// the head camera's pose at its frame, which head.csv holds per frame (the base's odometry pose and
+// the pan/tilt joints the loop read, scenarios::headTableColumns()). Each recorded frame goes
+// through the loop's own screens, detector (windowed around the config's track) and floor
+// measurement with the camera at that reading (scenarios::mobileCaptureRecordedMeasurements); with
+// the recording's config these are the live run's detections bit for bit. The replay then runs
+// on them as on live ones; truth.csv is not read (NIS only). The frame faults of the config, if
+// any, are drawn from a fixed seed, as in a footage session.
 
 #include <cmath>
+#include <filesystem>
 #include <limits>
 #include <map>
 #include <memory>
@@ -64,6 +75,8 @@ struct Detection {
   Eigen::Matrix2d unit_pixel_cov = Eigen::Matrix2d::Zero();  ///< m²/px², J Jᵀ
 };
 using Chase = std::vector<Detection>;
+/// Seed of the frame faults (if the config has any) when a recording is replayed.
+constexpr std::uint64_t kRecordingSeed = 1;
 using MobileReplayData = detail::Recording<Chase>;
 std::size_t chaseDetections(const Chase& c) { return c.size(); }
 
@@ -106,16 +119,36 @@ public:
         "of each detection); record live runs instead (viewline_tune autotune without --log, --record-seed N)");
   }
 
-  /// Refused, naming why: a detection becomes the filter's measurement only through the head
-  /// camera's pose at its frame, which a recording does not hold.
+  /// A recording's runs (header comment): every frame through the loop's perception, placed on
+  /// the floor with the head camera at its head.csv reading; the detections the track was given kept.
   std::unique_ptr<ReplayData> loadRecording(const std::string& dir) const override {
-    throw core::InvalidInput(
-        "mobile_capture: " + dir +
-        ": tuning on a recording is not supported: a detection becomes the track's measurement (its floor point and "
-        "ground-projection Jacobian) only through the head camera's pose at that frame, i.e. the base's odometry and "
-        "the pan/tilt joints, which move with the closed loop (the head aims at the filter's prediction) and which a "
-        "mobile_capture --record folder does not hold (frames, clocks and the object's truth only); record live runs "
-        "instead (viewline_tune autotune without --recording)");
+    namespace fs = std::filesystem;
+    std::vector<std::string> run_dirs;
+    if (fs::exists(fs::path(dir) / "session.json")) {
+      const int n = scenarios::recordedMobileCaptureRuns(dir);
+      for (int i = 0; i < n; ++i) run_dirs.push_back(scenarios::mobileCaptureRunDir(dir, i));
+    } else if (fs::exists(fs::path(dir) / "recording.csv")) {
+      run_dirs.push_back(dir);
+    } else {
+      throw core::InvalidInput(dir + ": not a recording (no session.json, as mobile_capture --record DIR writes, nor "
+                                     "one run's recording.csv)");
+    }
+    auto d = std::make_unique<MobileReplayData>("chases", "detections", &chaseDetections);
+    std::size_t frames = 0;
+    for (std::size_t i = 0; i < run_dirs.size(); ++i) {
+      const scenarios::RecordedMobileCaptureRun run = scenarios::mobileCaptureRecordedMeasurements(
+          cfg_, run_dirs[i], core::deriveSeed(kRecordingSeed, static_cast<std::uint64_t>(i)));
+      frames += run.frames;
+      Chase chase;
+      for (const scenarios::RecordedFloorMeasurement& m : run.measurements)
+        chase.push_back({m.t, m.floor.z, m.floor.unit_pixel_cov});
+      d->items.push_back(std::move(chase));
+    }
+    if (d->measurements() == 0)
+      throw core::InvalidInput(dir + ": the object was detected in none of the recording's frames");
+    d->source = "recording " + dir + " (" + std::to_string(run_dirs.size()) + " run(s), " + std::to_string(frames) +
+                " frames through the loop's detector, placed with the head readings of head.csv)";
+    return d;
   }
 
   ReplayResult replay(const ReplayData& data, const std::vector<double>& noise, double outlier_prior,

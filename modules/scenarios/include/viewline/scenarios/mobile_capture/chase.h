@@ -1,6 +1,7 @@
 #pragma once
 // Mobile capture: the chase's perception and command logic, one piece for the simulated loop
-// (loop.cpp) and the footage session (footage.cpp), so that the two cannot drift apart.
+// (loop.cpp), the footage session (footage.cpp) and a recording's replay for tuning
+// (mobileCaptureRecordedMeasurements, recording.h), so that they cannot drift apart.
 //
 // Per frame (frame()): the tracker's predicted pixel (the detector's search window), the screened
 // detection (detectScreened), its floor point and noise (floorMeasurement: the white pixel noise
@@ -16,6 +17,7 @@
 // it never executes (a held robot: turn rate 0).
 
 #include <Eigen/Core>
+#include <limits>
 #include <optional>
 #include <vector>
 
@@ -26,6 +28,7 @@
 #include "viewline/robots/mobile_pan_tilt.h"
 #include "viewline/runtime/faults.h"
 #include "viewline/runtime/frame_source.h"
+#include "viewline/runtime/stale_frames.h"
 #include "viewline/scenarios/mobile_capture/config.h"
 #include "viewline/scenarios/mobile_capture/world.h"
 #include "viewline/tracking/unicycle_tracker.h"
@@ -43,6 +46,21 @@ struct ChaseObservation {
   Eigen::Matrix2d R = Eigen::Matrix2d::Zero();
   /// The track's update with the floor point (empty without one).
   std::optional<tracking::UnicycleUpdate> update;
+};
+
+/// The screens a grabbed frame passes before it reaches the chase, in every loop of the scenario
+/// (the simulated chase, the footage session, a recording's replay for tuning): a frame that a late
+/// fault delays past its deadline (faults.h), a frozen camera's repeated image (stale_frames.h) and
+/// a stamp that does not move forward (the track only steps forward) are dropped and counted.
+class FrameScreen {
+public:
+  /// True when `frame` goes on to the chase; else counts why in `faults` (frames_late_dropped,
+  /// frames_frozen_dropped, frames_stale_stamp_dropped).
+  bool admit(runtime::FaultPlan& faults, const runtime::Frame& frame);
+
+private:
+  runtime::StaleFrameFilter stale_;
+  double last_stamp_ = -std::numeric_limits<double>::infinity();  // s, of the last frame admitted
 };
 
 /// One control period's commands.

@@ -75,7 +75,8 @@ struct MobileCaptureHooks {
   runtime::TelemetrySink* telemetry = nullptr;              ///< records of the run (none: nothing built)
   runtime::Pacing pacing;                                   ///< wall-clock pacing (a display: 1)
   std::function<bool()> quit_requested;                     ///< polled after each frame: true ends the run
-  std::string record_dir;  ///< record the run's frames and truth into this new folder (recording.h); "" : none
+  /// Record the run's frames, head readings and truth into this new folder (recording.h); "": none.
+  std::string record_dir;
   std::string replay_dir;  ///< run on the frames of this recorded run (recording.h) instead of the renderer; "" : render
 };
 

@@ -42,6 +42,20 @@ Eigen::Isometry3d trueCamera_c_M_w(const robots::MobilePanTilt& head, const robo
 /// The estimators' camera pose from the same joints and pose: c'_M_w = c'_M_c · c_M_w (rig), else c_M_w.
 Eigen::Isometry3d estimatorCamera_c_M_w(const MobileCaptureConfig& cfg, const Eigen::Isometry3d& true_c_M_w);
 
+/// What the loop reads of the robot when it takes a frame: the base pose from odometry and the
+/// head's joint encoders. The estimators' camera at that frame is a function of it alone
+/// (estimatorCamera_c_M_w below), so a recording that holds it (head.csv, recording.h) places the
+/// frame's detection on the floor without the robot, exactly as the loop did.
+struct HeadReading {
+  robots::BasePose base;    ///< x, y (m, world floor), θ (rad, from the world x axis)
+  robots::PanTiltJoints q;  ///< tilt, pan (rad)
+};
+/// The estimators' camera pose at reading `r` of the head `head`:
+/// c'_M_w = estimatorCamera_c_M_w(cfg, trueCamera_c_M_w(head, r.q, r.base.x, r.base.y, r.base.θ)).
+/// The one place a frame's camera pose is built (the loop, the footage session, a recording's replay).
+Eigen::Isometry3d estimatorCamera_c_M_w(const MobileCaptureConfig& cfg, const robots::MobilePanTilt& head,
+                                        const HeadReading& r);
+
 /// The object's motion ([K]'s profile) over `duration` s.
 sim::GroundTargetParams targetParams(const MobileCaptureConfig& cfg, sim::GroundProfile profile, double duration);
 /// How long the capture runs' object path must last (the run plus the planner's horizon).
@@ -99,6 +113,8 @@ struct RobotSim {
   robots::PanTiltJoints q;         ///< current head joints (tilt, pan), rad
   /// The base at the config's start pose, at rest; the head pointed 2 m ahead of it.
   explicit RobotSim(const MobileCaptureConfig& c);
+  /// What the loop reads now: the base pose (odometry) and the joints (encoders).
+  HeadReading reading() const { return {base.pose(), q}; }
   /// One control period of the head servo towards `target` (clamped to the joint limits).
   void stepHead(const robots::PanTiltJoints& target);
 };
