@@ -2,7 +2,8 @@
 // The viewline tracker's filter state with the optional per-camera pixel bias (tracker.h, "Pixel
 // bias"): x = (p, v) without it, x = (p, v, b_0, ..., b_{C−1}) (b_c in px) with it. Shared by
 // tracker.cpp and track_start.cpp; only used when TrackerConfig::pixel_bias is on (the (p, v)
-// code paths stay as they were, so the option off is bit-identical).
+// code paths stay as they were, so the option off is bit-identical). In TimeMode::DtOffset an
+// image Δt after the grid instant sees the bias at the grid instant (b(t + Δt) = b(t) for Δt ≪ τ).
 
 #include "viewline/tracking/tracker.h"
 
