@@ -170,6 +170,11 @@ void readTracker(const io::ConfigNode& t, tracking::TrackerConfig& k) {
   k.restart_after_rejections = t.getOr<int>("restart_after_rejections", k.restart_after_rejections);
   k.max_coast = t.getOr<double>("max_coast_s", k.max_coast);
   k.refit_young_tracks = t.getOr<int>("refit_young_tracks", k.refit_young_tracks);
+  if (t.has("pixel_bias")) {
+    const auto b = t.child("pixel_bias");
+    k.pixel_bias.sigma_px = b.getOr<double>("sigma_px", k.pixel_bias.sigma_px);
+    k.pixel_bias.time_constant_s = b.getOr<double>("time_constant_s", k.pixel_bias.time_constant_s);
+  }
 }
 
 void readPlanner(const io::ConfigNode& p, planning::CatchPlannerConfig& k) {

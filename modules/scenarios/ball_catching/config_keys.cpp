@@ -111,6 +111,10 @@ io::ConfigReferenceSection ballCatchingConfigReference() {
       {"tracker.restart_after_rejections", "", "consecutive gated images of one camera before the track restarts"},
       {"tracker.max_coast_s", "s", "time without a fused image after which the next one starts a new track"},
       {"tracker.refit_young_tracks", "", "re-filter a track over its history while it has at most this many images (0: off)"},
+      {"tracker.pixel_bias", "", "per-camera pixel bias in the tracker's state (first-order Gauss-Markov per axis)"},
+      {"tracker.pixel_bias.sigma_px", "px", "stationary std of each camera's bias per axis (0: no bias state); "
+                                            "detector.sigma_px is then the white part", "0"},
+      {"tracker.pixel_bias.time_constant_s", "s", "correlation time τ of the bias (e^(−Δt/τ))", "1"},
       {"planner", "", "the catch planner (planning::CatchPlanner)"},
       {"planner.model", "", "flight model of the crossing prediction: drag or ballistic"},
       {"planner.accel_psd", "m²/s³", "process noise of the prediction"},

@@ -1,5 +1,7 @@
 #include "viewline/scenarios/ball_catching/planner_input.h"
 
+#include <cmath>
+
 namespace viewline::scenarios {
 
 estimation::DragBallisticModel flightFitModel(const BallCatchingConfig& cfg) {
@@ -14,6 +16,7 @@ estimation::DragBallisticModel flightFitModel(const BallCatchingConfig& cfg) {
 
 PlannerInput::PlannerInput(const BallCatchingConfig& cfg, std::vector<core::Camera> cameras)
     : enabled_(cfg.flight_fit.enabled),
+      bias_sigma_px_(cfg.tracker.pixel_bias.sigma_px),
       fit_(cfg.flight_fit, std::move(cameras), flightFitModel(cfg), FitAimPlane{cfg.robot.home, cfg.box_normal}) {}
 
 estimation::StateEstimate PlannerInput::after(const tracking::ImageMeasurement& m,
@@ -25,7 +28,10 @@ estimation::StateEstimate PlannerInput::after(const tracking::ImageMeasurement& 
     track_ = ts.tracks_started;
     restarts_ = ts.restarts;
   }
-  const std::optional<estimation::StateEstimate> fitted = fit_.add({m.camera, m.t, m.uv, m.sigma_px}, tracker.state());
+  // The fit weighs its images as white; with the tracker's pixel bias on, m.sigma_px is only the
+  // white part, and the fit is given the total (white and bias in quadrature) as before.
+  const double sigma = bias_sigma_px_ > 0.0 ? std::hypot(m.sigma_px, bias_sigma_px_) : m.sigma_px;
+  const std::optional<estimation::StateEstimate> fitted = fit_.add({m.camera, m.t, m.uv, sigma}, tracker.state());
   return fitted ? *fitted : tracker.state();
 }
 

@@ -36,6 +36,7 @@
 
 #include "viewline/core/statistics.h"
 #include "viewline/tracking/tracker.h"
+#include "track_filter.h"
 
 namespace viewline::tracking {
 
@@ -60,31 +61,50 @@ estimation::StateEstimate fitPass(const std::vector<core::Camera>& cams, const T
                                   const std::vector<MeasurementOutcome>& items, const std::vector<char>& use,
                                   core::Timestamp t0, core::Timestamp t_end,
                                   const estimation::StateEstimate* depth_from, SubsetFit* out) {
-  estimation::StateEstimate s(cfg.prior_mean, cfg.prior_cov, t0);
+  // With the pixel bias (tracker.h) the same pass on the augmented state (p, v, b_0, ...).
+  const bool biased = cfg.pixel_bias.enabled();
+  estimation::StateEstimate s = biased ? detail::biasedPrior(cfg, cams.size(), t0)
+                                       : estimation::StateEstimate(cfg.prior_mean, cfg.prior_cov, t0);
+  const auto predictTo = [&](core::Timestamp t) {
+    if (biased)
+      detail::predictBiased(cfg, s, t - s.t());
+    else
+      estimation::predict(s, cfg.model.transition(t - s.t()));
+    s.setTime(t);
+  };
   for (std::size_t i = 0; i < items.size(); ++i) {
     if (!use[i]) continue;
     const ImageMeasurement& m = items[i].m;
     const core::Timestamp st = sampleOf(cfg, m.t);
-    if (st > s.t()) {
-      estimation::predict(s, cfg.model.transition(st - s.t()));
-      s.setTime(st);
-    }
+    if (st > s.t()) predictTo(st);
     const double dt_offset = (cfg.time_mode == TimeMode::Exact) ? 0.0 : m.t - s.t();
     const core::Camera& cam = cams[m.camera];
     ViewlineRows rows;
+    double depth_sq = 0.0;  // E[Z²] of the rows (used for the bias columns)
     if (depth_from == nullptr) {
-      rows = viewlineRows(cam, m.uv, m.sigma_px, s.x(), s.P(), dt_offset, cfg.model, cfg.min_depth,
-                          cfg.depth_variance_in_noise);
+      if (biased) {
+        depth_sq = expectedSquaredDepth(cam, detail::meanPV(s), detail::covPV(s), dt_offset, cfg.model, cfg.min_depth,
+                                        cfg.depth_variance_in_noise);
+        rows = viewlineRowsWithDepth(cam, m.uv, m.sigma_px, dt_offset, cfg.model, depth_sq);
+      } else {
+        rows = viewlineRows(cam, m.uv, m.sigma_px, s.x(), s.P(), dt_offset, cfg.model, cfg.min_depth,
+                            cfg.depth_variance_in_noise);
+      }
     } else {
       const double tau = m.t - depth_from->t();
-      const Vector6 xi = cfg.model.propagate(depth_from->x(), tau);
+      const Vector6 xi = cfg.model.propagate(biased ? detail::meanPV(*depth_from) : Vector6(depth_from->x()), tau);
       Matrix6 Phi = Matrix6::Identity();
       Phi.topRightCorner<3, 3>() = tau * Eigen::Matrix3d::Identity();
-      const Matrix6 Pi = Phi * depth_from->P() * Phi.transpose();
-      const double depth_sq =
-          expectedSquaredDepth(cam, xi, Pi, 0.0, cfg.model, cfg.min_depth, cfg.depth_variance_in_noise);
+      const Matrix6 Pi = Phi * (biased ? detail::covPV(*depth_from) : Matrix6(depth_from->P())) * Phi.transpose();
+      depth_sq = expectedSquaredDepth(cam, xi, Pi, 0.0, cfg.model, cfg.min_depth, cfg.depth_variance_in_noise);
       rows = viewlineRowsWithDepth(cam, m.uv, m.sigma_px, dt_offset, cfg.model, depth_sq);
       if (out != nullptr && cam.toCamera(xi.head<3>()).z() <= cfg.min_depth) out->feasible = false;
+    }
+    if (biased) {
+      const estimation::LinearMeasurement meas = detail::biasedMeasurement(s, cam, m, rows, depth_sq);
+      const estimation::UpdateReport rep = estimation::update(s, meas);
+      if (out != nullptr) out->cost += rep.nis;
+      continue;
     }
     if (out != nullptr) {
       const Eigen::Vector2d d = rows.y - rows.C * s.x();
@@ -93,10 +113,7 @@ estimation::StateEstimate fitPass(const std::vector<core::Camera>& cams, const T
     }
     estimation::update(s, estimation::LinearMeasurement{rows.C, rows.y, rows.R});
   }
-  if (t_end > s.t()) {
-    estimation::predict(s, cfg.model.transition(t_end - s.t()));
-    s.setTime(t_end);
-  }
+  if (t_end > s.t()) predictTo(t_end);
   return s;
 }
 
@@ -150,17 +167,26 @@ void ViewlineTracker::stepTentative(TrackState& ts, const ImageMeasurement& m, I
   const int fused_before = ts.fused_in_track;
   // The image's innovation against the tentative estimate (diagnostics only: the estimate is
   // re-fitted below from the prior over the chosen subset).
-  estimation::StateEstimate probe = ts.est;
+  estimation::StateEstimate probe = work(ts);
   const core::Timestamp st = sampleTime(m.t);
-  if (st > probe.t()) {
-    estimation::predict(probe, cfg_.model.transition(st - probe.t()));
-    probe.setTime(st);
-  }
+  if (st > probe.t()) predictTo(probe, st);
   const double dt_offset = (cfg_.time_mode == TimeMode::Exact) ? 0.0 : m.t - probe.t();
-  const ViewlineRows rows = viewlineRows(cameras_[m.camera], m.uv, m.sigma_px, probe.x(), probe.P(), dt_offset,
-                                         cfg_.model, cfg_.min_depth, cfg_.depth_variance_in_noise);
-  const Eigen::Vector2d d = rows.y - rows.C * probe.x();
-  const Eigen::Matrix2d S = rows.C * probe.P() * rows.C.transpose() + rows.R;
+  ViewlineRows rows;
+  Eigen::Vector2d d;
+  Eigen::Matrix2d S;
+  if (cfg_.pixel_bias.enabled()) {
+    const double depth_sq = expectedSquaredDepth(cameras_[m.camera], detail::meanPV(probe), detail::covPV(probe),
+                                                 dt_offset, cfg_.model, cfg_.min_depth, cfg_.depth_variance_in_noise);
+    rows = viewlineRowsWithDepth(cameras_[m.camera], m.uv, m.sigma_px, dt_offset, cfg_.model, depth_sq);
+    const estimation::LinearMeasurement meas = detail::biasedMeasurement(probe, cameras_[m.camera], m, rows, depth_sq);
+    d = meas.y - meas.C * probe.x();
+    S = estimation::innovationCovariance(probe, meas.C, meas.R);
+  } else {
+    rows = viewlineRows(cameras_[m.camera], m.uv, m.sigma_px, probe.x(), probe.P(), dt_offset, cfg_.model,
+                        cfg_.min_depth, cfg_.depth_variance_in_noise);
+    d = rows.y - rows.C * probe.x();
+    S = rows.C * probe.P() * rows.C.transpose() + rows.R;
+  }
   MeasurementOutcome o;
   o.m = m;
   o.fate = Fate::Fused;
@@ -190,7 +216,7 @@ void ViewlineTracker::stepTentative(TrackState& ts, const ImageMeasurement& m, I
   }
 
   // Maximum-consensus search, fewest set-aside images first.
-  const estimation::StateEstimate before = ts.est;  // the tentative estimate before this image
+  const estimation::StateEstimate before = work(ts);  // the tentative estimate before this image
   const estimation::StateEstimate* guess = ts.history.size() > 1 ? &before : nullptr;
   const std::size_t n = ts.history.size();
   const core::Timestamp t_end = sampleTime(ts.history.back().m.t);
@@ -223,7 +249,7 @@ void ViewlineTracker::stepTentative(TrackState& ts, const ImageMeasurement& m, I
   }
   const std::vector<char>& use = best ? best_use : fallback_use;
   const SubsetFit& fit = best ? *best : *fallback;
-  ts.est = fit.est;
+  work(ts) = fit.est;
   int used = 0;
   for (std::size_t i = 0; i < n; ++i) {
     ts.history[i].fate = use[i] ? Fate::Fused : Fate::Gated;
@@ -243,8 +269,8 @@ void ViewlineTracker::refitConfirmed(TrackState& ts) const {
   if (ts.history.empty() || sampleTime(ts.history.front().m.t) != ts.track_start_t) return;
   std::vector<char> use(ts.history.size());
   for (std::size_t i = 0; i < use.size(); ++i) use[i] = ts.history[i].fate == Fate::Fused ? 1 : 0;
-  const estimation::StateEstimate current = ts.est;
-  ts.est = fitSubset(cameras_, cfg_, ts.history, use, ts.track_start_t, current.t(), &current, kDepthPasses).est;
+  const estimation::StateEstimate current = work(ts);
+  work(ts) = fitSubset(cameras_, cfg_, ts.history, use, ts.track_start_t, current.t(), &current, kDepthPasses).est;
 }
 
 void ViewlineTracker::restartTentative(TrackState& ts) {

@@ -8,6 +8,7 @@
 
 #include "viewline/core/checks.h"
 #include "viewline/estimation/kalman_filter.h"
+#include "track_filter.h"
 
 namespace viewline::tracking {
 
@@ -60,17 +61,114 @@ void TrackerConfig::validate() const {
     if (!(start.probability > 0.0 && start.probability < 1.0))
       throw core::InvalidInput("tracker.start.probability: expected in (0, 1)");
   }
+  if (!(pixel_bias.sigma_px >= 0.0) || !std::isfinite(pixel_bias.sigma_px))
+    throw core::InvalidInput("tracker.pixel_bias.sigma_px: expected a finite number >= 0");
+  if (pixel_bias.enabled() && !(pixel_bias.time_constant_s > 0.0))
+    throw core::InvalidInput("tracker.pixel_bias.time_constant_s: expected > 0 (+infinity: a constant bias)");
   if (!(gate.directional_p > 0.0)) throw core::InvalidInput("tracker.gate.directional_p: expected > 0");
   if (!(gate.mahalanobis_alpha > 0.0 && gate.mahalanobis_alpha < 1.0))
     throw core::InvalidInput("tracker.gate.mahalanobis_alpha: expected in (0, 1)");
 }
 
+namespace detail {
+
+estimation::StateEstimate biasedPrior(const TrackerConfig& cfg, std::size_t cameras, core::Timestamp t) {
+  const Eigen::Index n = biasIndex(cameras);
+  const double var = cfg.pixel_bias.sigma_px * cfg.pixel_bias.sigma_px;
+  Eigen::VectorXd x(n);
+  x << cfg.prior_mean, Eigen::VectorXd::Zero(n - 6);
+  Eigen::MatrixXd P(n, n);
+  P << cfg.prior_cov, Eigen::MatrixXd::Zero(6, n - 6), Eigen::MatrixXd::Zero(n - 6, 6),
+      var * Eigen::MatrixXd::Identity(n - 6, n - 6);
+  return estimation::StateEstimate(x, P, t);
+}
+
+void predictBiased(const TrackerConfig& cfg, estimation::StateEstimate& s, double dt) {
+  const estimation::LinearTransition pv = cfg.model.transition(dt);
+  const Eigen::Index n = s.dim();
+  const double tau = cfg.pixel_bias.time_constant_s;
+  const double a = std::isinf(tau) ? 1.0 : std::exp(-dt / tau);
+  const double q = std::isinf(tau) ? 0.0 : -std::expm1(-2.0 * dt / tau) * cfg.pixel_bias.sigma_px * cfg.pixel_bias.sigma_px;
+  estimation::LinearTransition tr;
+  tr.Phi = Eigen::MatrixXd::Identity(n, n);
+  tr.Phi.topLeftCorner<6, 6>() = pv.Phi;
+  tr.Q = Eigen::MatrixXd::Zero(n, n);
+  tr.Q.topLeftCorner<6, 6>() = pv.Q;
+  for (Eigen::Index i = 6; i < n; ++i) {
+    tr.Phi(i, i) = a;
+    tr.Q(i, i) = q;
+  }
+  tr.Gamma = Eigen::MatrixXd::Zero(n, pv.Gamma.cols());
+  tr.Gamma.topRows<6>() = pv.Gamma;
+  tr.u = pv.u;
+  tr.dt = pv.dt;
+  estimation::predict(s, tr);
+}
+
+Matrix6 covPV(const estimation::StateEstimate& s) {
+  const auto L = s.sqrtP().topLeftCorner<6, 6>();
+  return L * L.transpose();
+}
+
+estimation::StateEstimate marginalPV(const estimation::StateEstimate& s) {
+  estimation::StateEstimate out;
+  out.assign(s.x().head<6>(), s.sqrtP().topLeftCorner<6, 6>(), s.t());
+  return out;
+}
+
+estimation::LinearMeasurement biasedMeasurement(const estimation::StateEstimate& s, const core::Camera& camera,
+                                                const ImageMeasurement& m, const ViewlineRows& rows,
+                                                double depth_sq) {
+  estimation::LinearMeasurement meas;
+  meas.C = Eigen::MatrixXd::Zero(2, s.dim());
+  meas.C.leftCols<6>() = rows.C;
+  meas.C.block<2, 2>(0, biasIndex(m.camera)) = viewlinePixelJacobian(camera, m.uv, depth_sq);
+  meas.y = rows.y;
+  meas.R = rows.R;
+  return meas;
+}
+
+}  // namespace detail
+
 namespace {
+
+// fuse() on the augmented state (pixel bias on): the same gate and update with the bias columns.
+MeasurementOutcome fuseBiased(estimation::StateEstimate& s, const core::Camera& camera, const ImageMeasurement& m,
+                              const BallisticModel& model, const GateConfig& gate, double dt_offset,
+                              double min_depth, bool force, bool depth_variance_in_noise, ImageUpdate* update) {
+  MeasurementOutcome out;
+  out.m = m;
+  if (!std::isfinite(dt_offset)) core::requireFinite(dt_offset, "viewline: capture-time offset dt");
+  const double depth_sq = expectedSquaredDepth(camera, detail::meanPV(s), detail::covPV(s), dt_offset, model,
+                                               min_depth, depth_variance_in_noise);
+  const ViewlineRows rows = viewlineRowsWithDepth(camera, m.uv, m.sigma_px, dt_offset, model, depth_sq);
+  const estimation::LinearMeasurement meas = detail::biasedMeasurement(s, camera, m, rows, depth_sq);
+  const Eigen::VectorXd d = meas.y - meas.C * s.x();
+  const Eigen::MatrixXd S = estimation::innovationCovariance(s, meas.C, meas.R);
+  out.gate = evaluateGate(d, S, gate);
+  if (update != nullptr) {
+    update->m = m;
+    update->innovation = d;
+    update->S = S;
+    update->R = rows.R;
+    update->nis = out.gate.mahalanobis;
+  }
+  if (force) out.gate.rejected = false;
+  if (out.gate.rejected) {
+    out.fate = Fate::Gated;
+  } else {
+    estimation::update(s, meas);
+    out.fate = Fate::Fused;
+  }
+  return out;
+}
 
 // fuseImage, also handing out the innovation, S and R2 it formed (when `update` is not null).
 MeasurementOutcome fuse(estimation::StateEstimate& s, const core::Camera& camera, const ImageMeasurement& m,
                         const BallisticModel& model, const GateConfig& gate, double dt_offset, double min_depth,
                         bool force, bool depth_variance_in_noise, ImageUpdate* update) {
+  if (s.dim() > 6)
+    return fuseBiased(s, camera, m, model, gate, dt_offset, min_depth, force, depth_variance_in_noise, update);
   MeasurementOutcome out;
   out.m = m;
   const Vector6 x = s.x();
@@ -166,12 +264,30 @@ void ViewlineTracker::startTrack(TrackState& ts, core::Timestamp t) {
   for (const MeasurementOutcome& o : ts.history) evict(o);
   ts.history.clear();
   ts.est = estimation::StateEstimate(cfg_.prior_mean, cfg_.prior_cov, sampleTime(t));
+  if (cfg_.pixel_bias.enabled()) ts.full = detail::biasedPrior(cfg_, cameras_.size(), ts.est.t());
   ts.fused_in_track = 0;
   ts.track_start_t = ts.est.t();
   ++ts.tracks_started;
 }
 
 void ViewlineTracker::step(TrackState& ts, const ImageMeasurement& m, ImageUpdate* update) {
+  stepFilter(ts, m, update);
+  if (cfg_.pixel_bias.enabled() && ts.full.dim() > 0) ts.est = detail::marginalPV(ts.full);
+}
+
+estimation::StateEstimate& ViewlineTracker::work(TrackState& ts) const {
+  return cfg_.pixel_bias.enabled() ? ts.full : ts.est;
+}
+
+void ViewlineTracker::predictTo(estimation::StateEstimate& s, core::Timestamp t) const {
+  if (cfg_.pixel_bias.enabled())
+    detail::predictBiased(cfg_, s, t - s.t());
+  else
+    estimation::predict(s, cfg_.model.transition(t - s.t()));
+  s.setTime(t);
+}
+
+void ViewlineTracker::stepFilter(TrackState& ts, const ImageMeasurement& m, ImageUpdate* update) {
   // No live track, or none fused for longer than max_coast: the image seeds a new one from the
   // prior (the test TrackGate::decide makes below, where it answers Start).
   const TrackGate& life = ts.gate;
@@ -183,12 +299,10 @@ void ViewlineTracker::step(TrackState& ts, const ImageMeasurement& m, ImageUpdat
   if (seed) startTrack(ts, m.t);
   const int fused_before = ts.fused_in_track;
   const core::Timestamp ts_time = sampleTime(m.t);
-  if (ts_time > ts.est.t()) {
-    estimation::predict(ts.est, cfg_.model.transition(ts_time - ts.est.t()));
-    ts.est.setTime(ts_time);
-  }
-  const double dt_offset = (cfg_.time_mode == TimeMode::Exact) ? 0.0 : m.t - ts.est.t();
-  MeasurementOutcome o = fuse(ts.est, cameras_[m.camera], m, cfg_.model, cfg_.gate, dt_offset, cfg_.min_depth, seed,
+  estimation::StateEstimate& est = work(ts);
+  if (ts_time > est.t()) predictTo(est, ts_time);
+  const double dt_offset = (cfg_.time_mode == TimeMode::Exact) ? 0.0 : m.t - est.t();
+  MeasurementOutcome o = fuse(est, cameras_[m.camera], m, cfg_.model, cfg_.gate, dt_offset, cfg_.min_depth, seed,
                               cfg_.depth_variance_in_noise, update);
   o.seed = seed;
   const bool fused = o.fate == Fate::Fused;
@@ -227,17 +341,17 @@ void ViewlineTracker::refit(TrackState& ts) const {
   const bool whole = ts.history.front().seed ||
                      (cfg_.start.confirm_images > 0 && sampleTime(ts.history.front().m.t) == ts.track_start_t);
   if (!whole) return;
-  const Vector6 xk = ts.est.x();
-  const Matrix6 Pk = ts.est.P();
-  const core::Timestamp tk = ts.est.t();
-  estimation::StateEstimate s(cfg_.prior_mean, cfg_.prior_cov, ts.track_start_t);
+  const bool biased = cfg_.pixel_bias.enabled();
+  const estimation::StateEstimate& current = biased ? ts.full : ts.est;
+  const Vector6 xk = biased ? detail::meanPV(current) : Vector6(current.x());
+  const Matrix6 Pk = biased ? detail::covPV(current) : Matrix6(current.P());
+  const core::Timestamp tk = current.t();
+  estimation::StateEstimate s = biased ? detail::biasedPrior(cfg_, cameras_.size(), ts.track_start_t)
+                                       : estimation::StateEstimate(cfg_.prior_mean, cfg_.prior_cov, ts.track_start_t);
   for (const MeasurementOutcome& o : ts.history) {
     if (o.fate != Fate::Fused) continue;
     const core::Timestamp st = sampleTime(o.m.t);
-    if (st > s.t()) {
-      estimation::predict(s, cfg_.model.transition(st - s.t()));
-      s.setTime(st);
-    }
+    if (st > s.t()) predictTo(s, st);
     const double dt_offset = (cfg_.time_mode == TimeMode::Exact) ? 0.0 : o.m.t - s.t();
     // Current estimate moved (noise-free) to the capture time: x(t) = Φ(t − tk) xk + Γ g,
     // its covariance Φ Pk Φᵀ (backwards in time there is no process noise to add).
@@ -250,13 +364,19 @@ void ViewlineTracker::refit(TrackState& ts) const {
                                                  cfg_.depth_variance_in_noise);
     const ViewlineRows rows =
         viewlineRowsWithDepth(cameras_[o.m.camera], o.m.uv, o.m.sigma_px, dt_offset, cfg_.model, depth_sq);
-    estimation::update(s, estimation::LinearMeasurement{rows.C, rows.y, rows.R});
+    if (biased)
+      estimation::update(s, detail::biasedMeasurement(s, cameras_[o.m.camera], o.m, rows, depth_sq));
+    else
+      estimation::update(s, estimation::LinearMeasurement{rows.C, rows.y, rows.R});
   }
   if (tk > s.t()) {
-    estimation::predict(s, cfg_.model.transition(tk - s.t()));
+    if (biased)
+      detail::predictBiased(cfg_, s, tk - s.t());
+    else
+      estimation::predict(s, cfg_.model.transition(tk - s.t()));
   }
   s.setTime(tk);
-  ts.est = std::move(s);
+  (biased ? ts.full : ts.est) = std::move(s);
 }
 
 void ViewlineTracker::restart(TrackState& ts) {

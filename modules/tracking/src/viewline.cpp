@@ -62,6 +62,14 @@ Eigen::Matrix2d viewlineRowNoise(const core::Camera& camera, const Eigen::Vector
   return R;
 }
 
+Eigen::Matrix2d viewlinePixelJacobian(const core::Camera& camera, const Eigen::Vector2d& uv, double depth_sq) {
+  if (!(std::isfinite(depth_sq) && depth_sq > 0.0)) core::requirePositive(depth_sq, "viewline: expected squared depth");
+  const Eigen::Vector2d xy = camera.pixelToNormalized(uv);
+  const Eigen::Matrix2d J = undistortionJacobian(camera, uv);
+  const Eigen::Vector2d D(1.0 / std::sqrt(1.0 + xy.x() * xy.x()), 1.0 / std::sqrt(1.0 + xy.y() * xy.y()));
+  return -std::sqrt(depth_sq) * (D.asDiagonal() * J);
+}
+
 double expectedSquaredDepth(const core::Camera& camera, const Vector6& x, const Matrix6& P,
                             double dt_offset, const BallisticModel& model, double min_depth,
                             bool include_variance) {

@@ -51,6 +51,37 @@
 // confirm_images images. A restart makes the track tentative again over its newest images, so
 // neither a start nor a restart can be seeded by one outlier.
 //
+// Pixel bias (TrackerConfig::pixel_bias, off by default). A detection's error is not all white:
+// the detector's own error (blur, the colour threshold on the ball's shaded side) and the
+// calibration / registration error persist along a track and change slowly across the image,
+// and a white σ cannot make both NIS and NEES consistent (the filter averages errors that do
+// not average out). With sigma_px > 0 each camera c gets a 2-D pixel bias b_c, a first-order
+// Gauss-Markov process per axis (exponentially correlated noise, ḃ = −b/τ + w, stationary
+// variance σ_b²: Grewal & Andrews, Kalman Filtering: Theory and Practice, the chapter on random
+// processes):
+//   predict  b ← e^{−dt/τ} b,   Q_b = σ_b² (1 − e^{−2dt/τ}) I₂   (exact discretisation);
+//   measure  detected pixel = image of the ball + b_c + white noise (σ_px of the measurement),
+// so an image's two viewline rows get the columns ∂(rows)/∂b_c = −√E[Z²] D J (viewline.h's
+// derivation: the row residual of a pixel error δ is −Z D J δ; √E[Z²] makes the prior's share
+// of the row variance E[Z²] σ_b² D J Jᵀ D, the white term's form). The filter AUGMENTS the
+// state to (p, v, b_0, ..., b_{C−1}) (6 + 2C; TrackState::full: coloured measurement noise by
+// state augmentation, Simon 2006, Optimal State Estimation, ch. 7) rather than run a Schmidt
+// ("consider") filter that would keep the biases at zero and carry only their covariance and
+// cross-covariance (Schmidt 1966): two views of one point over-determine it (4
+// rows, 3 unknowns), so the part of the biases across the epipolar lines is observable within a
+// track, and estimating it gives a smaller, still consistent, (p, v) covariance; with C <= 4 the
+// state has at most 14 entries. state(), predictAt() and the NEES a caller computes keep their
+// meaning: the (p, v) marginal (the first 6 rows of the lower-triangular square-root factor are
+// the factor of the marginal, so it is exact). NIS is that of the image's two rows with S
+// including the bias terms.
+// The biases restart from their stationary prior N(0, σ_b² I) with every track (seed, restart,
+// young-track refit): the calibration / registration part persists across throws, but it is a
+// pixel error that depends on where in the image and at what depth the ball is, and throws cross
+// different parts of the image; the stationary prior is then still the right (marginal) prior,
+// so the filter stays consistent and only forgoes what a previous track said; and a track stays
+// a function of its own history, which the restart, the refit and the late-data replay rely on.
+// With sigma_px = 0 the state is (p, v) and every operation is the one without the option.
+//
 // Each processed image reports what happened to it: its outcome carries the track gate's
 // decision (Start, Accept, Reject, Restart), and lastUpdate() gives the submitted image's
 // innovation, S and NIS as the tracker formed them, so a telemetry sink or a tuning tool reads
@@ -142,6 +173,14 @@ struct TrackStartConfig {
   double probability = 0.999;  ///< chi-square probability of the joint consistency test of a subset
 };
 
+/// Per-camera pixel bias (header comment): a first-order Gauss-Markov process per image axis.
+struct PixelBiasConfig {
+  double sigma_px = 0.0;          ///< stationary std per axis, px; 0 turns the bias state off
+  double time_constant_s = 1.0;   ///< τ, s (correlation e^{−|Δt|/τ}); +infinity: a random constant
+  /// True when the biases are part of the state.
+  bool enabled() const { return sigma_px > 0.0; }
+};
+
 /// Configuration of the viewline tracker: model, prior, gate, time handling, late-data horizon, restarts and
 /// noise model.
 struct TrackerConfig {
@@ -168,6 +207,7 @@ struct TrackerConfig {
   int refit_young_tracks = 8;
   double image_margin_px = 0.5;       ///< pixels this far outside the image are still accepted
   TrackStartConfig start;             ///< robust start (off by default: the first image seeds the track)
+  PixelBiasConfig pixel_bias;         ///< per-camera pixel-bias state (off by default)
   /// Throws core::InvalidInput naming the field.
   void validate() const;
 };
@@ -177,6 +217,9 @@ struct TrackState {
   /// A track state with this gate and no estimate yet.
   explicit TrackState(TrackGate g) : gate(std::move(g)) {}
   estimation::StateEstimate est;  ///< the estimate (x = (p, v) world frame, time)
+  /// With the pixel bias on: the filter's state (p, v, b_0, ..., b_{C−1}) (px), of which `est`
+  /// is the (p, v) marginal; empty (0-dim) otherwise.
+  estimation::StateEstimate full;
   /// Life cycle: live track, time of the last fused image, rejections in a row per camera.
   TrackGate gate;
   int fused_in_track = 0;  ///< images fused since the track's seed
@@ -251,7 +294,13 @@ private:
   };
   Refusal check(const ImageMeasurement& m) const;
   static TrackState initialState(const TrackerConfig& cfg, std::size_t cameras);
+  /// One image (stepFilter), then `est` set to the (p, v) marginal of `full` when the pixel bias is on.
   void step(TrackState& ts, const ImageMeasurement& m, ImageUpdate* update);
+  void stepFilter(TrackState& ts, const ImageMeasurement& m, ImageUpdate* update);
+  /// The state the filter runs on: `full` with the pixel bias, else `est`.
+  estimation::StateEstimate& work(TrackState& ts) const;
+  /// Time update of a filter state (either form) to t >= its time.
+  void predictTo(estimation::StateEstimate& s, core::Timestamp t) const;
   void startTrack(TrackState& ts, core::Timestamp t);
   void restart(TrackState& ts);
   void refit(TrackState& ts) const;

@@ -107,6 +107,12 @@ Eigen::Vector2d exactPixelOf(const core::Camera& camera, const Eigen::Vector2d& 
 Eigen::Matrix2d viewlineRowNoise(const core::Camera& camera, const Eigen::Vector2d& uv,
                                  const ViewlinePlanes& planes, double sigma_px, double depth_sq);
 
+/// ∂(rows' residual)/∂(pixel error) = −√E[Z²] D J (2x2, per px): the columns a pixel bias b of
+/// the image adds to its two rows (y = C x − √E[Z²] D J b + e; tracker.h, pixel bias). From the
+/// derivation above, e_x = −Z δx / √(1 + x²) with δ = J δuv; Z is taken as √E[Z²] so that a bias
+/// of covariance σ_b² I adds E[Z²] σ_b² D J Jᵀ D to the rows' variance, as white noise would.
+Eigen::Matrix2d viewlinePixelJacobian(const core::Camera& camera, const Eigen::Vector2d& uv, double depth_sq);
+
 /// Two rows of C, y and their 2x2 noise for one image.
 struct ViewlineRows {
   Eigen::Matrix<double, 2, 6> C;  ///< two rows of the measurement matrix (on x = (p, v))
