@@ -688,6 +688,10 @@ TEST(PlanarTargetFilter, LegPriorTablesGiveTheEvaluatedPriorBitForBit) {
     // A table is what logPrior gives at its points (the moments grid's θ_k = −π + (2π/180) k).
     const double step = 2.0 * core::kPi / 180.0;
     for (int k = 0; k < 180; k += 17) EXPECT_EQ((*tabled.log_prior_moments)[static_cast<std::size_t>(k)], leg.logPrior(-core::kPi + step * k));
+    // The normalisation on the filter's 720-point grid is the mean of exp(logPrior) evaluated point by point.
+    double sum = 0.0;
+    for (int k = 0; k < 720; ++k) sum += std::exp(leg.logPrior(-core::kPi + 2.0 * core::kPi * k / 720));
+    EXPECT_EQ(leg.logPriorNormalisation(720), -std::log(sum / 720)) << trial;
     ++compared;
   }
   EXPECT_EQ(compared, 6);
@@ -976,4 +980,66 @@ TEST(PlanarTargetFilter, LegEvidenceAndMomentsSkipOnlyPointsThatAddNothing) {
   }
   EXPECT_EQ(compared, 72);
   EXPECT_GT(narrow, 20);
+}
+
+namespace {
+// ConstantSpeedLeg::logPrior as first written (std::remainder for every wrap, boxReach from θ).
+double logPriorAsWritten(const tracking::ConstantSpeedLeg& leg, double th) {
+  double lp = leg.log_norm;
+  if (leg.region) {
+    const double R = std::max(tracking::boxReach(leg.region_c, leg.region_lo, leg.region_hi, th), 1e-4);
+    lp += leg.region_log_scale + 2.0 * std::log(R);
+  }
+  if (leg.prior_mu.empty() || leg.prior_weight <= 0.0) return lp;
+  double g = 0.0;
+  for (double mu : leg.prior_mu) {
+    const double d = std::remainder(th - mu, 2.0 * core::kPi);
+    if (d * d < 100.0 * leg.prior_sigma * leg.prior_sigma) g += std::exp(-0.5 * d * d / (leg.prior_sigma * leg.prior_sigma));
+  }
+  g *= std::sqrt(2.0 * core::kPi) / leg.prior_sigma / static_cast<double>(leg.prior_mu.size());
+  return lp + std::log((1.0 - leg.prior_weight) + leg.prior_weight * g);
+}
+}  // namespace
+
+TEST(PlanarTargetFilter, LegPriorWrapsTheTurnsAsRemainderDoes) {
+  // logPrior wraps θ − μ without std::remainder where the result is exact (|θ − μ| < π, and π < |θ − μ| < 2.5π),
+  // and takes cos θ and sin θ from the grids' tables: the same values as evaluated as first written, for centres
+  // μ over ±2π (a leg's direction plus a learnt turn) and θ on and off the grids, ±π and the wrap boundaries.
+  core::Rng rng = core::makeRng(67);
+  int compared = 0;
+  for (int trial = 0; trial < 20; ++trial) {
+    tracking::ConstantSpeedLeg leg = testLeg(1.0, Eigen::Vector2d(core::uniform(rng, -0.4, 1.8), core::uniform(rng, -0.4, 0.4)),
+                                             1e-4 * Eigen::Matrix2d::Identity(), core::uniform(rng, -core::kPi, core::kPi));
+    leg.prior_mu.clear();
+    for (int k = 0; k < 8; ++k) leg.prior_mu.push_back(core::uniform(rng, -2.0 * core::kPi, 2.0 * core::kPi));
+    leg.prior_mu.push_back(0.0);
+    leg.prior_mu.push_back(core::kPi);
+    leg.log_norm = core::uniform(rng, -0.5, 0.5);
+    std::vector<double> ths = {-core::kPi, core::kPi, 0.0, -0.0, 1.5 * core::kPi - 2.0 * core::kPi};
+    for (int k = 0; k < 400; ++k) ths.push_back(core::uniform(rng, -core::kPi, core::kPi));
+    for (double mu : leg.prior_mu) {  // θ − μ at ±π, ±2.5π and next to them
+      for (double edge : {core::kPi, 2.5 * core::kPi}) {
+        for (double sign : {-1.0, 1.0}) {
+          const double th = mu + sign * edge;
+          ths.push_back(th);
+          ths.push_back(std::nextafter(th, 0.0));
+          ths.push_back(std::nextafter(th, 10.0));
+        }
+      }
+    }
+    for (double th : ths) {
+      ASSERT_EQ(leg.logPrior(th), logPriorAsWritten(leg, th)) << trial << " " << th;
+      ++compared;
+    }
+    for (const bool evidence : {true, false}) {
+      const int points = evidence ? 120 : 180;
+      const std::vector<double> grid = leg.logPriorOnGrid(points, evidence);
+      const double step = 2.0 * core::kPi / points;
+      for (int k = 0; k < points; ++k) {
+        const double th = evidence ? -core::kPi + 2.0 * core::kPi * k / points : -core::kPi + step * k;
+        ASSERT_EQ(grid[static_cast<std::size_t>(k)], logPriorAsWritten(leg, th)) << trial << " " << k;
+      }
+    }
+  }
+  EXPECT_GT(compared, 8000);
 }

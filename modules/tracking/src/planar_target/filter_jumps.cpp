@@ -235,10 +235,7 @@ const PlanarTargetFilter::LegPriorMemo& PlanarTargetFilter::legPriorMemo(const C
   prior.log_norm = 0.0;
   if (leg.region && !leg.prior_mu.empty()) {
     // Both priors: normalise their product on a fine grid (each alone already has mean 1 in 2π p(θ)).
-    constexpr int kPoints = 720;
-    double sum = 0.0;
-    for (int k = 0; k < kPoints; ++k) sum += std::exp(prior.logPrior(-core::kPi + 2.0 * core::kPi * k / kPoints));
-    prior.log_norm = -std::log(sum / kPoints);
+    prior.log_norm = prior.logPriorNormalisation(720);
   }
   e.log_norm = prior.log_norm;
   e.evidence = std::make_shared<const std::vector<double>>(
@@ -254,6 +251,7 @@ ConstantSpeedLeg PlanarTargetFilter::makeLeg(core::Timestamp t_c, const Eigen::V
   ConstantSpeedLeg leg;
   leg.t_c = t_c;
   if (config_.turn_prior_weight > 0.0 && std::isfinite(from_direction) && !turns_.turns().empty()) {
+    leg.prior_mu.reserve(turns_.turns().size());
     for (double turn : turns_.turns()) leg.prior_mu.push_back(from_direction + turn);
     leg.prior_weight = config_.turn_prior_weight;
     leg.prior_sigma = config_.turn_prior_sigma_deg * core::kPi / 180.0;

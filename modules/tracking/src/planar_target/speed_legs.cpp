@@ -12,6 +12,37 @@
 
 namespace viewline::tracking {
 
+namespace {
+// cos θ_k and sin θ_k at θ_k = −π + 2π k / points (evidence: logEvidence's grid and the prior's normalisation)
+// or −π + (2π / points) k (moments()' first grid): the same θ_k, so the same values, as evaluating them where
+// they are used. Kept per thread, the last few grids.
+struct UnitGrid {
+  int points = 0;
+  bool evidence = false;
+  std::vector<double> cos, sin;
+};
+const UnitGrid& unitGrid(int points, bool evidence) {
+  thread_local UnitGrid grids[6];
+  thread_local std::size_t next = 0;
+  for (const UnitGrid& g : grids) {
+    if (g.points == points && g.evidence == evidence) return g;
+  }
+  UnitGrid& unit = grids[next];
+  next = (next + 1) % 6;
+  unit.points = points;
+  unit.evidence = evidence;
+  unit.cos.resize(static_cast<std::size_t>(points));
+  unit.sin.resize(static_cast<std::size_t>(points));
+  const double step = 2.0 * core::kPi / points;
+  for (int k = 0; k < points; ++k) {
+    const double th = evidence ? -core::kPi + 2.0 * core::kPi * k / points : -core::kPi + step * k;
+    unit.cos[static_cast<std::size_t>(k)] = std::cos(th);
+    unit.sin[static_cast<std::size_t>(k)] = std::sin(th);
+  }
+  return unit;
+}
+}  // namespace
+
 void ConstantSpeedLeg::add(double t, const Eigen::Vector2d& z, const Eigen::Matrix2d& R) {
   const Eigen::Matrix2d Ri = R.inverse();
   const double tau = t - t_c;
@@ -33,19 +64,28 @@ void ConstantSpeedLeg::copySums(const ConstantSpeedLeg& from) {
 }
 
 double ConstantSpeedLeg::logPrior(double th) const {
+  // (cos and sin only for the region prior, as boxReach(θ) takes them)
+  return logPrior(th, region ? Eigen::Vector2d(std::cos(th), std::sin(th)) : Eigen::Vector2d::Zero());
+}
+
+double ConstantSpeedLeg::logPrior(double th, const Eigen::Vector2d& u) const {
   double lp = log_norm;
   if (region) {
     // log(2π R² / (2A)); R floored at 0.1 mm so that a corner estimated on the boundary stays finite.
-    const double R = std::max(boxReach(region_c, region_lo, region_hi, th), 1e-4);
+    const double R = std::max(boxReach(region_c, region_lo, region_hi, u), 1e-4);
     lp += region_log_scale + 2.0 * std::log(R);
   }
   if (prior_mu.empty() || prior_weight <= 0.0) return lp;
   double g = 0.0;
   for (double mu : prior_mu) {
-    // Wrapped to [−π, π] (σ ≪ π, one wrap suffices). remainder(x, 2π) is x itself when |x| < π (the float 2π
-    // is twice the float π, so the nearest integer to x / 2π is 0): the libm call only beyond.
-    const double x = th - mu;
-    const double d = std::abs(x) < core::kPi ? x : std::remainder(x, 2.0 * core::kPi);
+    // Wrapped to [−π, π] (σ ≪ π, one wrap suffices). remainder(x, 2π) is exact: x itself when |x| < π (the
+    // float 2π is twice the float π, so the nearest integer to x / 2π is 0), x ∓ 2π when π < |x| < 2.5π (the
+    // nearest integer is ±1, and the subtraction is exact: Sterbenz, 2π / 2 <= |x| <= 2 · 2π); the libm call
+    // only elsewhere.
+    const double x = th - mu, a = std::abs(x);
+    const double d = a < core::kPi ? x
+                     : a > core::kPi && a < 2.5 * core::kPi ? x - std::copysign(2.0 * core::kPi, x)
+                                                            : std::remainder(x, 2.0 * core::kPi);
     if (d * d < 100.0 * prior_sigma * prior_sigma) g += std::exp(-0.5 * d * d / (prior_sigma * prior_sigma));  // (e^-50 beyond)
   }
   g *= std::sqrt(2.0 * core::kPi) / prior_sigma / static_cast<double>(prior_mu.size());
@@ -55,8 +95,9 @@ double ConstantSpeedLeg::logPrior(double th) const {
 namespace {
 // logLikelihood(θ) without the covariance: Λ(θ)'s Cholesky factor and the posterior mean of β are left in
 // llt and mean (the covariance is llt.solve(I), formed where it is needed), the same operations in order.
-double factoredLogLikelihood(const ConstantSpeedLeg& leg, double th, Eigen::LLT<Eigen::Matrix3d>& llt, Eigen::Vector3d& mean) {
-  const Eigen::Vector2d u(std::cos(th), std::sin(th));
+// u = (cos θ, sin θ).
+double factoredLogLikelihood(const ConstantSpeedLeg& leg, const Eigen::Vector2d& u, Eigen::LLT<Eigen::Matrix3d>& llt,
+                             Eigen::Vector3d& mean) {
   Eigen::Matrix3d L = leg.P0_inv;
   L.topLeftCorner<2, 2>() += leg.A;
   const Eigen::Vector2d Btu = leg.Bt * u;
@@ -77,7 +118,7 @@ double factoredLogLikelihood(const ConstantSpeedLeg& leg, double th, Eigen::LLT<
 double ConstantSpeedLeg::logLikelihood(double th, Eigen::Vector3d* m, Eigen::Matrix3d* cov) const {
   Eigen::LLT<Eigen::Matrix3d> llt;
   Eigen::Vector3d mean;
-  const double ll = factoredLogLikelihood(*this, th, llt, mean);
+  const double ll = factoredLogLikelihood(*this, Eigen::Vector2d(std::cos(th), std::sin(th)), llt, mean);
   if (m != nullptr) *m = mean;
   if (cov != nullptr) *cov = llt.solve(Eigen::Matrix3d::Identity());
   return ll;
@@ -125,27 +166,6 @@ struct SchurForm {
   Eigen::Vector2d g, P0_cs;
 };
 
-// cos θ_k and sin θ_k at θ_k = −π + 2π k / points (evidence) or −π + (2π / points) k (moments()' first grid),
-// kept per thread for the last size of each.
-struct UnitGrid {
-  std::vector<double> cos, sin;
-};
-const UnitGrid& unitGrid(int points, bool evidence) {
-  thread_local UnitGrid grids[2];
-  UnitGrid& unit = grids[evidence ? 0 : 1];
-  if (static_cast<int>(unit.cos.size()) != points) {
-    unit.cos.resize(static_cast<std::size_t>(points));
-    unit.sin.resize(static_cast<std::size_t>(points));
-    const double step = 2.0 * core::kPi / points;
-    for (int k = 0; k < points; ++k) {
-      const double th = evidence ? -core::kPi + 2.0 * core::kPi * k / points : -core::kPi + step * k;
-      unit.cos[static_cast<std::size_t>(k)] = std::cos(th);
-      unit.sin[static_cast<std::size_t>(k)] = std::sin(th);
-    }
-  }
-  return unit;
-}
-
 // Which points of a θ grid can be skipped: those whose exp(ll_k − top) is +0, top = max_k ll_k. ll_k =
 // t_k − ½ (log det M + log σ_k) + prior_k (SchurForm); exp(x) is +0 exactly for x < −745.2 (under half the
 // least subnormal). With σ_min = min_k σ_k, u_k = t_k − ½ (log det M + log σ_min) + prior_k >= ll_k; a point
@@ -157,8 +177,16 @@ std::size_t skippable(const SchurForm& form, const std::vector<double>& schur, c
                const std::vector<double>& prior, double margin, const Exact& exact, std::vector<double>& u,
                std::vector<unsigned char>& skip) {
   const std::size_t n = schur.size();
-  double schur_min = std::numeric_limits<double>::infinity();
-  for (double v : schur) schur_min = std::min(schur_min, v);
+  // min over the non-NaN σ_k, in four independent chains (the order does not change a minimum; NaN is skipped by
+  // std::min(acc, NaN) in any chain, and ±0 give the same log).
+  double acc[4] = {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
+                   std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
+  std::size_t k4 = 0;
+  for (; k4 + 4 <= n; k4 += 4) {
+    for (std::size_t l = 0; l < 4; ++l) acc[l] = std::min(acc[l], schur[k4 + l]);
+  }
+  for (; k4 < n; ++k4) acc[0] = std::min(acc[0], schur[k4]);
+  const double schur_min = std::min(std::min(acc[0], acc[1]), std::min(acc[2], acc[3]));
   const double log_schur_min = std::log(schur_min);
   u.resize(n);
   skip.resize(n);
@@ -216,14 +244,16 @@ double ConstantSpeedLeg::logEvidence(int points) const {
 estimation::StateEstimate ConstantSpeedLeg::moments(double t) const {
   struct Point {
     double th = 0.0, ll = 0.0;
+    Eigen::Vector2d u = Eigen::Vector2d::Zero();  ///< (cos θ, sin θ)
     Eigen::Vector3d m = Eigen::Vector3d::Zero();
     Eigen::LLT<Eigen::Matrix3d> llt;  ///< Λ(θ)'s factor: the covariance Λ⁻¹ is solved where it is used
     bool skipped = false;             ///< exp(ll − any grid maximum) is +0 (ll not evaluated)
   };
   const auto evaluate = [&](Point& pt, double th, const double* prior) {
     pt.th = th;
+    pt.u = Eigen::Vector2d(std::cos(th), std::sin(th));  // (once for the likelihood, the prior and the moments)
     pt.skipped = false;
-    pt.ll = factoredLogLikelihood(*this, th, pt.llt, pt.m) + (prior != nullptr ? *prior : logPrior(th));
+    pt.ll = factoredLogLikelihood(*this, pt.u, pt.llt, pt.m) + (prior != nullptr ? *prior : logPrior(th, pt.u));
   };
   // Grid over θ: 180 points on the circle, then refined (±2 steps of the previous grid, 81 points)
   // while one point holds more than 30 % of the mass, so a narrow posterior is still resolved. The first
@@ -246,7 +276,10 @@ estimation::StateEstimate ConstantSpeedLeg::moments(double t) const {
       schurs.resize(180);
       priors.resize(180);
       form.at(*this, unit.cos.data(), unit.sin.data(), 180, schurs.data(), quad.data());
-      for (std::size_t k = 0; k < 180; ++k) priors[k] = table != nullptr ? table[k] : logPrior(lo + step * static_cast<double>(k));
+      for (std::size_t k = 0; k < 180; ++k) {
+        priors[k] = table != nullptr ? table[k]
+                                     : logPrior(lo + step * static_cast<double>(k), Eigen::Vector2d(unit.cos[k], unit.sin[k]));
+      }
       const auto exact = [&](std::size_t k) {
         evaluate(grid[k], lo + step * static_cast<double>(k), table != nullptr ? table + k : nullptr);
         return grid[k].ll;
@@ -285,7 +318,7 @@ estimation::StateEstimate ConstantSpeedLeg::moments(double t) const {
     if (pt.skipped) continue;
     const double w = std::exp(pt.ll - top);
     if (w < 1e-12) continue;
-    const Eigen::Vector2d u(std::cos(pt.th), std::sin(pt.th));
+    const Eigen::Vector2d& u = pt.u;
     Eigen::Matrix<double, 4, 3> J = Eigen::Matrix<double, 4, 3>::Zero();  // (p, v) = J β
     J.topLeftCorner<2, 2>() = Eigen::Matrix2d::Identity();
     J.block<2, 1>(0, 2) = tau * u;
@@ -306,10 +339,24 @@ estimation::StateEstimate ConstantSpeedLeg::moments(double t) const {
 std::vector<double> ConstantSpeedLeg::logPriorOnGrid(int points, bool evidence) const {
   // The θ_k exactly as logEvidence and moments() form them.
   std::vector<double> out(static_cast<std::size_t>(points));
+  const UnitGrid& unit = unitGrid(points, evidence);
   const double step = 2.0 * core::kPi / points;
-  for (int k = 0; k < points; ++k)
-    out[static_cast<std::size_t>(k)] = logPrior(evidence ? -core::kPi + 2.0 * core::kPi * k / points : -core::kPi + step * k);
+  for (int k = 0; k < points; ++k) {
+    const auto kk = static_cast<std::size_t>(k);
+    out[kk] = logPrior(evidence ? -core::kPi + 2.0 * core::kPi * k / points : -core::kPi + step * k,
+                       Eigen::Vector2d(unit.cos[kk], unit.sin[kk]));
+  }
   return out;
+}
+
+double ConstantSpeedLeg::logPriorNormalisation(int points) const {
+  const UnitGrid& unit = unitGrid(points, true);
+  double sum = 0.0;
+  for (int k = 0; k < points; ++k) {
+    const auto kk = static_cast<std::size_t>(k);
+    sum += std::exp(logPrior(-core::kPi + 2.0 * core::kPi * k / points, Eigen::Vector2d(unit.cos[kk], unit.sin[kk])));
+  }
+  return -std::log(sum / points);
 }
 
 int legEvidencePoints(double turn_prior_sigma_deg) {

@@ -79,6 +79,11 @@ struct ConstantSpeedLeg {
   void copySums(const ConstantSpeedLeg& from);
   /// log(2π p(θ)): 0 when θ is uniform.
   double logPrior(double th) const;
+  /// logPrior(th) with u = (cos th, sin th) given (the region prior's direction, not evaluated again).
+  double logPrior(double th, const Eigen::Vector2d& u) const;
+  /// −log of the mean of 2π p(θ_k) = exp(logPrior(θ_k)) over θ_k = −π + 2π k / points: the log_norm that
+  /// normalises the prior on that grid.
+  double logPriorNormalisation(int points) const;
   /// log p(z | θ) (up to a constant), and the posterior mean and covariance of β = (c, s) given θ.
   double logLikelihood(double th, Eigen::Vector3d* m = nullptr, Eigen::Matrix3d* cov = nullptr) const;
   /// log p(measurements | leg) up to the terms every candidate corner time shares (see the source).
