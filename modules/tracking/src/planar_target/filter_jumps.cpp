@@ -211,10 +211,17 @@ const PlanarTargetFilter::LegPriorMemo& PlanarTargetFilter::legPriorMemo(const C
     e.moments = std::make_shared<const std::vector<double>>(prior.logPriorOnGrid(180, false));
   };
   ++memo_clock_;
-  for (LegPriorMemo& e : leg_prior_memo_) {
+  // From the entry after the last one found (a scan asks for its candidates in the order their entries were
+  // made), round the whole memo: keys are unique (an entry is made only after a full miss), so the entry
+  // found is the same in any order.
+  const std::size_t size = leg_prior_memo_.size();
+  for (std::size_t i = 0; i < size; ++i) {
+    const std::size_t at = (memo_hint_ + i) % size;
+    LegPriorMemo& e = leg_prior_memo_[at];
     if (same(e)) {
       e.used = memo_clock_;
       if (moments_table && !e.moments) addMoments(e);
+      memo_hint_ = at + 1;
       return e;
     }
   }
@@ -243,6 +250,7 @@ const PlanarTargetFilter::LegPriorMemo& PlanarTargetFilter::legPriorMemo(const C
   if (moments_table) addMoments(e);
   e.used = memo_clock_;
   leg_prior_memo_.push_back(std::move(e));
+  memo_hint_ = 0;
   return leg_prior_memo_.back();
 }
 

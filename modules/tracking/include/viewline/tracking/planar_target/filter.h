@@ -204,6 +204,7 @@ private:
   std::shared_ptr<const ConstantSpeedLeg> leg_;  ///< the current leg (immutable: copies share it until it changes)
   mutable std::vector<LegPriorMemo> leg_prior_memo_;  ///< legPriorMemo's entries (a cache: no effect on values)
   mutable std::uint64_t memo_clock_ = 0;              ///< counts legPriorMemo calls
+  mutable std::size_t memo_hint_ = 0;                 ///< where legPriorMemo's search starts (after the last hit)
   std::optional<estimation::StateEstimate> output_;  ///< the soft mixture, when it differs from state_
   PlanarHistory history_;  ///< measurements of the last jump_window s (since the last jump)
   std::uint64_t serial_ = 0;  ///< the last snapshot's serial
