@@ -268,8 +268,9 @@ PlanarTargetFilter::Update PlanarTargetFilter::updateUnder(core::Timestamp t, co
 }
 
 PlanarTargetFilter::Snapshot PlanarTargetFilter::snapshot(core::Timestamp t, const Eigen::Vector2d& z,
-                                                          const Eigen::Matrix2d& R) const {
+                                                          const Eigen::Matrix2d& R) {
   Snapshot s;
+  s.serial = ++serial_;
   s.t = t;
   s.z = z;
   s.R = R;

@@ -40,7 +40,9 @@ bool PlanarTargetFilter::detectJump() {
   std::function<double(int)> leg_bf;
   if (soft && legEvidenceMixture()) {
     const LegFactory make = legFactory();
-    leg_bf = [this, make](int j) { return legBayesFactor(history_, j, make, config_.turn_prior_sigma_deg); };
+    // legBayesFactor from the sums kept since the last scan (LegBayesFactors: the same values).
+    leg_bayes_factors_.sync(history_);
+    leg_bf = [this, make](int j) { return leg_bayes_factors_(history_, j, make, config_.turn_prior_sigma_deg); };
   }
   JumpScan scan = scanForJump(history_, settings, leg_bf, soft ? regionJumpOdds() : std::vector<double>{});
   int best_j = scan.jump;
@@ -74,7 +76,7 @@ double PlanarTargetFilter::cornerSigma() const {
 
 LegFactory PlanarTargetFilter::legFactory() const {
   return [this](core::Timestamp t_c, const Eigen::Vector2d& c, const Eigen::Matrix2d& P_c, double from_direction) {
-    return makeLeg(t_c, c, P_c, from_direction);
+    return makeLeg(t_c, c, P_c, from_direction, false);  // (the scan's legs: logEvidence only)
   };
 }
 
@@ -148,7 +150,12 @@ estimation::StateEstimate PlanarTargetFilter::alternative(int j) const {
   const std::size_t n = history_.size();
   if (config_.constant_speed && speed_.known()) {
     ConstantSpeedLeg leg = makeLeg(sj.t, sj.state.x().head<2>(), sj.state.P().block(0, 0, 2, 2), velocityDirection(sj.state));
-    for (std::size_t i = static_cast<std::size_t>(j) + 1; i < n; ++i) leg.add(history_[i].t, history_[i].z, history_[i].R);
+    // The scan has just summed the measurements after t_j for this candidate (the same sums as adding them here).
+    if (const ConstantSpeedLeg* sums = leg_bayes_factors_.legSums(history_, j)) {
+      leg.copySums(*sums);
+    } else {
+      for (std::size_t i = static_cast<std::size_t>(j) + 1; i < n; ++i) leg.add(history_[i].t, history_[i].z, history_[i].R);
+    }
     return leg.moments(history_.back().t);
   }
   estimation::StateEstimate s = reopened(sj);
@@ -190,16 +197,31 @@ void PlanarTargetFilter::applyJump(int best_j) {
   }
 }
 
-const PlanarTargetFilter::LegPriorMemo& PlanarTargetFilter::legPriorMemo(const ConstantSpeedLeg& leg) const {
+const PlanarTargetFilter::LegPriorMemo& PlanarTargetFilter::legPriorMemo(const ConstantSpeedLeg& leg,
+                                                                         bool moments_table) const {
   const auto same = [&leg](const LegPriorMemo& e) {
     return e.region == leg.region && e.region_c == leg.region_c && e.prior_mu == leg.prior_mu &&
            e.prior_weight == leg.prior_weight && e.prior_sigma == leg.prior_sigma && e.region_lo == leg.region_lo &&
            e.region_hi == leg.region_hi && e.region_log_scale == leg.region_log_scale;
   };
+  // moments()' table only when asked for (the scan's legs only need the evidence's); made from the same fields.
+  const auto addMoments = [&leg](LegPriorMemo& e) {
+    ConstantSpeedLeg prior = leg;
+    prior.log_norm = e.log_norm;
+    e.moments = std::make_shared<const std::vector<double>>(prior.logPriorOnGrid(180, false));
+  };
   ++memo_clock_;
-  for (LegPriorMemo& e : leg_prior_memo_) {
+  // From the entry after the last one found (a scan asks for its candidates in the order their entries were
+  // made), round the whole memo: keys are unique (an entry is made only after a full miss), so the entry
+  // found is the same in any order.
+  const std::size_t size = leg_prior_memo_.size();
+  for (std::size_t i = 0; i < size; ++i) {
+    const std::size_t at = (memo_hint_ + i) % size;
+    LegPriorMemo& e = leg_prior_memo_[at];
     if (same(e)) {
       e.used = memo_clock_;
+      if (moments_table && !e.moments) addMoments(e);
+      memo_hint_ = at + 1;
       return e;
     }
   }
@@ -220,25 +242,24 @@ const PlanarTargetFilter::LegPriorMemo& PlanarTargetFilter::legPriorMemo(const C
   prior.log_norm = 0.0;
   if (leg.region && !leg.prior_mu.empty()) {
     // Both priors: normalise their product on a fine grid (each alone already has mean 1 in 2π p(θ)).
-    constexpr int kPoints = 720;
-    double sum = 0.0;
-    for (int k = 0; k < kPoints; ++k) sum += std::exp(prior.logPrior(-core::kPi + 2.0 * core::kPi * k / kPoints));
-    prior.log_norm = -std::log(sum / kPoints);
+    prior.log_norm = prior.logPriorNormalisation(720);
   }
   e.log_norm = prior.log_norm;
   e.evidence = std::make_shared<const std::vector<double>>(
       prior.logPriorOnGrid(legEvidencePoints(config_.turn_prior_sigma_deg), true));
-  e.moments = std::make_shared<const std::vector<double>>(prior.logPriorOnGrid(180, false));
+  if (moments_table) addMoments(e);
   e.used = memo_clock_;
   leg_prior_memo_.push_back(std::move(e));
+  memo_hint_ = 0;
   return leg_prior_memo_.back();
 }
 
 ConstantSpeedLeg PlanarTargetFilter::makeLeg(core::Timestamp t_c, const Eigen::Vector2d& c, const Eigen::Matrix2d& P_c,
-                                             double from_direction) const {
+                                             double from_direction, bool moments_table) const {
   ConstantSpeedLeg leg;
   leg.t_c = t_c;
   if (config_.turn_prior_weight > 0.0 && std::isfinite(from_direction) && !turns_.turns().empty()) {
+    leg.prior_mu.reserve(turns_.turns().size());
     for (double turn : turns_.turns()) leg.prior_mu.push_back(from_direction + turn);
     leg.prior_weight = config_.turn_prior_weight;
     leg.prior_sigma = config_.turn_prior_sigma_deg * core::kPi / 180.0;
@@ -254,7 +275,7 @@ ConstantSpeedLeg PlanarTargetFilter::makeLeg(core::Timestamp t_c, const Eigen::V
   // The prior of θ is a function of the fields set above alone, and the scan asks for the same ones at
   // every measurement (one per candidate corner): the normalisation and the θ grids' logPrior tables are
   // memoised, keyed by those fields compared exactly, so a hit gives the values a fresh evaluation would.
-  const LegPriorMemo& memo = legPriorMemo(leg);
+  const LegPriorMemo& memo = legPriorMemo(leg, moments_table);
   leg.log_norm = memo.log_norm;
   leg.log_prior_evidence = memo.evidence;
   leg.log_prior_moments = memo.moments;

@@ -10,7 +10,10 @@
 namespace viewline::tracking {
 
 double boxReach(const Eigen::Vector2d& c, const Eigen::Vector2d& lo, const Eigen::Vector2d& hi, double th) {
-  const Eigen::Vector2d u(std::cos(th), std::sin(th));
+  return boxReach(c, lo, hi, Eigen::Vector2d(std::cos(th), std::sin(th)));
+}
+
+double boxReach(const Eigen::Vector2d& c, const Eigen::Vector2d& lo, const Eigen::Vector2d& hi, const Eigen::Vector2d& u) {
   double r = std::numeric_limits<double>::infinity();
   for (int a = 0; a < 2; ++a) {
     if (u(a) > 1e-12) r = std::min(r, (hi(a) - c(a)) / u(a));

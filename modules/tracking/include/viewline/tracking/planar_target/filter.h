@@ -151,15 +151,17 @@ private:
   bool admit(Update& out, core::Timestamp t, const Eigen::Vector2d& z, const Eigen::Matrix2d& R,
              const estimation::StateEstimate* coast = nullptr, std::optional<GateDecision> decided = std::nullopt);
   void count(const Update& u);
-  Snapshot snapshot(core::Timestamp t, const Eigen::Vector2d& z, const Eigen::Matrix2d& R) const;
+  /// The measurement and the state now, under a new serial.
+  Snapshot snapshot(core::Timestamp t, const Eigen::Vector2d& z, const Eigen::Matrix2d& R);
   bool detectJump();
   void applyJump(int j);  ///< restart from history_[j] with the motion prior re-opened, re-process the rest
   void softMixture(std::vector<std::pair<double, int>>& log_odds);
   /// The constant-speed leg from the corner (t_c, c ~ N(c, P_c)) under the current speed, turn and
-  /// region priors; from_direction: the direction (rad) of the leg that ended there (NaN: θ uniform).
+  /// region priors; from_direction: the direction (rad) of the leg that ended there (NaN: θ uniform);
+  /// moments_table: with the logPrior table of moments()' first grid (false: logEvidence's only).
   ConstantSpeedLeg makeLeg(core::Timestamp t_c, const Eigen::Vector2d& c, const Eigen::Matrix2d& P_c,
-                           double from_direction) const;
-  LegFactory legFactory() const;  ///< makeLeg with the priors at the time of the call
+                           double from_direction, bool moments_table = true) const;
+  LegFactory legFactory() const;  ///< makeLeg with the priors at the time of the call (logEvidence's table only)
   /// A leg prior's normalisation and logPrior tables (ConstantSpeedLeg), keyed by the fields logPrior reads.
   struct LegPriorMemo {
     bool region = false;  ///< key: ConstantSpeedLeg::region
@@ -172,11 +174,11 @@ private:
            prior_sigma = 0.0;       ///< key: ConstantSpeedLeg::prior_sigma, rad
     double log_norm = 0.0;          ///< the normalisation for these fields
     std::shared_ptr<const std::vector<double>> evidence,  ///< logPrior on legBayesFactor's grid
-                                               moments;   ///< logPrior on moments()' first grid
+                                               moments;   ///< logPrior on moments()' first grid (once asked for)
     std::uint64_t used = 0;         ///< last use (memo_clock_), for dropping the least recent
   };
-  /// The memo entry of this leg's prior fields (made on a miss).
-  const LegPriorMemo& legPriorMemo(const ConstantSpeedLeg& leg) const;
+  /// The memo entry of this leg's prior fields (made on a miss), with moments()' table if moments_table.
+  const LegPriorMemo& legPriorMemo(const ConstantSpeedLeg& leg, bool moments_table) const;
   static constexpr std::size_t kLegPriorMemoSize = 256;  ///< entries kept (a scan asks for ~1 per measurement of the window)
   estimation::StateEstimate reopened(const Snapshot& sj) const;  ///< x(j|j) with the motion prior re-opened
   estimation::StateEstimate alternative(int j) const;            ///< the state now after a jump at history_[j]
@@ -202,8 +204,11 @@ private:
   std::shared_ptr<const ConstantSpeedLeg> leg_;  ///< the current leg (immutable: copies share it until it changes)
   mutable std::vector<LegPriorMemo> leg_prior_memo_;  ///< legPriorMemo's entries (a cache: no effect on values)
   mutable std::uint64_t memo_clock_ = 0;              ///< counts legPriorMemo calls
+  mutable std::size_t memo_hint_ = 0;                 ///< where legPriorMemo's search starts (after the last hit)
   std::optional<estimation::StateEstimate> output_;  ///< the soft mixture, when it differs from state_
   PlanarHistory history_;  ///< measurements of the last jump_window s (since the last jump)
+  std::uint64_t serial_ = 0;  ///< the last snapshot's serial
+  LegBayesFactors leg_bayes_factors_;  ///< the scan's legBayesFactor, its sums kept between scans (a cache)
   std::size_t jumps_ = 0;
   std::optional<estimation::Imm> imm_;
   std::optional<WaypointParticleFilter> particles_;  ///< model waypoint_particles

@@ -4,6 +4,7 @@
 // re-processes; and the motions those states extrapolate by.
 
 #include <Eigen/Core>
+#include <cstdint>
 #include <optional>
 #include <vector>
 
@@ -20,6 +21,9 @@ struct PlanarSnapshot {
   Eigen::Matrix2d R = Eigen::Matrix2d::Identity();  ///< its covariance, m²
   estimation::StateEstimate state;       ///< x(t|t) after this measurement
   std::optional<estimation::Imm> imm;  ///< the IMM's full state after this measurement (IMM models only)
+  /// Names this snapshot (LegBayesFactors keeps sums by it): increases along a history, and a serial is never
+  /// given to another measurement or state (the filter numbers every snapshot it makes).
+  std::uint64_t serial = 0;
 };
 /// The measurements of the last jump window, oldest first.
 using PlanarHistory = std::vector<PlanarSnapshot>;

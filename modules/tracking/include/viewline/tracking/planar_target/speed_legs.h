@@ -34,6 +34,7 @@
 // region is set (normalised on a grid when both are on): logPrior() is log(2π p(θ)), 0 when uniform.
 
 #include <Eigen/Core>
+#include <cstdint>
 #include <functional>
 #include <limits>
 #include <memory>
@@ -74,8 +75,15 @@ struct ConstantSpeedLeg {
 
   /// Adds the measurement z (covariance R) at t to the statistics.
   void add(double t, const Eigen::Vector2d& z, const Eigen::Matrix2d& R);
+  /// The statistics A, B_z, B_τ, C_τz, C_ττ, zz of `from` (a leg of the same t_c), the prior fields kept.
+  void copySums(const ConstantSpeedLeg& from);
   /// log(2π p(θ)): 0 when θ is uniform.
   double logPrior(double th) const;
+  /// logPrior(th) with u = (cos th, sin th) given (the region prior's direction, not evaluated again).
+  double logPrior(double th, const Eigen::Vector2d& u) const;
+  /// −log of the mean of 2π p(θ_k) = exp(logPrior(θ_k)) over θ_k = −π + 2π k / points: the log_norm that
+  /// normalises the prior on that grid.
+  double logPriorNormalisation(int points) const;
   /// log p(z | θ) (up to a constant), and the posterior mean and covariance of β = (c, s) given θ.
   double logLikelihood(double th, Eigen::Vector3d* m = nullptr, Eigen::Matrix3d* cov = nullptr) const;
   /// log p(measurements | leg) up to the terms every candidate corner time shares (see the source).
@@ -137,6 +145,50 @@ private:
 /// measurements after history[j] (the soft mixture's jump_evidence "legs"); turn_prior_sigma_deg sets
 /// the θ grid.
 double legBayesFactor(const PlanarHistory& history, int j, const LegFactory& make, double turn_prior_sigma_deg);
+
+/// legBayesFactor for the candidate corners of successive scans, from sums kept between the scans. Per
+/// candidate history[j]: the leg's statistics and the straight-on fit's information Λ, vector η and
+/// Σ zᵀR⁻¹z over the measurements after it. A scan adds to them only the measurements that arrived since the
+/// previous one, each to the sum so far in the order legBayesFactor adds them (history[j+1], ..., history[n−1]),
+/// so every sum, and the factor, is legBayesFactor's to the last bit (its O(n) sums per candidate per scan
+/// become O(1)). Candidates are told apart by PlanarSnapshot::serial; one that left the history is dropped.
+class LegBayesFactors {
+public:
+  /// Drops the candidates no longer in `history` (call before each scan; no allocation).
+  void sync(const PlanarHistory& history);
+  /// legBayesFactor(history, j, make, turn_prior_sigma_deg) from the kept sums, brought up to date first.
+  double operator()(const PlanarHistory& history, int j, const LegFactory& make, double turn_prior_sigma_deg);
+  /// The leg statistics over history[j+1..n−1] (ConstantSpeedLeg's sums, t_c = history[j].t) when they are
+  /// up to date with the history's last measurement, else nullptr (a candidate this scan did not score).
+  const ConstantSpeedLeg* legSums(const PlanarHistory& history, int j) const;
+  /// Drops every candidate.
+  void clear() { candidates_.clear(); }
+
+  /// One candidate corner: legBayesFactor's two fits from x(j|j), without the leg's prior (made at evaluation).
+  struct Candidate {
+    /// From history[j] (serial, t, state), no measurement summed yet.
+    explicit Candidate(const PlanarSnapshot& sj);
+    /// Adds the measurement of snapshot si (after the corner) to both fits.
+    void add(const PlanarSnapshot& si);
+    /// log BF (legBayesFactor) from the sums so far and the leg make() gives for the corner.
+    double value(const LegFactory& make, double turn_prior_sigma_deg) const;
+
+    std::uint64_t serial = 0;  ///< of the corner's snapshot
+    std::uint64_t last = 0;    ///< serial of the last measurement summed (the corner's own: none)
+    Eigen::Vector4d x = Eigen::Vector4d::Zero();          ///< x(j|j)'s (p, v)
+    Eigen::Matrix2d P_pos = Eigen::Matrix2d::Zero();      ///< its position covariance (+ 1e-10 I), make's P_c
+    double direction = 0.0;                               ///< velocityDirection(x(j|j)), make's from_direction
+    Eigen::Matrix4d P_inv = Eigen::Matrix4d::Zero();      ///< (P + 1e-10 I)⁻¹
+    double logdet_P = 0.0;                                ///< log det (P + 1e-10 I)
+    Eigen::Matrix4d L = Eigen::Matrix4d::Zero();          ///< straight on: Λ = P⁻¹ + Σ H_iᵀR_i⁻¹H_i
+    Eigen::Vector4d eta = Eigen::Vector4d::Zero();        ///< straight on: η = P⁻¹ x̂ + Σ H_iᵀR_i⁻¹z_i
+    double zz = 0.0;                                      ///< straight on: Σ z_iᵀR_i⁻¹z_i
+    ConstantSpeedLeg leg;                                 ///< t_c and the leg's statistics (no prior)
+  };
+
+private:
+  std::vector<Candidate> candidates_;  ///< by serial, increasing
+};
 
 /// The constant-speed leg's most likely start within ±6 measurements of history[j] (see the source).
 int refineCornerTime(const PlanarHistory& history, int j, const LegFactory& make);

@@ -28,6 +28,8 @@ namespace viewline::tracking {
 
 /// Distance from c (inside the box [lo, hi]) to the box's boundary along u(θ) = (cos θ, sin θ).
 double boxReach(const Eigen::Vector2d& c, const Eigen::Vector2d& lo, const Eigen::Vector2d& hi, double theta);
+/// The same with u(θ) = (cos θ, sin θ) given (computed once by a caller that needs it too).
+double boxReach(const Eigen::Vector2d& c, const Eigen::Vector2d& lo, const Eigen::Vector2d& hi, const Eigen::Vector2d& u);
 
 /// The density p(θ) = R(θ)² / (2A) of the direction θ from c to a point drawn uniformly in the box
 /// (centre, size = (width, height), area A), R(θ) the distance from c to the box's boundary along
