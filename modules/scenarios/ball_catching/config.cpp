@@ -155,7 +155,7 @@ void readDetector(const io::ConfigNode& d, BallCatchingConfig& c) {
   c.pixel_noise_px = d.getOr<double>("pixel_noise_px", c.pixel_noise_px);
 }
 
-void readTracker(const io::ConfigNode& t, tracking::TrackerConfig& k) {
+void readTracker(const io::ConfigNode& t, tracking::TrackerConfig& k, double& unregistered_bias_sigma_px) {
   Vector6 m = k.prior_mean;
   m.head<3>() = t.getOr<Eigen::Vector3d>("prior_position", Eigen::Vector3d(2.0, 0.0, 1.4));
   m.tail<3>() = t.getOr<Eigen::Vector3d>("prior_velocity", Eigen::Vector3d(7.5, 0.0, 0.0));
@@ -174,6 +174,7 @@ void readTracker(const io::ConfigNode& t, tracking::TrackerConfig& k) {
     const auto b = t.child("pixel_bias");
     k.pixel_bias.sigma_px = b.getOr<double>("sigma_px", k.pixel_bias.sigma_px);
     k.pixel_bias.time_constant_s = b.getOr<double>("time_constant_s", k.pixel_bias.time_constant_s);
+    unregistered_bias_sigma_px = b.getOr<double>("unregistered_sigma_px", unregistered_bias_sigma_px);
   }
 }
 
@@ -231,6 +232,15 @@ Eigen::Matrix3d boxRotation(const Eigen::Vector3d& n) {
   return R;
 }
 
+tracking::TrackerConfig BallCatchingConfig::trackerConfig() const {
+  tracking::TrackerConfig t = tracker;
+  if (!t.pixel_bias.enabled() || unregistered_bias_sigma_px <= 0.0) return t;
+  t.pixel_bias.camera_sigma_px.clear();
+  for (std::size_t i = 0; i < activeCameras(); ++i)
+    t.pixel_bias.camera_sigma_px.push_back(cameras[i].registered ? t.pixel_bias.sigma_px : unregistered_bias_sigma_px);
+  return t;
+}
+
 planning::CatchPlannerConfig BallCatchingConfig::plannerConfig() const {
   planning::CatchPlannerConfig p = planner;
   p.home = robot.home;
@@ -248,6 +258,8 @@ bool BallCatchingConfig::onFootage() const {
 
 void BallCatchingConfig::validate() const {
   if (cameras.empty()) throw InvalidInput("cameras: expected at least one camera");
+  if (!(unregistered_bias_sigma_px >= 0.0) || !std::isfinite(unregistered_bias_sigma_px))
+    throw InvalidInput("tracker.pixel_bias.unregistered_sigma_px: expected a finite number >= 0");
   if (camera_count > cameras.size()) throw InvalidInput("camera_count: more than the cameras listed");
   if (onFootage()) {
     // One clock for the session: footage cannot be fused with a camera rendered on a throw's clock.
@@ -333,7 +345,7 @@ BallCatchingConfig loadBallCatchingConfig(const io::ConfigNode& root) {
   c.robot.w_R_box = boxRotation(c.box_normal);  // the arm holds the box front towards the thrower
   if (root.has("detector")) readDetector(root.child("detector"), c);
   if (root.has("tracker")) {
-    readTracker(root.child("tracker"), c.tracker);
+    readTracker(root.child("tracker"), c.tracker, c.unregistered_bias_sigma_px);
   } else {
     c.tracker.prior_mean << 2.0, 0.0, 1.4, 7.5, 0.0, 0.0;
     c.tracker.model.accel_psd = 0.5;

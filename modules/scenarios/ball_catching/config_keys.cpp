@@ -115,6 +115,8 @@ io::ConfigReferenceSection ballCatchingConfigReference() {
       {"tracker.pixel_bias.sigma_px", "px", "stationary std of each camera's bias per axis (0: no bias state); "
                                             "detector.sigma_px is then the white part", "0"},
       {"tracker.pixel_bias.time_constant_s", "s", "correlation time τ of the bias (e^(−Δt/τ))", "1"},
+      {"tracker.pixel_bias.unregistered_sigma_px", "px", "the bias std of a camera not registered to the robot "
+                                                         "(its calibration error stays); 0: sigma_px for every camera", "0"},
       {"planner", "", "the catch planner (planning::CatchPlanner)"},
       {"planner.model", "", "flight model of the crossing prediction: drag or ballistic"},
       {"planner.accel_psd", "m²/s³", "process noise of the prediction"},

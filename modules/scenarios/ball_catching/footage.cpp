@@ -63,7 +63,7 @@ public:
                  runtime::ProcessingTimer* timer, double t0)
       : cfg_(cfg), frames_(faults.wrap(source)), faults_(faults), guard_(robot, faults),
         est_cams_(std::move(est_cams)), robot_(robot), planner_(cfg.plannerConfig(), robot),
-        tracker_(est_cams_, cfg.tracker), sum_(sum), hooks_(hooks), tel_(tel),
+        tracker_(est_cams_, cfg.trackerConfig()), sum_(sum), hooks_(hooks), tel_(tel),
         noise_rng_(core::makeRng(core::deriveSeed(seed, 0xD37))), planner_input_(cfg, est_cams_), timer_(timer) {
     planner_.reset(t0, cfg.robot.home);
     guard_.reset(robot.read(t0));

@@ -47,7 +47,7 @@ public:
             const CatchHooks* hooks, runtime::TelemetrySink* tel, std::uint64_t seed, runtime::FaultPlan& faults)
       : cfg_(cfg), flight_(flight), source_(source), frames_(faults.wrap(source)), faults_(faults),
         guard_(robot, faults), est_cams_(std::move(est_cams)), robot_(robot),
-        planner_(cfg.plannerConfig(), robot), tracker_(est_cams_, cfg.tracker), res_(res), hooks_(hooks), tel_(tel),
+        planner_(cfg.plannerConfig(), robot), tracker_(est_cams_, cfg.trackerConfig()), res_(res), hooks_(hooks), tel_(tel),
         noise_rng_(core::makeRng(core::deriveSeed(seed, 0xD37))),  // pixel_noise_px only
         planner_input_(cfg, est_cams_) {
     planner_.reset(0.0, cfg.robot.home);

@@ -14,9 +14,19 @@ estimation::DragBallisticModel flightFitModel(const BallCatchingConfig& cfg) {
   return d;
 }
 
+namespace {
+std::vector<double> biasSigmas(const BallCatchingConfig& cfg) {
+  const tracking::TrackerConfig t = cfg.trackerConfig();
+  std::vector<double> s(cfg.activeCameras(), 0.0);
+  if (t.pixel_bias.enabled())
+    for (std::size_t c = 0; c < s.size(); ++c) s[c] = t.pixel_bias.sigmaOf(c);
+  return s;
+}
+}  // namespace
+
 PlannerInput::PlannerInput(const BallCatchingConfig& cfg, std::vector<core::Camera> cameras)
     : enabled_(cfg.flight_fit.enabled),
-      bias_sigma_px_(cfg.tracker.pixel_bias.sigma_px),
+      bias_sigma_px_(biasSigmas(cfg)),
       fit_(cfg.flight_fit, std::move(cameras), flightFitModel(cfg), FitAimPlane{cfg.robot.home, cfg.box_normal}) {}
 
 estimation::StateEstimate PlannerInput::after(const tracking::ImageMeasurement& m,
@@ -30,7 +40,8 @@ estimation::StateEstimate PlannerInput::after(const tracking::ImageMeasurement& 
   }
   // The fit weighs its images as white; with the tracker's pixel bias on, m.sigma_px is only the
   // white part, and the fit is given the total (white and bias in quadrature) as before.
-  const double sigma = bias_sigma_px_ > 0.0 ? std::hypot(m.sigma_px, bias_sigma_px_) : m.sigma_px;
+  const double bias = m.camera < bias_sigma_px_.size() ? bias_sigma_px_[m.camera] : 0.0;
+  const double sigma = bias > 0.0 ? std::hypot(m.sigma_px, bias) : m.sigma_px;
   const std::optional<estimation::StateEstimate> fitted = fit_.add({m.camera, m.t, m.uv, sigma}, tracker.state());
   return fitted ? *fitted : tracker.state();
 }

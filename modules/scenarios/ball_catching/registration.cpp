@@ -145,6 +145,7 @@ RegistrationResult registerCamerasToRobot(BallCatchingConfig& cfg, const sim::Sc
     core::Camera cam = est[ci];
     cam.c_M_w = Mn;
     cfg.cameras[ci].calibrated_camera = cam;
+    cfg.cameras[ci].registered = true;
     ++out.cameras_registered;
   }
   if (out.cameras_registered == 0)

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <string>
 #include <tuple>
 #include <unordered_map>
 
@@ -74,12 +75,14 @@ namespace detail {
 
 estimation::StateEstimate biasedPrior(const TrackerConfig& cfg, std::size_t cameras, core::Timestamp t) {
   const Eigen::Index n = biasIndex(cameras);
-  const double var = cfg.pixel_bias.sigma_px * cfg.pixel_bias.sigma_px;
   Eigen::VectorXd x(n);
   x << cfg.prior_mean, Eigen::VectorXd::Zero(n - 6);
-  Eigen::MatrixXd P(n, n);
-  P << cfg.prior_cov, Eigen::MatrixXd::Zero(6, n - 6), Eigen::MatrixXd::Zero(n - 6, 6),
-      var * Eigen::MatrixXd::Identity(n - 6, n - 6);
+  Eigen::MatrixXd P = Eigen::MatrixXd::Zero(n, n);
+  P.topLeftCorner<6, 6>() = cfg.prior_cov;
+  for (std::size_t c = 0; c < cameras; ++c) {
+    const double sigma = cfg.pixel_bias.sigmaOf(c);
+    P.block<2, 2>(biasIndex(c), biasIndex(c)) = sigma * sigma * Eigen::Matrix2d::Identity();
+  }
   return estimation::StateEstimate(x, P, t);
 }
 
@@ -88,15 +91,16 @@ void predictBiased(const TrackerConfig& cfg, estimation::StateEstimate& s, doubl
   const Eigen::Index n = s.dim();
   const double tau = cfg.pixel_bias.time_constant_s;
   const double a = std::isinf(tau) ? 1.0 : std::exp(-dt / tau);
-  const double q = std::isinf(tau) ? 0.0 : -std::expm1(-2.0 * dt / tau) * cfg.pixel_bias.sigma_px * cfg.pixel_bias.sigma_px;
+  const double share = std::isinf(tau) ? 0.0 : -std::expm1(-2.0 * dt / tau);  // 1 − a²
   estimation::LinearTransition tr;
   tr.Phi = Eigen::MatrixXd::Identity(n, n);
   tr.Phi.topLeftCorner<6, 6>() = pv.Phi;
   tr.Q = Eigen::MatrixXd::Zero(n, n);
   tr.Q.topLeftCorner<6, 6>() = pv.Q;
   for (Eigen::Index i = 6; i < n; ++i) {
+    const double sigma = cfg.pixel_bias.sigmaOf(static_cast<std::size_t>((i - 6) / 2));
     tr.Phi(i, i) = a;
-    tr.Q(i, i) = q;
+    tr.Q(i, i) = share * sigma * sigma;
   }
   tr.Gamma = Eigen::MatrixXd::Zero(n, pv.Gamma.cols());
   tr.Gamma.topRows<6>() = pv.Gamma;
@@ -208,6 +212,15 @@ MeasurementOutcome fuseImage(estimation::StateEstimate& s, const core::Camera& c
 TrackState ViewlineTracker::initialState(const TrackerConfig& cfg, std::size_t cameras) {
   cfg.validate();
   if (cameras == 0) throw core::InvalidInput("tracker: at least one camera is needed");
+  const auto& per_camera = cfg.pixel_bias.camera_sigma_px;
+  if (cfg.pixel_bias.enabled() && !per_camera.empty()) {
+    if (per_camera.size() != cameras)
+      throw core::InvalidInput("tracker.pixel_bias.camera_sigma_px: " + std::to_string(per_camera.size()) +
+                               " entries for " + std::to_string(cameras) + " cameras");
+    for (const double sigma : per_camera)
+      if (!(sigma > 0.0) || !std::isfinite(sigma))
+        throw core::InvalidInput("tracker.pixel_bias.camera_sigma_px: expected finite numbers > 0");
+  }
   // The image gate (gates.h) decides accept / reject; the track gate keeps the life cycle, with
   // one rejection count per camera. Its own chi-square threshold is that of the Mahalanobis gate.
   TrackGateConfig life;

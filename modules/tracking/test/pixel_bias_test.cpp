@@ -60,12 +60,13 @@ struct Flight {
   Vector6 truthAt(double t, const BallisticModel& model) const { return model.propagate(x0, t); }
 };
 
-Flight drawFlight(const std::vector<core::Camera>& cams, const TrackerConfig& cfg, double bias_px, core::Rng& rng,
-                  std::uint64_t& next_id) {
+Flight drawFlight(const std::vector<core::Camera>& cams, const TrackerConfig& cfg, const std::vector<double>& bias_px,
+                  core::Rng& rng, std::uint64_t& next_id) {
   Flight f;
   f.x0 = core::sampleGaussian(rng, cfg.prior_mean, cfg.prior_cov);
   std::vector<Eigen::Vector2d> bias(cams.size());
-  for (auto& b : bias) b = {core::gaussian(rng, bias_px), core::gaussian(rng, bias_px)};
+  for (std::size_t c = 0; c < cams.size(); ++c)
+    bias[c] = {core::gaussian(rng, bias_px[c]), core::gaussian(rng, bias_px[c])};
   for (std::size_t c = 0; c < cams.size(); ++c) {
     const double phase = core::uniform(rng, 0.0, 0.02);
     for (double t = phase; t < 0.5; t += 0.02) {
@@ -90,14 +91,15 @@ struct Consistency {
   static double band(int dof, int k, double p) { return core::chiSquareQuantile(dof * k, p) / k; }
 };
 
-Consistency run(const TrackerConfig& cfg, int tracks, std::uint64_t seed) {
+Consistency run(const TrackerConfig& cfg, int tracks, std::uint64_t seed,
+                const std::vector<double>& bias_px = {kBiasPx, kBiasPx}) {
   const std::vector<core::Camera> cams = rig();
   core::Rng rng = core::makeRng(seed);
   std::uint64_t id = 1;
   Consistency out;
   double nees_sum = 0.0, nis_sum = 0.0;
   for (int k = 0; k < tracks; ++k) {
-    const Flight f = drawFlight(cams, cfg, kBiasPx, rng, id);
+    const Flight f = drawFlight(cams, cfg, bias_px, rng, id);
     ViewlineTracker tr(cams, cfg);
     for (const ImageMeasurement& m : f.images) {
       EXPECT_EQ(tr.submit(m), Refusal::None);
@@ -154,7 +156,7 @@ TEST(TrackerPixelBias, OffIsTheSixStateFilterAndATinyBiasChangesAlmostNothing) {
   core::Rng rng = core::makeRng(3);
   std::uint64_t id = 1;
   for (int k = 0; k < 5; ++k) {
-    const Flight f = drawFlight(cams, plain, kBiasPx, rng, id);
+    const Flight f = drawFlight(cams, plain, {kBiasPx, kBiasPx}, rng, id);
     ViewlineTracker a(cams, plain), b(cams, off), c(cams, tiny);
     for (const ImageMeasurement& m : f.images) {
       a.submit(m);
@@ -183,11 +185,12 @@ TEST(TrackerPixelBias, OffIsTheSixStateFilterAndATinyBiasChangesAlmostNothing) {
 TEST(TrackerPixelBias, LateArrivalsGiveExactlyTheInOrderResultWithTheBiasState) {
   const std::vector<core::Camera> cams = rig();
   TrackerConfig cfg = baseConfig();
-  cfg.pixel_bias = {kBiasPx, 2.0};
+  cfg.pixel_bias.sigma_px = kBiasPx;
+  cfg.pixel_bias.time_constant_s = 2.0;
   core::Rng rng = core::makeRng(8);
   std::uint64_t id = 1;
   for (int k = 0; k < 5; ++k) {
-    const Flight f = drawFlight(cams, cfg, kBiasPx, rng, id);
+    const Flight f = drawFlight(cams, cfg, {kBiasPx, kBiasPx}, rng, id);
     ViewlineTracker in_order(cams, cfg), late(cams, cfg);
     std::vector<std::pair<double, std::size_t>> arrival;
     for (std::size_t i = 0; i < f.images.size(); ++i) {
@@ -205,11 +208,12 @@ TEST(TrackerPixelBias, LateArrivalsGiveExactlyTheInOrderResultWithTheBiasState) 
 TEST(TrackerPixelBias, RobustStartConfirmsAndSetsAsideAnOutlierWithTheBiasState) {
   const std::vector<core::Camera> cams = rig();
   TrackerConfig cfg = baseConfig();
-  cfg.pixel_bias = {kBiasPx, 2.0};
+  cfg.pixel_bias.sigma_px = kBiasPx;
+  cfg.pixel_bias.time_constant_s = 2.0;
   cfg.start.confirm_images = 5;
   core::Rng rng = core::makeRng(4);
   std::uint64_t id = 1;
-  Flight f = drawFlight(cams, cfg, kBiasPx, rng, id);
+  Flight f = drawFlight(cams, cfg, {kBiasPx, kBiasPx}, rng, id);
   f.images[1].uv += Eigen::Vector2d(40.0, -30.0);  // a gross outlier among the first images
   ViewlineTracker tr(cams, cfg);
   for (const ImageMeasurement& m : f.images) tr.submit(m);
@@ -231,4 +235,23 @@ TEST(TrackerConfig, PixelBiasFieldsAreChecked) {
   EXPECT_THROW(c.validate(), core::InvalidInput);
   c.pixel_bias.time_constant_s = std::numeric_limits<double>::infinity();
   EXPECT_NO_THROW(c.validate());
+}
+
+TEST(TrackerPixelBias, EachCameraItsOwnBiasStd) {
+  // Camera 1 keeps a four times larger persistent error (e.g. not registered to the robot).
+  const std::vector<double> bias = {0.1, 0.4};
+  TrackerConfig cfg = baseConfig();
+  cfg.pixel_bias.sigma_px = 0.1;
+  cfg.pixel_bias.time_constant_s = std::numeric_limits<double>::infinity();
+  const Consistency one = run(cfg, 150, 23, bias);  // both cameras told 0.1 px
+  EXPECT_GT(one.nees, Consistency::band(6, one.tracks, 0.995)) << "NEES " << one.nees;
+  cfg.pixel_bias.camera_sigma_px = bias;
+  const Consistency each = run(cfg, 150, 23, bias);
+  EXPECT_TRUE(each.inNeesBand()) << "NEES " << each.nees;
+  EXPECT_TRUE(each.inNisBand()) << "NIS " << each.nis;
+  // One entry per camera, each > 0.
+  cfg.pixel_bias.camera_sigma_px = {0.1};
+  EXPECT_THROW(ViewlineTracker(rig(), cfg), core::InvalidInput);
+  cfg.pixel_bias.camera_sigma_px = {0.1, 0.0};
+  EXPECT_THROW(ViewlineTracker(rig(), cfg), core::InvalidInput);
 }

@@ -177,8 +177,14 @@ struct TrackStartConfig {
 struct PixelBiasConfig {
   double sigma_px = 0.0;          ///< stationary std per axis, px; 0 turns the bias state off
   double time_constant_s = 1.0;   ///< τ, s (correlation e^{−|Δt|/τ}); +infinity: a random constant
+  /// Per-camera stationary std, px (one entry per camera, each > 0), e.g. a camera registered to
+  /// the robot against one that keeps its calibrated pose; empty: sigma_px for every camera.
+  /// Only read when sigma_px > 0.
+  std::vector<double> camera_sigma_px;
   /// True when the biases are part of the state.
   bool enabled() const { return sigma_px > 0.0; }
+  /// Camera c's stationary std, px.
+  double sigmaOf(std::size_t camera) const { return camera_sigma_px.empty() ? sigma_px : camera_sigma_px[camera]; }
 };
 
 /// Configuration of the viewline tracker: model, prior, gate, time handling, late-data horizon, restarts and

@@ -58,6 +58,9 @@ struct CatchCameraConfig {
   /// Where this camera's frames come from: sim (rendered, the default) or footage (images, video,
   /// v4l2; footage.h). Every active camera renders, or every one has footage.
   runtime::SourceConfig source;
+  /// Set by registerCamerasToRobot when it replaced calibrated_camera's pose by the registered one
+  /// (not a config key): the camera's persistent pixel error is then the registered rig's.
+  bool registered = false;
   core::Camera renderCamera() const;     ///< true_camera, or the one built from the fields
   core::Camera estimatorCamera() const;  ///< calibrated_camera, or the one built from the fields
 };
@@ -141,6 +144,10 @@ struct BallCatchingConfig {
   /// its own stream (deriveSeed(throw seed, 0xD37)), so the rest of a throw is unchanged.
   double pixel_noise_px = 0.0;
   tracking::TrackerConfig tracker;   ///< multi-camera ball tracker (world frame, drag-free model + white acceleration)
+  /// px: the pixel-bias std (tracker.pixel_bias) of a camera whose pose is its calibration only
+  /// (registration off, refused, or the marker out of its view), whose calibration error is not
+  /// removed; 0: tracker.pixel_bias.sigma_px for every camera. trackerConfig() applies it.
+  double unregistered_bias_sigma_px = 0.0;
   /// Drag-model batch fit of the track's fused images (flight_fit.h): the state the planner predicts from.
   FlightFitConfig flight_fit;
   /// The planner's own settings (model, thresholds). Home, limits and latency are the robot's and
@@ -164,6 +171,9 @@ struct BallCatchingConfig {
   /// The planner settings with what the planner takes from the world: the crossing plane (home,
   /// box normal), gravity and the known ball's drag. Limits and latency come from the robot.
   planning::CatchPlannerConfig plannerConfig() const;
+  /// The tracker settings for the active cameras: `tracker`, with each camera's pixel-bias std
+  /// (tracker.pixel_bias.camera_sigma_px) from whether it is registered (CatchCameraConfig::registered).
+  tracking::TrackerConfig trackerConfig() const;
   /// Throws core::InvalidInput naming the key. loadBallCatchingConfig() calls it; code that edits
   /// a loaded config (benches, tests) calls it again through runBallCatching().
   void validate() const;

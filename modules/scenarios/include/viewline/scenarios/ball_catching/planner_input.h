@@ -32,7 +32,7 @@ public:
 
 private:
   bool enabled_;
-  double bias_sigma_px_;  // the tracker's pixel-bias std (0: none), added to the fit's σ in quadrature
+  std::vector<double> bias_sigma_px_;  // per camera: the tracker's pixel-bias std (0: none), added to the fit's σ in quadrature
   FlightFit fit_;
   int track_ = -1, restarts_ = -1;  // the tracker's track the fit belongs to
 };
