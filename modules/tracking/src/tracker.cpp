@@ -136,6 +136,29 @@ estimation::LinearMeasurement biasedMeasurement(const estimation::StateEstimate&
 
 namespace {
 
+// The image gate and, when it accepts (or `force`), the update: shared by the (p, v) and the
+// bias-augmented paths. `d` = y − C x̂, `R2` the rows' own noise (reported in `update`).
+void gateAndFuse(estimation::StateEstimate& s, const estimation::LinearMeasurement& meas, const Eigen::VectorXd& d,
+                 const Eigen::Matrix2d& R2, const GateConfig& gate, bool force, ImageUpdate* update,
+                 MeasurementOutcome& out) {
+  const Eigen::MatrixXd S = estimation::innovationCovariance(s, meas.C, meas.R);
+  out.gate = evaluateGate(d, S, gate);
+  if (update != nullptr) {
+    update->m = out.m;
+    update->innovation = d;
+    update->S = S;
+    update->R = R2;
+    update->nis = out.gate.mahalanobis;
+  }
+  if (force) out.gate.rejected = false;
+  if (out.gate.rejected) {
+    out.fate = Fate::Gated;
+  } else {
+    estimation::update(s, meas);
+    out.fate = Fate::Fused;
+  }
+}
+
 // fuse() on the augmented state (pixel bias on): the same gate and update with the bias columns.
 MeasurementOutcome fuseBiased(estimation::StateEstimate& s, const core::Camera& camera, const ImageMeasurement& m,
                               const BallisticModel& model, const GateConfig& gate, double dt_offset,
@@ -148,22 +171,7 @@ MeasurementOutcome fuseBiased(estimation::StateEstimate& s, const core::Camera& 
   const ViewlineRows rows = viewlineRowsWithDepth(camera, m.uv, m.sigma_px, dt_offset, model, depth_sq);
   const estimation::LinearMeasurement meas = detail::biasedMeasurement(s, camera, m, rows, depth_sq);
   const Eigen::VectorXd d = meas.y - meas.C * s.x();
-  const Eigen::MatrixXd S = estimation::innovationCovariance(s, meas.C, meas.R);
-  out.gate = evaluateGate(d, S, gate);
-  if (update != nullptr) {
-    update->m = m;
-    update->innovation = d;
-    update->S = S;
-    update->R = rows.R;
-    update->nis = out.gate.mahalanobis;
-  }
-  if (force) out.gate.rejected = false;
-  if (out.gate.rejected) {
-    out.fate = Fate::Gated;
-  } else {
-    estimation::update(s, meas);
-    out.fate = Fate::Fused;
-  }
+  gateAndFuse(s, meas, d, rows.R, gate, force, update, out);
   return out;
 }
 
@@ -181,22 +189,7 @@ MeasurementOutcome fuse(estimation::StateEstimate& s, const core::Camera& camera
                                           depth_variance_in_noise);
   estimation::LinearMeasurement meas{rows.C, rows.y, rows.R};
   const Eigen::VectorXd d = rows.y - rows.C * x;
-  const Eigen::MatrixXd S = estimation::innovationCovariance(s, meas.C, meas.R);
-  out.gate = evaluateGate(d, S, gate);
-  if (update != nullptr) {
-    update->m = m;
-    update->innovation = d;
-    update->S = S;
-    update->R = rows.R;
-    update->nis = out.gate.mahalanobis;
-  }
-  if (force) out.gate.rejected = false;
-  if (out.gate.rejected) {
-    out.fate = Fate::Gated;
-  } else {
-    estimation::update(s, meas);
-    out.fate = Fate::Fused;
-  }
+  gateAndFuse(s, meas, d, rows.R, gate, force, update, out);
   return out;
 }
 
