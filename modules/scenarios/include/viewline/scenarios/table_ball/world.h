@@ -43,8 +43,9 @@ std::vector<vision::TagOnTable> tableTagLayout(const sim::TableWorld& world);
 /// Event order of a table-ball session, the same in the simulated loop (loop.cpp) and on footage
 /// (footage.cpp), so that both see a frame against the same physics ticks.
 namespace table_ball_order {
-/// At equal times the frame runs before the wrist's physics tick.
+/// Rank of a frame: at equal times it runs before the wrist's physics tick.
 inline constexpr int kFrame = runtime::priority::Physics;
+/// Rank of a physics tick (after a frame at the same time).
 inline constexpr int kTick = runtime::priority::Physics + 1;
 /// A frame ready at r sees the physics ticks that start before r − 1 ns (the 1 ms grid and the
 /// capture times are rounded separately; a tick due at r itself simulates what follows it), and a
