@@ -40,11 +40,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <filesystem>
 #include <memory>
 #include <optional>
 
 #include "adapter_util.h"
+#include "recorded_units.h"
 #include "viewline/core/error.h"
 #include "viewline/core/random.h"
 #include "viewline/estimation/consistency.h"
@@ -152,17 +152,7 @@ public:
   /// detected in a window around the shipped filter's prediction and given to its tracker, as live;
   /// the images it was given are kept. The throws' truth is not read: NIS only.
   std::unique_ptr<ReplayData> loadRecording(const std::string& dir) const override {
-    namespace fs = std::filesystem;
-    std::vector<std::string> throw_dirs;
-    if (fs::exists(fs::path(dir) / "session.json")) {
-      const int n = scenarios::recordedCatchThrows(dir);
-      for (int i = 0; i < n; ++i) throw_dirs.push_back(scenarios::catchThrowDir(dir, i));
-    } else if (fs::exists(fs::path(dir) / "recording.csv")) {
-      throw_dirs.push_back(dir);
-    } else {
-      throw core::InvalidInput(dir + ": not a recording (no session.json, as ball_catching --record DIR writes, nor "
-                                     "one throw's recording.csv)");
-    }
+    const std::vector<std::string> throw_dirs = detail::recordedUnitDirs(dir, "ball_catching", "throw");
     auto d = std::make_unique<CatchReplayData>("ball-catching throws", "images", &imagesOf);
     std::vector<core::Camera> cams;  // the estimators' cameras on a recording: the rig's calibration
     for (std::size_t i = 0; i < cfg_.activeCameras(); ++i) cams.push_back(cfg_.cameras[i].estimatorCamera());

@@ -31,12 +31,12 @@
 // any, are drawn from a fixed seed, as in a footage session.
 
 #include <cmath>
-#include <filesystem>
 #include <limits>
 #include <map>
 #include <memory>
 
 #include "adapter_util.h"
+#include "recorded_units.h"
 #include "viewline/core/error.h"
 #include "viewline/runtime/telemetry.h"
 #include "viewline/scenarios/mobile_capture.h"
@@ -122,17 +122,7 @@ public:
   /// A recording's runs (header comment): every frame through the loop's perception, placed on
   /// the floor with the head camera at its head.csv reading; the detections the track was given kept.
   std::unique_ptr<ReplayData> loadRecording(const std::string& dir) const override {
-    namespace fs = std::filesystem;
-    std::vector<std::string> run_dirs;
-    if (fs::exists(fs::path(dir) / "session.json")) {
-      const int n = scenarios::recordedMobileCaptureRuns(dir);
-      for (int i = 0; i < n; ++i) run_dirs.push_back(scenarios::mobileCaptureRunDir(dir, i));
-    } else if (fs::exists(fs::path(dir) / "recording.csv")) {
-      run_dirs.push_back(dir);
-    } else {
-      throw core::InvalidInput(dir + ": not a recording (no session.json, as mobile_capture --record DIR writes, nor "
-                                     "one run's recording.csv)");
-    }
+    const std::vector<std::string> run_dirs = detail::recordedUnitDirs(dir, "mobile_capture", "run");
     auto d = std::make_unique<MobileReplayData>("chases", "detections", &chaseDetections);
     std::size_t frames = 0;
     for (std::size_t i = 0; i < run_dirs.size(); ++i) {
