@@ -150,7 +150,8 @@ AdapterOptions checkedOptions(const std::vector<AdapterOption>& declared, const 
   AdapterOptions out;
   for (const AdapterOption& o : declared) out[o.name] = o.default_value;
   for (const auto& [name, text] : given) {
-    const auto it = std::find_if(declared.begin(), declared.end(), [&](const AdapterOption& o) { return o.name == name; });
+    const std::string& key = name;  // a structured binding cannot be captured in C++17 (clang refuses it)
+    const auto it = std::find_if(declared.begin(), declared.end(), [&](const AdapterOption& o) { return o.name == key; });
     if (it == declared.end()) throw core::InvalidInput(adapter + ": '" + name + "' is not an option of this adapter");
     if (!it->accepts(text))
       throw core::InvalidInput(adapter + " adapter option '" + name + "': expected " + it->expected() + ", got '" + text + "'");
