@@ -44,4 +44,26 @@ LinearTransition discretize(const ContinuousLinearModel& model, double dt, const
   return tr;
 }
 
+LinearTransition discretizeFirstOrderHold(const ContinuousLinearModel& model, double dt, const Eigen::VectorXd& u0,
+                                          const Eigen::VectorXd& u1) {
+  const Eigen::Index p = model.B.cols();
+  if (p == 0) throw core::InvalidInput("discretizeFirstOrderHold: the model has no input (B has no columns)");
+  core::requireSize(u1, p, 1, "input u1");
+  core::requireFinite(u1, "input u1");
+  LinearTransition tr = discretize(model, dt, u0);  // Φ, Q and the checks of A, B, G, Qc, u0
+  const Eigen::Index n = model.A.rows();
+  Eigen::MatrixXd M = Eigen::MatrixXd::Zero(n + 2 * p, n + 2 * p);
+  M.topLeftCorner(n, n) = model.A * dt;
+  M.block(0, n, n, p) = model.B * dt;
+  M.block(n, n + p, p, p) = Eigen::MatrixXd::Identity(p, p) * dt;
+  const Eigen::MatrixXd E = M.exp();
+  const Eigen::MatrixXd Gamma = E.block(0, n, n, p);
+  const Eigen::MatrixXd Lambda_dt = E.block(0, n + p, n, p) / dt;  // Λ / dt
+  tr.Gamma.resize(n, 2 * p);
+  tr.Gamma << Gamma - Lambda_dt, Lambda_dt;
+  tr.u.resize(2 * p);
+  tr.u << u0, u1;
+  return tr;
+}
+
 }  // namespace viewline::estimation

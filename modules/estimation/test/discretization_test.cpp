@@ -68,3 +68,68 @@ TEST(Discretization, RejectsBadDt) {
   EXPECT_THROW(discretize(m, -1.0), core::InvalidInput);
   EXPECT_THROW(discretize(m, std::nan("")), core::InvalidInput);
 }
+
+TEST(Discretization, FirstOrderHoldOfADoubleIntegratorClosedForm) {
+  // ẋ = v, v̇ = u with u ramping from u0 to u1 over dt: x gains u0 dt²/3 + u1 dt²/6 and v gains
+  // (u0 + u1) dt / 2 (the trapezoid); with u0 = u1 it is the zero-order hold.
+  ContinuousLinearModel m;
+  m.A = Eigen::Matrix2d::Zero();
+  m.A(0, 1) = 1.0;
+  m.B = Eigen::Vector2d(0.0, 1.0);
+  m.G = Eigen::Vector2d(0.0, 1.0);
+  m.Qc = Eigen::MatrixXd::Constant(1, 1, 0.4);
+  for (double dt : {1e-3, 0.02, 0.5}) {
+    const LinearTransition foh = discretizeFirstOrderHold(m, dt, Eigen::VectorXd::Constant(1, 1.5),
+                                                          Eigen::VectorXd::Constant(1, -0.7));
+    ASSERT_EQ(foh.Gamma.rows(), 2);
+    ASSERT_EQ(foh.Gamma.cols(), 2);
+    Eigen::Matrix2d expected;
+    expected << dt * dt / 3.0, dt * dt / 6.0, dt / 2.0, dt / 2.0;
+    EXPECT_LT((foh.Gamma - expected).norm(), 1e-13) << dt;
+    const LinearTransition zoh = discretize(m, dt, Eigen::VectorXd::Constant(1, 0.3));
+    EXPECT_LT((foh.Phi - zoh.Phi).norm(), 1e-15);
+    EXPECT_LT((foh.Q - zoh.Q).norm(), 1e-15);
+    EXPECT_LT((foh.Gamma.col(0) + foh.Gamma.col(1) - zoh.Gamma).norm(), 1e-13);
+  }
+}
+
+TEST(Discretization, FirstOrderHoldMatchesAFineIntegrationOfARampedInput) {
+  // A damped oscillator driven by a ramp: the exact step against 20,000 midpoint (RK2) substeps.
+  ContinuousLinearModel m;
+  m.A.resize(2, 2);
+  m.A << 0.0, 1.0, -4.0, -0.6;
+  m.B = Eigen::MatrixXd(2, 1);
+  m.B << 0.2, 1.0;
+  m.G = Eigen::MatrixXd::Identity(2, 2);
+  m.Qc = Eigen::MatrixXd::Identity(2, 2);
+  const double dt = 0.3, u0 = 2.0, u1 = -1.0;
+  const Eigen::Vector2d x0(0.1, -0.4);
+  const LinearTransition tr = discretizeFirstOrderHold(m, dt, Eigen::VectorXd::Constant(1, u0), Eigen::VectorXd::Constant(1, u1));
+  const Eigen::Vector2d exact = tr.Phi * x0 + tr.Gamma * tr.u;
+  const int n = 20000;
+  const double h = dt / n;
+  auto f = [&](const Eigen::Vector2d& x, double s) -> Eigen::Vector2d {
+    return m.A * x + m.B.col(0) * (u0 + (u1 - u0) * s / dt);
+  };
+  Eigen::Vector2d x = x0;
+  for (int k = 0; k < n; ++k) {
+    const double s = k * h;
+    x += h * f(x + 0.5 * h * f(x, s), s + 0.5 * h);
+  }
+  EXPECT_LT((exact - x).norm(), 1e-9);
+  // The zero-order hold of either end is visibly off (the test would catch a swapped column).
+  EXPECT_GT((discretize(m, dt, Eigen::VectorXd::Constant(1, u1)).Gamma * u1 + tr.Phi * x0 - x).norm(), 1e-2);
+}
+
+TEST(Discretization, FirstOrderHoldNeedsAnInputOfTheRightSize) {
+  ContinuousLinearModel m;
+  m.A = Eigen::MatrixXd::Zero(1, 1);
+  m.G = Eigen::MatrixXd::Identity(1, 1);
+  m.Qc = Eigen::MatrixXd::Identity(1, 1);
+  EXPECT_THROW(discretizeFirstOrderHold(m, 0.1, Eigen::VectorXd(), Eigen::VectorXd()), core::InvalidInput);
+  m.B = Eigen::MatrixXd::Ones(1, 1);
+  EXPECT_THROW(discretizeFirstOrderHold(m, 0.1, Eigen::VectorXd::Ones(1), Eigen::VectorXd::Ones(2)), core::InvalidInput);
+  EXPECT_THROW(discretizeFirstOrderHold(m, 0.1, Eigen::VectorXd::Ones(1), Eigen::VectorXd::Constant(1, std::nan(""))),
+               core::InvalidInput);
+  EXPECT_THROW(discretizeFirstOrderHold(m, 0.0, Eigen::VectorXd::Ones(1), Eigen::VectorXd::Ones(1)), core::InvalidInput);
+}

@@ -165,6 +165,9 @@ void readObserver(const io::ConfigNode& n, TableBallConfig& c) {
   c.observer.tracker.impulse_std = n.getOr<double>("impulse_std", c.observer.tracker.impulse_std);
   c.observer.tracker.coloured_sigma = n.getOr<double>("coloured_sigma", c.observer.tracker.coloured_sigma);
   c.observer.tracker.coloured_correlation = n.getOr<double>("coloured_correlation", c.observer.tracker.coloured_correlation);
+  c.observer.tracker.input_hold = n.getChoiceOr("input_hold", {"end", "ramp"}, "end") == "ramp"
+                                     ? tracking::InputHold::Ramp
+                                     : tracking::InputHold::End;
   auto& gate = c.observer.tracker.gate;
   gate.probability = n.getOr<double>("gate_probability", gate.probability);
   gate.restart_after = n.getOr<int>("restart_after", gate.restart_after);

@@ -69,6 +69,7 @@ io::ConfigReferenceSection tableBallConfigReference() {
       {"observer.impulse_std", "m/s", "std per axis of the assumed velocity jump of a push"},
       {"observer.coloured_sigma", "m", "std of the frame-to-frame correlated (AR(1)) part of the measurement error; sigma_v is then the white part; 0: white only ([M])"},
       {"observer.coloured_correlation", "", "correlation of that error from one frame to the next, in [0, 1)"},
+      {"observer.input_hold", "", "the measured tilt acceleration over the interval before a frame: end (that frame's value held, [M]) or ramp (linear from the previous frame's value, as the wrist turns the table between frames)"},
       {"observer.gate_probability", "", "chi-square gate on the update's NIS (tracking::TrackGate); 1: no gate, as [M]"},
       {"observer.restart_after", "", "rejections in a row that restart the track (with a gate)"},
       {"observer.refine", "", "detector refinements after [M]'s steps (false: [M] exactly)"},

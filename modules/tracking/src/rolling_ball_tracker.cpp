@@ -55,6 +55,7 @@ void RollingBallTracker::start(double t, const Eigen::Vector2d& a_xy, const Eige
   }
   state_ = estimation::StateEstimate(xa, P0, t);
   t_ = t;
+  a_prev_ = a_xy;
   initialized_ = true;
   missed_ = 0;
   predictions_ = model.predictPositions(x_, last_dt_, a_xy);
@@ -76,7 +77,18 @@ void RollingBallTracker::step(double t, const Eigen::Vector2d& a_xy, const std::
   }
   if (!(t > t_)) throw core::InvalidInput("RollingBallTracker::step: time must increase");
   const double dt = t - t_;
-  const estimation::LinearTransition tr = model.transition(dt, a_xy);  // rediscretised every frame
+  // Rediscretised every frame; with the ramp, `hold` is the same step with the newest a_xy held
+  // (Γ u0 + Γ1 u1 with u0 = u1: Γ_ZOH = Γ0 + Γ1), for the predictions beyond t.
+  const bool ramp = config_.input_hold == InputHold::Ramp;
+  const estimation::LinearTransition tr = ramp ? model.transitionRamp(dt, a_prev_, a_xy) : model.transition(dt, a_xy);
+  estimation::LinearTransition hold;
+  if (ramp) {
+    hold.Phi = tr.Phi;
+    hold.Gamma = tr.Gamma.leftCols(2) + tr.Gamma.rightCols(2);
+    hold.u = a_xy;
+    hold.dt = dt;
+  }
+  a_prev_ = a_xy;
   if (!stationary_) {
     estimation::predict(state_, augmented(tr));
     clampState(state_);
@@ -134,7 +146,7 @@ void RollingBallTracker::step(double t, const Eigen::Vector2d& a_xy, const std::
   missed_ = fused ? 0 : missed_ + 1;
   t_ = t;
   last_dt_ = dt;
-  predictions_ = model.predictPositions(x_, tr, 0);  // tr is transition(dt, a_xy)
+  predictions_ = model.predictPositions(x_, ramp ? hold : tr, 0);  // a_xy held beyond t
 }
 
 Eigen::Index RollingBallTracker::stateDim() const { return config_.coloured_sigma > 0.0 ? 8 : 6; }

@@ -182,3 +182,43 @@ TEST(RollingBallTracker, RefusesAColouredErrorWithTheStationaryGain) {
   cfg.coloured_correlation = 1.0;
   EXPECT_THROW(tracking::RollingBallTracker{cfg}, core::InvalidInput);
 }
+
+// A wrist that turns the table between frames makes the ball's acceleration ramp from one frame's
+// value to the next. The ball simulated with the model itself (its own Φ, Q) under such ramps:
+// the tracker told the ramp (InputHold::Ramp) is consistent; the one holding each frame's value
+// over the interval before it (InputHold::End, [M]) is overconfident by the input it misplaces.
+TEST(RollingBallTracker, ARampedTiltIsConsistentWithTheRampHoldOnly) {
+  estimation::RollingBallModel model;
+  model.sigma_w = 0.002;
+  model.sigma_v = 2e-5;
+  model.beta = 1.0;
+  const double dt = 0.02;
+  auto nis = [&](tracking::InputHold hold) {
+    tracking::RollingBallTrackerConfig cfg;
+    cfg.model = model;
+    cfg.input_hold = hold;
+    estimation::ConsistencyStats stats;
+    for (std::uint64_t run = 0; run < 4; ++run) {
+      tracking::RollingBallTracker trk(cfg);
+      core::Rng rng = core::makeRng(300 + run);
+      // p = (0.05 sin 3t, 0.04 cos 2t) m without the noise: a = (−0.45 sin 3t, −0.16 cos 2t) m/s².
+      Eigen::VectorXd x = Eigen::VectorXd::Zero(6);
+      x[1] = 0.15;
+      x[2] = 0.04;
+      auto accel = [](double t) { return Eigen::Vector2d(-0.45 * std::sin(3.0 * t), -0.16 * std::cos(2.0 * t)); };
+      trk.step(0.0, accel(0.0), Eigen::Vector2d(x[0], x[2]));
+      for (int k = 1; k <= 250; ++k) {  // 5 s: the ball stays well inside the table
+        const estimation::LinearTransition tr = model.transitionRamp(dt, accel((k - 1) * dt), accel(k * dt));
+        x = tr.Phi * x + tr.Gamma * tr.u + core::sampleGaussian(rng, Eigen::VectorXd::Zero(6), tr.Q);
+        EXPECT_LT(std::max(std::abs(x[0]), std::abs(x[2])), model.positionLimit());
+        const Eigen::Vector2d y(x[0] + core::gaussian(rng, model.sigma_v), x[2] + core::gaussian(rng, model.sigma_v));
+        trk.step(k * dt, accel(k * dt), y);
+        if (k > 25) stats.add(trk.lastUpdate()->report.nis, 2.0);
+      }
+    }
+    return stats;
+  };
+  const estimation::ConsistencyStats ramp = nis(tracking::InputHold::Ramp), end = nis(tracking::InputHold::End);
+  EXPECT_TRUE(ramp.consistent(0.99)) << ramp.mean() << " outside [" << ramp.bounds().lo << ", " << ramp.bounds().hi << "]";
+  EXPECT_GT(end.mean(), end.bounds(0.99).hi) << end.mean();
+}

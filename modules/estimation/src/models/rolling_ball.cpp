@@ -76,6 +76,13 @@ LinearTransition RollingBallModel::transition(double dt, const Eigen::Vector2d& 
   return discretize(continuous(), dt, a_xy);
 }
 
+LinearTransition RollingBallModel::transitionRamp(double dt, const Eigen::Vector2d& a0, const Eigen::Vector2d& a1) const {
+  detail::requireDt(dt, "RollingBallModel");
+  core::requireFinite(a0, "RollingBallModel: input a0");
+  core::requireFinite(a1, "RollingBallModel: input a1");
+  return discretizeFirstOrderHold(continuous(), dt, a0, a1);
+}
+
 LinearMeasurement RollingBallModel::measurement(const Eigen::Vector2d& y) const {
   validate();
   core::requireFinite(y, "RollingBallModel: measurement y");

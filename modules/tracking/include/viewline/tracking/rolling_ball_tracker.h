@@ -27,6 +27,11 @@
 //    frame (two more states), v white of std σv (Bryson and Johansen, "Linear filtering for
 //    time-varying systems using measurements containing colored noise", IEEE TAC 1965: state
 //    augmentation). x() and P() stay the ball's six states;
+//  - the input over the interval before a frame (input_hold): End holds that frame's measured
+//    a_xy over the whole interval (zero-order hold, as [M]); Ramp lets it ramp linearly from the
+//    previous frame's a_xy to this frame's (first-order hold, estimation::discretizeFirstOrderHold),
+//    which is how a wrist that moves between frames turns the table; predictions then hold the
+//    newest a_xy;
 //  - or, with `stationary_gain`, the DARE's constant gain for the nominal period ([M]'s option;
 //    P(t|t−) is then the DARE's a-priori covariance);
 //  - the next N positions are predicted from the filtered state (clamped at the borders).
@@ -41,6 +46,12 @@
 #include "viewline/tracking/track_gate.h"
 
 namespace viewline::tracking {
+
+/// How the measured in-plane acceleration drives the interval before a frame (see the header).
+enum class InputHold {
+  End,   ///< the frame's own a_xy over the whole interval (zero-order hold)
+  Ramp,  ///< a linear ramp from the previous frame's a_xy to this frame's (first-order hold)
+};
 
 /// Settings of RollingBallTracker.
 struct RollingBallTrackerConfig {
@@ -57,6 +68,8 @@ struct RollingBallTrackerConfig {
   double coloured_sigma = 0.0;
   /// Correlation φ of that coloured error from one nominal period to the next, in [0, 1).
   double coloured_correlation = 0.5;
+  /// The input over each interval: held end value (as [M]) or a ramp between the frames' values.
+  InputHold input_hold = InputHold::End;
   /// The measurement gate and restart rule; probability 1 (the default) accepts every finite NIS.
   TrackGateConfig gate{1.0, 3};
   /// Throws core::InvalidInput naming the first bad value.
@@ -118,6 +131,7 @@ private:
   bool initialized_ = false;
   double t_ = 0.0;
   double last_dt_ = 0.02;
+  Eigen::Vector2d a_prev_ = Eigen::Vector2d::Zero();  // the last step's a_xy (m/s², for the ramp)
   Eigen::VectorXd x_ = Eigen::VectorXd::Zero(6);
   estimation::StateEstimate state_;
   std::optional<estimation::StationaryFilter> stationary_;

@@ -65,6 +65,10 @@ struct RollingBallModel {
   ContinuousLinearModel continuous() const;
   /// Φ, Γ, u = a_xy, Q for dt > 0 (rebuild every frame).
   LinearTransition transition(double dt, const Eigen::Vector2d& a_xy) const;
+  /// Φ, Γ, Q for dt > 0 with the input ramping from a0 (start of the interval) to a1 (its end):
+  /// first-order hold (discretizeFirstOrderHold), Gamma 6 x 4, u = (a0, a1). For a tilt that
+  /// the wrist turns between two frames whose tilts are both measured.
+  LinearTransition transitionRamp(double dt, const Eigen::Vector2d& a0, const Eigen::Vector2d& a1) const;
   /// C = rows selecting (p_x, p_y), R = σv² I.
   LinearMeasurement measurement(const Eigen::Vector2d& y) const;
   /// L/2 − r [m].
