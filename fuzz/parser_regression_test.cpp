@@ -70,3 +70,11 @@ TEST(FuzzRegression, OpenCvStandardExceptionsBecomeInvalidInput) {
   const std::string path = std::string(VIEWLINE_SOURCE_DIR) + "/fuzz/corpus/opencv_yaml/regression_length_error.yaml";
   EXPECT_THROW(io::loadOpenCvIntrinsics(path), viewline::core::InvalidInput);
 }
+
+// F10: NUL bytes inside an XML declaration sent OpenCV 4.6's XML parser through a null pointer
+// (SEGV in cv::FileStorage::open). A calibration file with a NUL byte is refused, naming its offset.
+TEST(FuzzRegression, OpenCvFileWithANulByteIsRefusedBeforeOpenCvReadsIt) {
+  const std::string path = std::string(VIEWLINE_SOURCE_DIR) + "/fuzz/corpus/opencv_yaml/regression_nul_in_xml_declaration.xml";
+  const std::string msg = invalidInputMessage([&] { io::loadOpenCvIntrinsics(path); });
+  EXPECT_NE(msg.find("NUL byte at offset 14"), std::string::npos) << msg;
+}

@@ -1,8 +1,12 @@
 #include "viewline/io/camera_io.h"
 
+#include <array>
+#include <cstdint>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <mutex>
+#include <optional>
 #include <opencv2/core.hpp>
 #include <visp3/core/vpException.h>
 #include <visp3/core/vpXmlParserCamera.h>
@@ -14,6 +18,24 @@ namespace fs = std::filesystem;
 
 namespace viewline::io {
 namespace {
+
+// Offset of the first NUL byte of the file, if any (read in blocks; throws when unreadable).
+std::optional<std::uintmax_t> firstNulByte(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw core::InvalidInput(path + ": cannot open for reading");
+  std::array<char, 4096> block{};
+  std::uintmax_t offset = 0;
+  while (in) {
+    in.read(block.data(), static_cast<std::streamsize>(block.size()));
+    const auto n = static_cast<std::size_t>(in.gcount());
+    for (std::size_t i = 0; i < n; ++i) {
+      if (block[i] == '\0') return offset + i;
+    }
+    offset += n;
+  }
+  if (in.bad()) throw core::InvalidInput(path + ": read error");
+  return std::nullopt;
+}
 vpCameraParameters::vpCameraParametersProjType toVisp(Projection p) {
   return p == Projection::WithDistortion ? vpCameraParameters::perspectiveProjWithDistortion
                                          : vpCameraParameters::perspectiveProjWithoutDistortion;
@@ -136,6 +158,13 @@ void saveVispCameraXml(const std::string& path, const std::string& camera_name,
 OpenCvIntrinsics loadOpenCvIntrinsics(const std::string& path) {
   std::error_code ec;  // (as loadVispCameraXml: no filesystem_error on a bad name)
   if (!fs::is_regular_file(path, ec)) throw core::InvalidInput(path + ": OpenCV intrinsics file does not exist");
+  // OpenCV 4.6's FileStorage parsers read lines as C strings: a NUL byte inside an XML
+  // declaration sent its XML parser through a null pointer (fuzz_opencv_yaml). A calibration
+  // file is text, so a NUL byte is refused before OpenCV sees the file.
+  if (const auto offset = firstNulByte(path)) {
+    throw core::InvalidInput(path + ": not a text file (a NUL byte at offset " + std::to_string(*offset) +
+                             "); expected an OpenCV calibration file (YAML or XML)");
+  }
   cv::FileStorage fsr;
   try {
     fsr.open(path, cv::FileStorage::READ);
