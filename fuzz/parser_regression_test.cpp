@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
+#include <opencv2/core.hpp>
 #include <string>
 
 #include "viewline/core/error.h"
@@ -47,11 +49,14 @@ TEST(FuzzRegression, FileNameTooLongIsInvalidInput) {
 }
 
 // F5: a matrix header whose rows is not a plain integer ("rows:(5") made cv::read allocate and clear
-// gigabytes (a 10 s timeout under the fuzzer); the header is now checked before OpenCV reads it.
+// gigabytes (a 10 s timeout under the fuzzer); the header is now checked before OpenCV reads it
+// (XML). A YAML file no longer reaches OpenCV (F9): yaml-cpp refuses it, naming the line.
 TEST(FuzzRegression, OpenCvMatrixHeaderIsCheckedBeforeReading) {
-  const std::string path = std::string(VIEWLINE_SOURCE_DIR) + "/fuzz/corpus/opencv_yaml/regression_rows_not_an_integer.yaml";
-  const std::string msg = invalidInputMessage([&] { io::loadOpenCvIntrinsics(path); });
-  EXPECT_NE(msg.find("distortion_coefficients"), std::string::npos) << msg;
+  const std::string dir = std::string(VIEWLINE_SOURCE_DIR) + "/fuzz/corpus/opencv_yaml/";
+  const std::string xml = invalidInputMessage([&] { io::loadOpenCvIntrinsics(dir + "regression_rows_not_an_integer.xml"); });
+  EXPECT_NE(xml.find("'distortion_coefficients': rows and cols must be integers"), std::string::npos) << xml;
+  const std::string yaml = invalidInputMessage([&] { io::loadOpenCvIntrinsics(dir + "regression_rows_not_an_integer.yaml"); });
+  EXPECT_NE(yaml.find("line 12"), std::string::npos) << yaml;
   // A good file still reads.
   EXPECT_NO_THROW(io::loadOpenCvIntrinsics(std::string(VIEWLINE_SOURCE_DIR) + "/fuzz/corpus/opencv_yaml/side.yaml"));
   EXPECT_NO_THROW(io::loadOpenCvIntrinsics(std::string(VIEWLINE_SOURCE_DIR) + "/fuzz/corpus/opencv_yaml/zero_distortion.xml"));
@@ -63,6 +68,35 @@ TEST(FuzzRegression, NestedAliasesAreCheckedOnce) {
   const std::string path = std::string(VIEWLINE_SOURCE_DIR) + "/fuzz/corpus/scenario_yaml/regression_nested_aliases.yaml";
   EXPECT_NO_THROW(io::ConfigNode::loadFile(path));  // seconds before the fix: the test's timeout catches it
   EXPECT_THROW(io::ConfigNode::fromString("a: &a {x: 1}\nb: [*a, {y: 1, y: 2}]\n"), viewline::core::InvalidInput);
+}
+
+// F9: OpenCV 4.6's YAML parser never returned on a line like "b?x-" after an indented map
+// (regression_opencv_parser_hang.yaml). YAML calibration files are read with yaml-cpp: refused at once, and the
+// shipped OpenCV YAML files (the rigs' intrinsics) read as before.
+TEST(FuzzRegression, OpenCvYamlThatHungOpenCvIsRefusedAndRealFilesRead) {
+  const std::string hang = std::string(VIEWLINE_SOURCE_DIR) + "/fuzz/corpus/opencv_yaml/regression_opencv_parser_hang.yaml";
+  EXPECT_THROW(io::loadOpenCvIntrinsics(hang), viewline::core::InvalidInput);
+  // Every shipped YAML calibration reads exactly as cv::FileStorage reads it.
+  int files = 0;
+  for (const auto& e : std::filesystem::recursive_directory_iterator(std::string(VIEWLINE_SOURCE_DIR) + "/calib/rigs")) {
+    if (e.path().extension() != ".yaml" || e.path().parent_path().filename() != "intrinsics") continue;
+    const std::string path = e.path().string();
+    const io::OpenCvIntrinsics ours = io::loadOpenCvIntrinsics(path);
+    cv::FileStorage fs(path, cv::FileStorage::READ);
+    ASSERT_TRUE(fs.isOpened()) << path;
+    cv::Mat K, D;
+    fs["camera_matrix"] >> K;
+    fs["distortion_coefficients"] >> D;
+    EXPECT_EQ(static_cast<int>(ours.width), static_cast<int>(fs["image_width"])) << path;
+    EXPECT_EQ(static_cast<int>(ours.height), static_cast<int>(fs["image_height"])) << path;
+    EXPECT_EQ(ours.rms_px, static_cast<double>(fs["avg_reprojection_error"])) << path;
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) EXPECT_EQ(ours.camera_matrix(r, c), K.at<double>(r, c)) << path;
+    ASSERT_EQ(ours.distortion.size(), static_cast<Eigen::Index>(D.total())) << path;
+    for (int i = 0; i < static_cast<int>(D.total()); ++i) EXPECT_EQ(ours.distortion(i), D.at<double>(i)) << path;
+    ++files;
+  }
+  EXPECT_GE(files, 8);
 }
 
 // F7: cv::FileStorage::open let a std::length_error (not a cv::Exception) out of a malformed file.

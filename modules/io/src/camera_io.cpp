@@ -1,12 +1,15 @@
 #include "viewline/io/camera_io.h"
 
 #include <array>
+#include <cctype>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <mutex>
 #include <optional>
+#include <sstream>
+#include <yaml-cpp/yaml.h>
 #include <opencv2/core.hpp>
 #include <visp3/core/vpException.h>
 #include <visp3/core/vpXmlParserCamera.h>
@@ -80,6 +83,133 @@ void checkMatrixNode(const cv::FileNode& n, const std::string& path, const char*
     throw core::InvalidInput(what + "rows and cols must be integers from 1 to 16");
   if (!d.isSeq() || d.size() != static_cast<std::size_t>(static_cast<int>(r) * static_cast<int>(c)))
     throw core::InvalidInput(what + "data must be a list of rows x cols numbers");
+}
+
+// True when the first character that is not white space is '<' (OpenCV's own format test).
+bool startsLikeXml(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  char c = 0;
+  while (in.get(c)) {
+    if (!std::isspace(static_cast<unsigned char>(c))) return c == '<';
+  }
+  return false;
+}
+
+// An XML calibration file through cv::FileStorage; K and D with the file's rows and columns.
+void readOpenCvXml(const std::string& path, Eigen::MatrixXd& K, Eigen::MatrixXd& D, OpenCvIntrinsics& out) {
+  cv::FileStorage fsr;
+  try {
+    fsr.open(path, cv::FileStorage::READ);
+  } catch (const cv::Exception& e) {
+    throw core::InvalidInput(path + ": cannot parse as OpenCV FileStorage: " + e.what());
+  } catch (const std::exception& e) {  // OpenCV 4.6 lets std::length_error out of a bad file (fuzz_opencv_yaml)
+    throw core::InvalidInput(path + ": cannot parse as OpenCV FileStorage: " + e.what());
+  }
+  if (!fsr.isOpened()) throw core::InvalidInput(path + ": cannot open as OpenCV FileStorage");
+  cv::Mat k, d;
+  try {
+    checkMatrixNode(fsr["camera_matrix"], path, "camera_matrix");
+    checkMatrixNode(fsr["distortion_coefficients"], path, "distortion_coefficients");
+    fsr["camera_matrix"] >> k;
+    fsr["distortion_coefficients"] >> d;
+    int w = 0, h = 0;
+    fsr["image_width"] >> w;
+    fsr["image_height"] >> h;
+    if (w < 0 || h < 0) throw core::InvalidInput(path + ": image_width/image_height must be positive");
+    out.width = static_cast<unsigned>(w);
+    out.height = static_cast<unsigned>(h);
+    if (!fsr["avg_reprojection_error"].empty()) fsr["avg_reprojection_error"] >> out.rms_px;
+  } catch (const cv::Exception& e) {
+    throw core::InvalidInput(path + ": bad OpenCV intrinsics: " + e.what());
+  } catch (const core::InvalidInput&) {
+    throw;
+  } catch (const std::exception& e) {  // (as open: not only cv::Exception comes out of FileStorage)
+    throw core::InvalidInput(path + ": bad OpenCV intrinsics: " + e.what());
+  }
+  auto toEigen = [](cv::Mat m) {
+    Eigen::MatrixXd e(m.rows, m.cols);
+    if (m.empty()) return e;
+    m = m.reshape(1);
+    m.convertTo(m, CV_64F);
+    for (int r = 0; r < m.rows; ++r)
+      for (int c = 0; c < m.cols; ++c) e(r, c) = m.at<double>(r, c);
+    return e;
+  };
+  K = toEigen(k);
+  D = toEigen(d);
+}
+
+// An OpenCV matrix node {rows, cols, dt, data} read with yaml-cpp (rows and cols 1-16, as
+// checkMatrixNode); empty when the key is absent.
+Eigen::MatrixXd yamlMatrix(const YAML::Node& root, const std::string& path, const char* key) {
+  const YAML::Node n = root[key];
+  if (!n || n.IsNull()) return {};
+  const std::string what = path + ": '" + key + "': ";
+  if (!n.IsMap()) throw core::InvalidInput(what + "expected an OpenCV matrix (rows, cols, dt, data)");
+  int rows = 0, cols = 0;
+  try {
+    rows = n["rows"].as<int>();
+    cols = n["cols"].as<int>();
+  } catch (const YAML::Exception&) {
+    throw core::InvalidInput(what + "rows and cols must be integers from 1 to 16");
+  }
+  if (rows < 1 || cols < 1 || rows > 16 || cols > 16)
+    throw core::InvalidInput(what + "rows and cols must be integers from 1 to 16");
+  const YAML::Node data = n["data"];
+  if (!data.IsSequence() || data.size() != static_cast<std::size_t>(rows * cols))
+    throw core::InvalidInput(what + "data must be a list of rows x cols numbers");
+  Eigen::MatrixXd m(rows, cols);
+  for (int i = 0; i < rows * cols; ++i) {
+    try {
+      m(i / cols, i % cols) = data[static_cast<std::size_t>(i)].as<double>();
+    } catch (const YAML::Exception&) {
+      throw core::InvalidInput(what + "data item " + std::to_string(i + 1) + " is not a number");
+    }
+  }
+  return m;
+}
+
+// A YAML calibration file through yaml-cpp: OpenCV's first line "%YAML:1.0" is not YAML 1.2's
+// directive syntax and is skipped; the !!opencv-matrix tags are ignored.
+void readOpenCvYaml(const std::string& path, Eigen::MatrixXd& K, Eigen::MatrixXd& D, OpenCvIntrinsics& out) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw core::InvalidInput(path + ": cannot open for reading");
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  std::string text = buffer.str();
+  if (text.rfind("%YAML", 0) == 0) {
+    const auto eol = text.find('\n');
+    text = eol == std::string::npos ? std::string() : text.substr(eol + 1);
+  }
+  YAML::Node root;
+  try {
+    root = YAML::Load(text);
+  } catch (const YAML::Exception& e) {
+    throw core::InvalidInput(path + ": cannot parse as YAML: " + e.what());
+  }
+  if (!root.IsMap()) throw core::InvalidInput(path + ": expected a map of OpenCV calibration keys (camera_matrix, ...)");
+  K = yamlMatrix(root, path, "camera_matrix");
+  D = yamlMatrix(root, path, "distortion_coefficients");
+  auto integer = [&](const char* key) {
+    const YAML::Node n = root[key];
+    if (!n || n.IsNull()) return 0;
+    try {
+      return n.as<int>();
+    } catch (const YAML::Exception&) {
+      throw core::InvalidInput(path + ": '" + key + "': expected an integer");
+    }
+  };
+  const int w = integer("image_width"), h = integer("image_height");
+  if (w < 0 || h < 0) throw core::InvalidInput(path + ": image_width/image_height must be positive");
+  out.width = static_cast<unsigned>(w);
+  out.height = static_cast<unsigned>(h);
+  if (const YAML::Node r = root["avg_reprojection_error"]; r && !r.IsNull()) {
+    try {
+      out.rms_px = r.as<double>();
+    } catch (const YAML::Exception&) {
+      throw core::InvalidInput(path + ": 'avg_reprojection_error': expected a number");
+    }
+  }
 }
 }  // namespace
 
@@ -160,51 +290,29 @@ OpenCvIntrinsics loadOpenCvIntrinsics(const std::string& path) {
   if (!fs::is_regular_file(path, ec)) throw core::InvalidInput(path + ": OpenCV intrinsics file does not exist");
   // OpenCV 4.6's FileStorage parsers read lines as C strings: a NUL byte inside an XML
   // declaration sent its XML parser through a null pointer (fuzz_opencv_yaml). A calibration
-  // file is text, so a NUL byte is refused before OpenCV sees the file.
+  // file is text, so a NUL byte is refused before any parser sees the file.
   if (const auto offset = firstNulByte(path)) {
     throw core::InvalidInput(path + ": not a text file (a NUL byte at offset " + std::to_string(*offset) +
                              "); expected an OpenCV calibration file (YAML or XML)");
   }
-  cv::FileStorage fsr;
-  try {
-    fsr.open(path, cv::FileStorage::READ);
-  } catch (const cv::Exception& e) {
-    throw core::InvalidInput(path + ": cannot parse as OpenCV FileStorage: " + e.what());
-  } catch (const std::exception& e) {  // OpenCV 4.6 lets std::length_error out of a bad file (fuzz_opencv_yaml)
-    throw core::InvalidInput(path + ": cannot parse as OpenCV FileStorage: " + e.what());
-  }
-  if (!fsr.isOpened()) throw core::InvalidInput(path + ": cannot open as OpenCV FileStorage");
-  cv::Mat K, D;
+  // XML goes to cv::FileStorage. YAML goes to yaml-cpp: OpenCV 4.6's own YAML parser loops forever
+  // on some malformed files (a line "b?x-" after an indented map; fuzz_opencv_yaml, fuzz/README.md
+  // F9), and the calibration keys are plain YAML (OpenCV's "%YAML:1.0" line and !!opencv-matrix
+  // tags aside).
   OpenCvIntrinsics out;
-  try {
-    checkMatrixNode(fsr["camera_matrix"], path, "camera_matrix");
-    checkMatrixNode(fsr["distortion_coefficients"], path, "distortion_coefficients");
-    fsr["camera_matrix"] >> K;
-    fsr["distortion_coefficients"] >> D;
-    int w = 0, h = 0;
-    fsr["image_width"] >> w;
-    fsr["image_height"] >> h;
-    if (w < 0 || h < 0) throw core::InvalidInput(path + ": image_width/image_height must be positive");
-    out.width = static_cast<unsigned>(w);
-    out.height = static_cast<unsigned>(h);
-    if (!fsr["avg_reprojection_error"].empty()) fsr["avg_reprojection_error"] >> out.rms_px;
-  } catch (const cv::Exception& e) {
-    throw core::InvalidInput(path + ": bad OpenCV intrinsics: " + e.what());
-  } catch (const core::InvalidInput&) {
-    throw;
-  } catch (const std::exception& e) {  // (as open: not only cv::Exception comes out of FileStorage)
-    throw core::InvalidInput(path + ": bad OpenCV intrinsics: " + e.what());
+  Eigen::MatrixXd K, D;
+  if (startsLikeXml(path)) {
+    readOpenCvXml(path, K, D, out);
+  } else {
+    readOpenCvYaml(path, K, D, out);
   }
-  if (K.rows != 3 || K.cols != 3)
+  if (K.rows() != 3 || K.cols() != 3)
     throw core::InvalidInput(path + ": 'camera_matrix' missing or not a 3x3 matrix");
-  K.convertTo(K, CV_64F);
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) out.camera_matrix(r, c) = K.at<double>(r, c);
-  if (!D.empty()) {
-    D.convertTo(D, CV_64F);
-    D = D.reshape(1, static_cast<int>(D.total()));
-    out.distortion.resize(static_cast<Eigen::Index>(D.total()));
-    for (int i = 0; i < static_cast<int>(D.total()); ++i) out.distortion(i) = D.at<double>(i);
+  out.camera_matrix = K;
+  if (D.size() > 0) {
+    out.distortion.resize(D.size());  // the file's order (row-major), whatever the matrix's shape
+    for (Eigen::Index r = 0; r < D.rows(); ++r)
+      for (Eigen::Index c = 0; c < D.cols(); ++c) out.distortion(r * D.cols() + c) = D(r, c);
   } else {
     out.distortion = Eigen::VectorXd::Zero(5);
   }
