@@ -78,8 +78,8 @@ const std::string kMinimal = "events: {setpoints: [{t: 0.0, xy: [0.0, 0.0]}]}\nt
 
 // The CI guard of the headline figures (docs/results.md "Table-ball balancing"), on a short
 // seeded run of the shipped config: an 8 cm step. The bounds sit about 20 % above what this
-// run gives (2-D settling 0.69 s, observer RMSE 0.096 mm = 0.29 of the raw measurement's,
-// steady state 0.061 mm, sampled NIS 2.38 in its band of 30 samples), so a regression of the
+// run gives (2-D settling 0.68 s, observer RMSE 0.097 mm = 0.30 of the raw measurement's,
+// steady state 0.061 mm, sampled NIS 2.36 in its band of 30 samples), so a regression of the
 // method fails here; the telemetry sink sees every update.
 TEST(TableBallScenario, ShortClosedLoopRunGuardsTheHeadlineFigures) {
   const scenarios::TableBallConfig cfg = shortRun();
