@@ -36,7 +36,7 @@ scenarios::PanTiltReplayMetrics replayShipped(const std::string& name, std::uint
 // Seed 21 (the settings were chosen on seeds 1-5), 40 s (the occlusion at 30 s included). Today on this seed:
 // rectangle filtered 0.998 / 0.622 cm, 10.13 px at the frames' horizon; circle 0.303 / 0.259 cm, 2.95 px;
 // random 1.161 / 0.673 cm, 12.02 px; NIS means 1.908, 1.933, 1.947 (band [1.838, 2.170] for 960 samples);
-// NEES means 2.79, 1.31, 5.07 (band [2.829, 5.405], one sample per second): the random path's is guarded.
+// NEES means 2.79, 1.30, 5.06 (band [2.829, 5.405], one sample per second): the random path's is guarded.
 constexpr std::uint64_t kSeed = 21;
 constexpr double kDuration = 40.0;
 
