@@ -1,6 +1,9 @@
 // The planar target filter on tracking::TrackGate decides as its own hand-written gate did (NIS > χ²₂(p):
 // reject; reinit_after rejections in a row: re-initialise): the decisions below were recorded from the
 // filter before it used TrackGate, on seeded sequences with outliers, bursts and gaps, for every model.
+// Seed 2, config 7 (the constant-speed legs with the soft corner mixture) was recorded again when that
+// mixture came to weigh the jump times up to the last measurement: its estimate moved, so near one corner a
+// declared jump became a rejection one sample later (the filter, not the gate, changed).
 #include <gtest/gtest.h>
 
 #include <array>
@@ -116,8 +119,8 @@ const std::array<std::array<const char*, tracking::planar_test::kGateConfigs>, 3
         "12-2r1-2r1a40j1a8-2r1-2r1a6-1a1-2r1a42-1a5-1a6-2a33-1a47-1a3.67s1a5-1a18-1a20.24a9-1a14j1a50",
         "s1a32-2r1-2a22-2r1-1a10j1a24.17-2r1a35j1a28-2r1-1a56-1a1-1a1j1a62j1a51-2r1a6-1a73-1a12-1a15-2r1-"
         "2r1a40j1a8-2r1-2r1a6-1a1-2r1a42-1a5-1a6-2r1-2a30-1j1a46-1a3.67s1a5-1a18-1a20.24a9-1a19-1a45",
-        "s1a32-2r1-2a22-2r1-1a10j1a24.17-2r1a35j1a28-2r1-1a56-1a1-1a1j1a62j1a51-2r1a6-1a73-1a7j1a20-2r1-2"
-        "r1a43j1a5-2r1-2r1a6-1a1-2r1a42-1a5-1a6-2r1-2a30-1j1a46-1a3.67s1a5-1a18-1a20.24a9-1a19-1a45",
+        "s1a32-2r1-2a22-2r1-1a10j1a24.17-2r1a35j1a28-2r1-1a56-1a1-1a1j1a62j1a51-2r1a6-1a73-1a12-1a15-2r1-2r"
+        "1a43j1a5-2r1-2r1a6-1a1-2r1a42-1a5-1a6-2r1-2a30-1j1a46-1a3.67s1a5-1a18-1a20.24a9-1a19-1a45",
         "s1a33r1a1r1a24r1a3r1a33.17a24r1a43r1a1r1a1r1a129r1a156r1a1r1a52r1a1r1a3r1a7r1a1r1a55r1a1r1a57r1a"
         "25.67s1a45.24a75",
     }},

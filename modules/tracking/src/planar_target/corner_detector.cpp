@@ -32,7 +32,12 @@ JumpScan scanForJump(const PlanarHistory& history, const JumpScanSettings& setti
   const int n = static_cast<int>(history.size());
   const int m = settings.min_samples;
   const bool soft = settings.soft;
-  // Hard test: m <= j < n - m. Soft mixture: every j with m measurements before and 2 after.
+  // Hard test: m <= j < n - m. Soft mixture: every j with m measurements before and, with the legs' Bayes
+  // factors, up to the last one (a jump at or just before the last measurement is what a new corner first is:
+  // leaving those out made the estimate's velocity sure of the old leg for the corner's first samples, the
+  // random path's NEES 80-100); with the kinks' (before the speed is learnt), 2 after, as the restart a kink
+  // hypothesis runs re-opens the velocity to init_velocity_sigma, not to the jump prior jump_prior_sigma: with
+  // fewer measurements after t_j its velocity would be that restart prior's, not the jump model's.
   if (n < (soft ? m + 3 : 2 * m + 1)) return out;
   double best = settings.threshold;
   int best_j = -1;
@@ -53,7 +58,7 @@ JumpScan scanForJump(const PlanarHistory& history, const JumpScanSettings& setti
   // legs' Bayes factors, so no fit at all); the values that are computed are unchanged.
   const bool need_test = !(soft && settings.posterior_decision);
   const bool need_kink_bf = soft && !leg_bf;
-  for (int j = m; j + (soft ? 2 : m) < n; ++j) {
+  for (int j = m; j + (soft ? (leg_bf ? 0 : 2) : m) < n; ++j) {
     const PlanarSnapshot& sj = history[static_cast<std::size_t>(j)];
     const Eigen::VectorXd& xj = sj.state.x();
     for (int i = 0; i < n && (need_test || need_kink_bf); ++i) {
