@@ -36,6 +36,7 @@ RegistrationResult registerCamerasToRobot(BallCatchingConfig& cfg, const sim::Sc
   }
   sim::CameraRig rig(sims, rng, cfg.render);
   RegistrationResult out;
+  out.registered.assign(sims.size(), false);
   // Per camera: known marker positions (robot world) and their detected, undistorted normalised
   // image points (calibrated intrinsics).
   std::vector<std::vector<cv::Point3d>> obj(sims.size());
@@ -146,6 +147,7 @@ RegistrationResult registerCamerasToRobot(BallCatchingConfig& cfg, const sim::Sc
     cam.c_M_w = Mn;
     cfg.cameras[ci].calibrated_camera = cam;
     cfg.cameras[ci].registered = true;
+    out.registered[ci] = true;
     ++out.cameras_registered;
   }
   if (out.cameras_registered == 0)

@@ -23,7 +23,8 @@
 // tracker (camera, stamp, pixel, in submission order, from the telemetry's camera<k> channels),
 // the tracker's cameras (registered to the robot) and the true flight; replay() feeds them to a
 // fresh ViewlineTracker per throw with the candidate noise (σ told = hypot(sigma_px,
-// pixel_noise_px), as the loop tells it) and takes NIS exactly as the loop does (accepted images
+// pixel_noise_px), as the loop tells it; each camera's pixel-bias std as the loop told it, registered
+// or not, BallCatchingConfig::trackerConfig) and takes NIS exactly as the loop does (accepted images
 // after kConsistencyBurnIn fused images of their track, the tracker's own gate statistic) and the
 // innovation cost of autotune.h from the tracker's own update. What a replay cannot follow: the
 // detector searched a window around the shipped filter's prediction, so a filter that would have
@@ -33,7 +34,8 @@
 // auto-tuning is refused. From a recording (ball_catching --record DIR: session.json and
 // throw_iii/, or one throw's folder): each throw's frames through the footage session
 // (scenarios::runCatchFootageOnRecording: windowed detection around the shipped filter's
-// prediction, the rig's calibration taken as registered, the added pixel noise from a fixed seed),
+// prediction, the rig's calibration taken as registered and its bias std the registered one, where
+// the footage session tells the unregistered one; the added pixel noise from a fixed seed),
 // the images it gave its tracker kept; throw.json and truth.csv are not read (NIS only).
 // The scenario's live view (viz::BallCatchingDisplay) is not wired here: this module does not
 // link viz.
@@ -87,6 +89,7 @@ const detail::SeriesLabels kLabels{"time since release [s]", "tracker position e
 struct CatchThrow {
   std::vector<tracking::ImageMeasurement> images;  ///< in submission order (σ as the loop told it)
   std::vector<core::Camera> cameras;               ///< the tracker's cameras (registered)
+  std::vector<double> bias_sigma_px;               ///< per camera, the pixel-bias std the loop told its tracker
   Eigen::Vector3d release = Eigen::Vector3d::Zero(), launch = Eigen::Vector3d::Zero();  ///< the flight, world
   double t_end = 0.0;                              ///< end of the true flight, s (throw clock)
   bool has_truth = true;                           ///< false: from a recording (no NEES)
@@ -133,9 +136,17 @@ public:
         return true;
       };
       const scenarios::CatchSummary sum = scenarios::runBallCatching(cfg_, opt_.throws, s, hooks);
+      // Each camera's bias std as the loop told it: registered or not (BallCatchingConfig::trackerConfig).
+      scenarios::BallCatchingConfig told = cfg_;
+      if (sum.registration) {
+        for (std::size_t c = 0; c < told.cameras.size() && c < sum.registration->registered.size(); ++c)
+          told.cameras[c].registered = sum.registration->registered[c];
+      }
+      const std::vector<double> bias_sigma = told.trackerConfig().pixel_bias.camera_sigma_px;
       for (const scenarios::ThrowResult& tr : sum.results) {
         CatchThrow t;
         t.cameras = cams[static_cast<std::size_t>(tr.index)];
+        t.bias_sigma_px = bias_sigma;
         t.release = tr.release;
         t.launch = tr.launch_velocity;
         t.t_end = tr.t_cross + cfg_.post_crossing_s + 0.3;
@@ -164,6 +175,10 @@ public:
       scenarios::runCatchFootageOnRecording(cfg_, core::deriveSeed(kRecordingSeed, i), throw_dirs[i], hooks);
       CatchThrow t;
       t.cameras = cams;
+      // The bias std stays the registered one (tracker.pixel_bias.sigma_px) for every camera, although
+      // the footage session tells its tracker the unregistered one (1 px as shipped): on the simulated
+      // rig's recordings the calibration error is ~0.2-0.3 px, and told 1 px the replayed NIS is 0.95,
+      // underconfident, which autotune (q and the white std only) cannot correct (docs/results.md).
       t.has_truth = false;
       addImages(*sink, t);
       d->items.push_back(std::move(t));
@@ -247,7 +262,9 @@ private:
   void replayThrow(const CatchThrow& t, const tracking::TrackerConfig& tc, double sigma, double eps,
                    detail::InnovationTally& a, RunSeries* series, std::size_t& sample) const {
     if (t.images.empty()) return;
-    tracking::ViewlineTracker tracker(t.cameras, tc);
+    tracking::TrackerConfig told = tc;
+    told.pixel_bias.camera_sigma_px = t.bias_sigma_px;  // empty: the config's one std for every camera
+    tracking::ViewlineTracker tracker(t.cameras, told);
     std::optional<sim::DragFlight> flight;
     if (t.has_truth) flight.emplace(sim::FlightState{t.release, t.launch}, 0.0, t.t_end, cfg_.throws.body);
     int in_track = 0, fused_total = 0;

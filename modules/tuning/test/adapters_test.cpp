@@ -16,6 +16,7 @@
 #include "viewline/core/error.h"
 #include "viewline/core/random.h"
 #include "viewline/io/config.h"
+#include "viewline/io/config_edit.h"
 #include "viewline/tuning/scenario.h"
 #include "viewline/tuning/session.h"
 #include "viewline/tuning/yaml_edit.h"
@@ -182,6 +183,26 @@ TEST(ScenarioAdapters, BallCatchingReplayIsWhatTheLoopGaveItsTracker) {
   const ReplayResult wide = inst->replay(*data, {noise[0].value, 4.0 * noise[1].value}, 0.0, false);
   EXPECT_LT(wide.nis.mean(), 0.25 * same.nis.mean());
   EXPECT_GT(same.terms, 0u);
+}
+
+// With four cameras `high` cannot see the registration marker and keeps its calibrated pose; the
+// loop tells it the unregistered bias std (tracker.pixel_bias.unregistered_sigma_px) and the others
+// the registered one. The replay tells each camera what the loop told it: the same NIS, sample for
+// sample (told the registered std everywhere, it differed).
+TEST(ScenarioAdapters, BallCatchingReplayTellsEachCameraTheBiasStdTheLoopToldIt) {
+  const AdapterRegistry reg = makeBuiltinAdapters();
+  const ScenarioAdapter& ad = reg.get("ball_catching");
+  const io::ConfigNode o = io::ConfigNode::fromString("throws: 2", "adapter options");
+  const auto inst = ad.loadConfig(io::loadConfigWithValues(configPath("ball_catching.yaml"), {"camera_count=4"}),
+                                  readAdapterOptions(ad, &o));
+  const std::vector<NoiseParameter> noise = inst->noiseParameters();
+  const std::uint64_t seed = 22;
+  const RunResult live = inst->run(core::deriveSeed(seed, 0), {});
+  const auto data = inst->record(seed, 1);
+  const ReplayResult same = inst->replay(*data, {noise[0].value, noise[1].value}, 0.0, false);
+  ASSERT_GT(live.nis.count, 20u);
+  EXPECT_EQ(same.nis.count, live.nis.count);
+  EXPECT_DOUBLE_EQ(same.nis.sum, live.nis.sum);
 }
 
 TEST(ScenarioAdapters, MobileCaptureAutotunesFromLiveRecordingsNotFromLogs) {

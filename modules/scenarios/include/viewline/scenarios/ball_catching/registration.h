@@ -16,6 +16,7 @@ struct RegistrationResult {
       cameras_registered = 0,  ///< cameras whose pose c_M_w was replaced
       cameras_refused = 0;     ///< cameras that kept their calibrated pose (too few points, bad fit)
   std::vector<int> points_per_camera;               ///< marker detections per configured camera
+  std::vector<bool> registered;                    ///< per configured camera: its pose was replaced
   double reprojection_px_before = 0.0;              ///< RMS over the registered cameras, calibrated pose
   double reprojection_px_after = 0.0;               ///< same, registered pose
   std::vector<double> centre_shift_mm,  ///< per registered camera: optical-centre shift, mm
