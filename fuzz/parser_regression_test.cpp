@@ -99,6 +99,14 @@ TEST(FuzzRegression, OpenCvYamlThatHungOpenCvIsRefusedAndRealFilesRead) {
   EXPECT_GE(files, 8);
 }
 
+// F11: the yaml-cpp reader of F9's fix let YAML::InvalidNode out of a matrix without 'data'
+// (terminate): every yaml-cpp exception is now a refusal naming the file.
+TEST(FuzzRegression, OpenCvYamlMatrixWithoutDataIsRefused) {
+  const std::string path = std::string(VIEWLINE_SOURCE_DIR) + "/fuzz/corpus/opencv_yaml/regression_yaml_invalid_node.yaml";
+  const std::string msg = invalidInputMessage([&] { io::loadOpenCvIntrinsics(path); });
+  EXPECT_NE(msg.find("regression_yaml_invalid_node.yaml"), std::string::npos) << msg;
+}
+
 // F7: cv::FileStorage::open let a std::length_error (not a cv::Exception) out of a malformed file.
 TEST(FuzzRegression, OpenCvStandardExceptionsBecomeInvalidInput) {
   const std::string path = std::string(VIEWLINE_SOURCE_DIR) + "/fuzz/corpus/opencv_yaml/regression_length_error.yaml";

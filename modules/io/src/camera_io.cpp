@@ -156,7 +156,7 @@ Eigen::MatrixXd yamlMatrix(const YAML::Node& root, const std::string& path, cons
   if (rows < 1 || cols < 1 || rows > 16 || cols > 16)
     throw core::InvalidInput(what + "rows and cols must be integers from 1 to 16");
   const YAML::Node data = n["data"];
-  if (!data.IsSequence() || data.size() != static_cast<std::size_t>(rows * cols))
+  if (!data || !data.IsSequence() || data.size() != static_cast<std::size_t>(rows * cols))
     throw core::InvalidInput(what + "data must be a list of rows x cols numbers");
   Eigen::MatrixXd m(rows, cols);
   for (int i = 0; i < rows * cols; ++i) {
@@ -168,6 +168,9 @@ Eigen::MatrixXd yamlMatrix(const YAML::Node& root, const std::string& path, cons
   }
   return m;
 }
+
+void readOpenCvYamlKeys(const YAML::Node& root, const std::string& path, Eigen::MatrixXd& K, Eigen::MatrixXd& D,
+                        OpenCvIntrinsics& out);
 
 // A YAML calibration file through yaml-cpp: OpenCV's first line "%YAML:1.0" is not YAML 1.2's
 // directive syntax and is skipped; the !!opencv-matrix tags are ignored.
@@ -187,6 +190,16 @@ void readOpenCvYaml(const std::string& path, Eigen::MatrixXd& K, Eigen::MatrixXd
   } catch (const YAML::Exception& e) {
     throw core::InvalidInput(path + ": cannot parse as YAML: " + e.what());
   }
+  try {  // yaml-cpp throws on a node it cannot use (e.g. InvalidNode): refused, naming the file
+    readOpenCvYamlKeys(root, path, K, D, out);
+  } catch (const YAML::Exception& e) {
+    throw core::InvalidInput(path + ": bad OpenCV calibration YAML: " + e.what());
+  }
+}
+
+// The keys of a parsed YAML calibration file (readOpenCvYaml).
+void readOpenCvYamlKeys(const YAML::Node& root, const std::string& path, Eigen::MatrixXd& K, Eigen::MatrixXd& D,
+                        OpenCvIntrinsics& out) {
   if (!root.IsMap()) throw core::InvalidInput(path + ": expected a map of OpenCV calibration keys (camera_matrix, ...)");
   K = yamlMatrix(root, path, "camera_matrix");
   D = yamlMatrix(root, path, "distortion_coefficients");
