@@ -1,14 +1,12 @@
 #include "viewline/io/camera_io.h"
 
-#include <array>
-#include <cctype>
-#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <mutex>
 #include <optional>
 #include <sstream>
+#include <utility>
 #include <yaml-cpp/yaml.h>
 #include <opencv2/core.hpp>
 #include <visp3/core/vpException.h>
@@ -22,23 +20,16 @@ namespace fs = std::filesystem;
 namespace viewline::io {
 namespace {
 
-// Offset of the first NUL byte of the file, if any (read in blocks; throws when unreadable).
-std::optional<std::uintmax_t> firstNulByte(const std::string& path) {
+// The whole file (calibration files are small); throws when it cannot be read.
+std::string readWholeFile(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw core::InvalidInput(path + ": cannot open for reading");
-  std::array<char, 4096> block{};
-  std::uintmax_t offset = 0;
-  while (in) {
-    in.read(block.data(), static_cast<std::streamsize>(block.size()));
-    const auto n = static_cast<std::size_t>(in.gcount());
-    for (std::size_t i = 0; i < n; ++i) {
-      if (block[i] == '\0') return offset + i;
-    }
-    offset += n;
-  }
+  std::stringstream buffer;
+  buffer << in.rdbuf();
   if (in.bad()) throw core::InvalidInput(path + ": read error");
-  return std::nullopt;
+  return buffer.str();
 }
+
 vpCameraParameters::vpCameraParametersProjType toVisp(Projection p) {
   return p == Projection::WithDistortion ? vpCameraParameters::perspectiveProjWithDistortion
                                          : vpCameraParameters::perspectiveProjWithoutDistortion;
@@ -86,13 +77,9 @@ void checkMatrixNode(const cv::FileNode& n, const std::string& path, const char*
 }
 
 // True when the first character that is not white space is '<' (OpenCV's own format test).
-bool startsLikeXml(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  char c = 0;
-  while (in.get(c)) {
-    if (!std::isspace(static_cast<unsigned char>(c))) return c == '<';
-  }
-  return false;
+bool startsLikeXml(const std::string& text) {
+  const auto first = text.find_first_not_of(" \t\r\n\f\v");
+  return first != std::string::npos && text[first] == '<';
 }
 
 // An XML calibration file through cv::FileStorage; K and D with the file's rows and columns.
@@ -169,34 +156,6 @@ Eigen::MatrixXd yamlMatrix(const YAML::Node& root, const std::string& path, cons
   return m;
 }
 
-void readOpenCvYamlKeys(const YAML::Node& root, const std::string& path, Eigen::MatrixXd& K, Eigen::MatrixXd& D,
-                        OpenCvIntrinsics& out);
-
-// A YAML calibration file through yaml-cpp: OpenCV's first line "%YAML:1.0" is not YAML 1.2's
-// directive syntax and is skipped; the !!opencv-matrix tags are ignored.
-void readOpenCvYaml(const std::string& path, Eigen::MatrixXd& K, Eigen::MatrixXd& D, OpenCvIntrinsics& out) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw core::InvalidInput(path + ": cannot open for reading");
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  std::string text = buffer.str();
-  if (text.rfind("%YAML", 0) == 0) {
-    const auto eol = text.find('\n');
-    text = eol == std::string::npos ? std::string() : text.substr(eol + 1);
-  }
-  YAML::Node root;
-  try {
-    root = YAML::Load(text);
-  } catch (const YAML::Exception& e) {
-    throw core::InvalidInput(path + ": cannot parse as YAML: " + e.what());
-  }
-  try {  // yaml-cpp throws on a node it cannot use (e.g. InvalidNode): refused, naming the file
-    readOpenCvYamlKeys(root, path, K, D, out);
-  } catch (const YAML::Exception& e) {
-    throw core::InvalidInput(path + ": bad OpenCV calibration YAML: " + e.what());
-  }
-}
-
 // The keys of a parsed YAML calibration file (readOpenCvYaml).
 void readOpenCvYamlKeys(const YAML::Node& root, const std::string& path, Eigen::MatrixXd& K, Eigen::MatrixXd& D,
                         OpenCvIntrinsics& out) {
@@ -224,6 +183,28 @@ void readOpenCvYamlKeys(const YAML::Node& root, const std::string& path, Eigen::
     }
   }
 }
+
+// A YAML calibration file through yaml-cpp: OpenCV's first line "%YAML:1.0" is not YAML 1.2's
+// directive syntax and is skipped; the !!opencv-matrix tags are ignored.
+void readOpenCvYaml(std::string text, const std::string& path, Eigen::MatrixXd& K, Eigen::MatrixXd& D,
+                    OpenCvIntrinsics& out) {
+  if (text.rfind("%YAML", 0) == 0) {
+    const auto eol = text.find('\n');
+    text = eol == std::string::npos ? std::string() : text.substr(eol + 1);
+  }
+  YAML::Node root;
+  try {
+    root = YAML::Load(text);
+  } catch (const YAML::Exception& e) {
+    throw core::InvalidInput(path + ": cannot parse as YAML: " + e.what());
+  }
+  try {  // yaml-cpp throws on a node it cannot use (e.g. InvalidNode): refused, naming the file
+    readOpenCvYamlKeys(root, path, K, D, out);
+  } catch (const YAML::Exception& e) {
+    throw core::InvalidInput(path + ": bad OpenCV calibration YAML: " + e.what());
+  }
+}
+
 }  // namespace
 
 std::string toString(Projection p) {
@@ -304,8 +285,9 @@ OpenCvIntrinsics loadOpenCvIntrinsics(const std::string& path) {
   // OpenCV 4.6's FileStorage parsers read lines as C strings: a NUL byte inside an XML
   // declaration sent its XML parser through a null pointer (fuzz_opencv_yaml). A calibration
   // file is text, so a NUL byte is refused before any parser sees the file.
-  if (const auto offset = firstNulByte(path)) {
-    throw core::InvalidInput(path + ": not a text file (a NUL byte at offset " + std::to_string(*offset) +
+  std::string text = readWholeFile(path);
+  if (const auto offset = text.find('\0'); offset != std::string::npos) {
+    throw core::InvalidInput(path + ": not a text file (a NUL byte at offset " + std::to_string(offset) +
                              "); expected an OpenCV calibration file (YAML or XML)");
   }
   // XML goes to cv::FileStorage. YAML goes to yaml-cpp: OpenCV 4.6's own YAML parser loops forever
@@ -314,10 +296,10 @@ OpenCvIntrinsics loadOpenCvIntrinsics(const std::string& path) {
   // tags aside).
   OpenCvIntrinsics out;
   Eigen::MatrixXd K, D;
-  if (startsLikeXml(path)) {
-    readOpenCvXml(path, K, D, out);
+  if (startsLikeXml(text)) {
+    readOpenCvXml(path, K, D, out);  // cv::FileStorage reads the file itself
   } else {
-    readOpenCvYaml(path, K, D, out);
+    readOpenCvYaml(std::move(text), path, K, D, out);
   }
   if (K.rows() != 3 || K.cols() != 3)
     throw core::InvalidInput(path + ": 'camera_matrix' missing or not a 3x3 matrix");
