@@ -77,10 +77,18 @@ void RollingBallTracker::step(double t, const Eigen::Vector2d& a_xy, const std::
   }
   if (!(t > t_)) throw core::InvalidInput("RollingBallTracker::step: time must increase");
   const double dt = t - t_;
-  // Rediscretised every frame; with the ramp, `hold` is the same step with the newest a_xy held
-  // (Γ u0 + Γ1 u1 with u0 = u1: Γ_ZOH = Γ0 + Γ1), for the predictions beyond t.
+  // Discretised for this interval (from the cache of intervals, see discretised()); with the ramp,
+  // `hold` is the same step with the newest a_xy held (Γ u0 + Γ1 u1 with u0 = u1: Γ_ZOH = Γ0 + Γ1),
+  // for the predictions beyond t.
   const bool ramp = config_.input_hold == InputHold::Ramp;
-  const estimation::LinearTransition tr = ramp ? model.transitionRamp(dt, a_prev_, a_xy) : model.transition(dt, a_xy);
+  const Discretised& step = discretised(dt);
+  estimation::LinearTransition tr = step.tr;
+  tr.u.resize(ramp ? 4 : 2);
+  if (ramp) {
+    tr.u << a_prev_, a_xy;
+  } else {
+    tr.u = a_xy;
+  }
   estimation::LinearTransition hold;
   if (ramp) {
     hold.Phi = tr.Phi;
@@ -90,7 +98,9 @@ void RollingBallTracker::step(double t, const Eigen::Vector2d& a_xy, const std::
   }
   a_prev_ = a_xy;
   if (!stationary_) {
-    estimation::predict(state_, augmented(tr));
+    estimation::LinearTransition aug = step.augmented;
+    aug.u = tr.u;
+    estimation::predict(state_, aug);
     clampState(state_);
   }
   bool fused = false;
@@ -147,6 +157,25 @@ void RollingBallTracker::step(double t, const Eigen::Vector2d& a_xy, const std::
   t_ = t;
   last_dt_ = dt;
   predictions_ = model.predictPositions(x_, ramp ? hold : tr, 0);  // a_xy held beyond t
+}
+
+const RollingBallTracker::Discretised& RollingBallTracker::discretised(double dt) {
+  for (const Discretised& d : discretised_)
+    if (d.dt == dt) return d;  // exact: the same numbers as discretising again
+  Discretised d;
+  d.dt = dt;
+  const Eigen::Vector2d zero = Eigen::Vector2d::Zero();
+  d.tr = config_.input_hold == InputHold::Ramp ? config_.model.transitionRamp(dt, zero, zero)
+                                                : config_.model.transition(dt, zero);
+  d.augmented = augmented(d.tr);
+  if (discretised_.size() < kDiscretisedIntervals) {
+    discretised_.push_back(std::move(d));
+    return discretised_.back();
+  }
+  Discretised& slot = discretised_[next_slot_];  // the oldest entry
+  next_slot_ = (next_slot_ + 1) % kDiscretisedIntervals;
+  slot = std::move(d);
+  return slot;
 }
 
 Eigen::Index RollingBallTracker::stateDim() const { return config_.coloured_sigma > 0.0 ? 8 : 6; }

@@ -38,6 +38,7 @@
 
 #include <Eigen/Core>
 #include <optional>
+#include <cstddef>
 #include <vector>
 
 #include "viewline/estimation/kalman_filter.h"
@@ -120,6 +121,16 @@ public:
   const RollingBallTrackerConfig& config() const { return config_; }
 
 private:
+  // Φ, Γ, Q (and the augmented step) for one interval, without its input. Frame stamps k·T in
+  // floating point give about a dozen distinct intervals (and their multiples after dropped
+  // frames), so each is discretised once: the matrix exponentials were most of a step's cost.
+  // Looked up by exact dt, so the numbers are those of discretising every step.
+  struct Discretised {
+    double dt = 0.0;
+    estimation::LinearTransition tr, augmented;
+  };
+  static constexpr std::size_t kDiscretisedIntervals = 32;
+  const Discretised& discretised(double dt);
   void start(double t, const Eigen::Vector2d& a_xy, const Eigen::Vector2d& y, GateDecision why);
   Eigen::Index stateDim() const;  // 6, or 8 with the coloured measurement error
   estimation::LinearTransition augmented(const estimation::LinearTransition& tr) const;
@@ -132,6 +143,8 @@ private:
   double t_ = 0.0;
   double last_dt_ = 0.02;
   Eigen::Vector2d a_prev_ = Eigen::Vector2d::Zero();  // the last step's a_xy (m/s², for the ramp)
+  std::vector<Discretised> discretised_;  // by interval, at most kDiscretisedIntervals
+  std::size_t next_slot_ = 0;             // the entry replaced next once full
   Eigen::VectorXd x_ = Eigen::VectorXd::Zero(6);
   estimation::StateEstimate state_;
   std::optional<estimation::StationaryFilter> stationary_;
