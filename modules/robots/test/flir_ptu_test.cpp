@@ -342,6 +342,9 @@ TEST(FlirPtu, PositionBeyondTheLimitIsALimitErrorAndHalts) {
     EXPECT_EQ(e.unitError(), PtuErrorClass::PositionLimit);
     EXPECT_NE(std::string(e.what()).find("Maximum allowable Pan position exceeded"), std::string::npos) << e.what();
   }
+  // The driver sends the halt after the error; the emulator's thread counts it when it has read it
+  // (under load that can be after the throw returns here): wait for it, at most 1 s.
+  for (int i = 0; i < 200 && rig.emu.haltsReceived() <= halts; ++i) sleepSeconds(0.005);
   EXPECT_GT(rig.emu.haltsReceived(), halts);
 }
 
